@@ -1,0 +1,194 @@
+#include "bake/bake.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "bake/embree_scene.h"
+#include "bake/grid_caches.h"
+#include "bake/lightmap_caches.h"
+#include "bake/lightmap_charts.h"
+#include "bake/surfel_hierarchy.h"
+#include "bake/surfel_placement.h"
+#include "core/sh.h"
+
+namespace pic {
+
+namespace {
+
+/// Wall-clock timer of one stage that appends to the report when stopped.
+class StageTimer {
+public:
+    StageTimer(BakeReport& report, std::string name)
+        : mReport(report), mName(std::move(name)), mStart(std::chrono::steady_clock::now()) {}
+    void stop() {
+        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - mStart).count();
+        mReport.seconds.emplace_back(mName, s);
+    }
+
+private:
+    BakeReport& mReport;
+    std::string mName;
+    std::chrono::steady_clock::time_point mStart;
+};
+
+// Scene-relative defaults (documented in README): a 1 m box and a 100 m level both get
+// a surfel spacing of 1/64 of their largest extent, 16 grid cells along it and about
+// 8k light-map texels, within the ranges below.
+constexpr double kSurfelSpacingDivisor = 64.0;
+constexpr uint32_t kMinDefaultSurfels = 8192;
+constexpr uint32_t kMaxDefaultSurfels = 131072;
+constexpr float kGridCellsAlongExtent = 16.0f;
+constexpr double kDefaultLightmapTexels = 8192.0;
+constexpr uint32_t kDefaultLinks = 128;
+constexpr uint32_t kDefaultBandsY = 3;
+constexpr uint32_t kDefaultBandsC = 2;
+
+}  // namespace
+
+uint64_t peakMemoryBytes() {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line)) {
+        if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024ull;
+    }
+    return 0;
+}
+
+Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& options,
+                                     std::map<std::string, std::string>& defaults) {
+    const glm::vec3 extent = scene.bounds.extent();
+    const float largest = std::max({extent.x, extent.y, extent.z});
+    if (!(largest > 0.0f) || !(scene.totalArea > 0.0))
+        return fail(ErrorCode::InvalidInput, "scene '{}' has no extent or area to bake", scene.sourcePath);
+    BakeParams p;
+
+    if (options.surfels) {
+        p.surfels = *options.surfels;
+    } else {
+        double spacing = largest / kSurfelSpacingDivisor;
+        double wanted = scene.totalArea / (spacing * spacing);
+        p.surfels = static_cast<uint32_t>(std::clamp(std::round(wanted / 1024.0) * 1024.0,
+                                                     double(kMinDefaultSurfels), double(kMaxDefaultSurfels)));
+        defaults["surfels"] = fmt::format("{:.4g} m² at {:.3g} m spacing (extent/{}), clamped to [{}, {}]",
+                                          scene.totalArea, spacing, kSurfelSpacingDivisor,
+                                          kMinDefaultSurfels, kMaxDefaultSurfels);
+    }
+    if (p.surfels < 2 || p.surfels > (1u << 24))
+        return fail(ErrorCode::InvalidInput, "--surfels must be in [2, 16777216], got {}", p.surfels);
+
+    p.linksPerCache = options.links.value_or(kDefaultLinks);
+    if (!options.links) defaults["links"] = fmt::format("{} (paper 000 moderate setting)", kDefaultLinks);
+    if (p.linksPerCache < 1 || p.linksPerCache > 4096)
+        return fail(ErrorCode::InvalidInput, "--links must be in [1, 4096], got {}", p.linksPerCache);
+
+    p.bandsY = options.bandsY.value_or(kDefaultBandsY);
+    if (!options.bandsY) defaults["bands"] = fmt::format("{}", kDefaultBandsY);
+    if (p.bandsY < 1 || p.bandsY > static_cast<uint32_t>(kMaxShBands))
+        return fail(ErrorCode::InvalidInput, "--bands must be in [1, {}], got {}", kMaxShBands, p.bandsY);
+    p.bandsC = options.bandsC.value_or(std::min(kDefaultBandsC, p.bandsY));
+    if (!options.bandsC) defaults["chroma_bands"] = fmt::format("{} (≤ bands)", p.bandsC);
+    if (p.bandsC < 1 || p.bandsC > p.bandsY)
+        return fail(ErrorCode::InvalidInput, "--chroma-bands must be in [1, --bands = {}], got {}", p.bandsY, p.bandsC);
+
+    if (options.gridCell) {
+        p.gridCell = *options.gridCell;
+    } else {
+        p.gridCell = largest / kGridCellsAlongExtent;
+        defaults["grid_cell"] = fmt::format("{:.3g} m = largest extent {:.3g} m / {}", p.gridCell,
+                                            largest, kGridCellsAlongExtent);
+    }
+    if (!(p.gridCell > 0.0f) || !std::isfinite(p.gridCell))
+        return fail(ErrorCode::InvalidInput, "--grid-cell must be a positive number of metres, got {}", p.gridCell);
+
+    if (options.lightmapTexel) {
+        p.lightmapTexel = *options.lightmapTexel;
+    } else {
+        p.lightmapTexel = static_cast<float>(std::sqrt(scene.totalArea / kDefaultLightmapTexels));
+        defaults["lightmap_texel"] = fmt::format("{:.3g} m = sqrt({:.4g} m² / {} texels)", p.lightmapTexel,
+                                                 scene.totalArea, kDefaultLightmapTexels);
+    }
+    if (!(p.lightmapTexel > 0.0f) || !std::isfinite(p.lightmapTexel))
+        return fail(ErrorCode::InvalidInput, "--lightmap-texel must be a positive number of metres, got {}",
+                    p.lightmapTexel);
+
+    p.linkMode = options.linkMode;
+    p.hierarchy = options.hierarchy;
+    p.linkSamples = options.linkSamples;
+    if (p.linkSamples < 1 || p.linkSamples > 1024)
+        return fail(ErrorCode::InvalidInput, "--link-samples must be in [1, 1024], got {}", p.linkSamples);
+    p.relaxIterations = options.relaxIterations;
+    p.seed = options.seed;
+    return p;
+}
+
+Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report) {
+    BakeData bake;
+    PIC_TRY_ASSIGN(bake.params, resolveBakeParams(scene, options, bake.defaults));
+    const BakeParams& p = bake.params;
+    bake.sceneHash = scene.hash;
+
+    StageTimer raysTimer(report, "rays");
+    PIC_TRY_ASSIGN(std::unique_ptr<EmbreeScene> rays, EmbreeScene::create(scene));
+    raysTimer.stop();
+
+    StageTimer surfelTimer(report, "surfels");
+    PIC_TRY_ASSIGN(std::vector<Surfel> surfels,
+                   placeSurfels(scene, SurfelParams{p.surfels, p.relaxIterations, 16, p.seed}));
+    surfelTimer.stop();
+
+    StageTimer hierarchyTimer(report, "hierarchy");
+    HierarchyParams hierarchyParams;
+    hierarchyParams.method = p.hierarchy;
+    hierarchyParams.sceneExtent = scene.bounds.diagonal();
+    PIC_TRY_ASSIGN(SurfelHierarchy hierarchy, buildHierarchy(std::move(surfels), hierarchyParams));
+    bake.surfels = std::move(hierarchy.surfels);
+    bake.nodes = std::move(hierarchy.nodes);
+    bake.levelOffsets = std::move(hierarchy.levelOffsets);
+    hierarchyTimer.stop();
+
+    StageTimer gridTimer(report, "grid_caches");
+    GridCacheParams gridParams;
+    gridParams.cellSize = p.gridCell;
+    PIC_TRY_ASSIGN(GridCacheSet grid, placeGridCaches(scene, *rays, 0, gridParams));
+    bake.grid = std::move(grid.layout);
+    bake.caches = std::move(grid.caches);
+    report.gridInsideSolid = grid.insideSolid;
+    report.gridDuplicates = grid.duplicates;
+    gridTimer.stop();
+
+    StageTimer lightmapTimer(report, "lightmap");
+    LightmapChartParams chartParams;
+    chartParams.texelSize = p.lightmapTexel;
+    PIC_TRY_ASSIGN(LightmapCharts charts, buildLightmapCharts(scene, chartParams));
+    LightmapCacheParams lightmapParams;
+    lightmapParams.texelSize = p.lightmapTexel;
+    PIC_TRY_ASSIGN(LightmapCacheSet lightmap,
+                   placeLightmapCaches(scene, *rays, std::move(charts),
+                                       static_cast<uint32_t>(bake.caches.size()), lightmapParams));
+    bake.lightmap = std::move(lightmap.layout);
+    bake.caches.insert(bake.caches.end(), lightmap.caches.begin(), lightmap.caches.end());
+    report.lightmapDuplicates = lightmap.duplicateTexels;
+    report.lightmapRelocated = lightmap.relocated;
+    report.lightmapRejected = lightmap.rejected;
+    lightmapTimer.stop();
+
+    StageTimer linkTimer(report, "links");
+    LinkParams linkParams;
+    linkParams.linksPerCache = p.linksPerCache;
+    linkParams.mode = p.linkMode;
+    linkParams.bands = p.bandsY;
+    linkParams.samplesPerNode = p.linkSamples;
+    linkParams.seed = p.seed;
+    PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams));
+    bake.links = std::move(links.links);
+    report.links = links.stats;
+    linkTimer.stop();
+
+    report.peakMemoryBytes = peakMemoryBytes();
+    return bake;
+}
+
+}  // namespace pic

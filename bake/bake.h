@@ -1,0 +1,54 @@
+#pragma once
+/// The whole precomputation (paper 000 §4): surfels, hierarchy, caches, links.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bake/link_generation.h"
+#include "core/bake_data.h"
+#include "core/error.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// What the user asked for; unset values get scene-dependent defaults.
+struct BakeOptions {
+    std::optional<uint32_t> surfels;
+    std::optional<uint32_t> links;
+    std::optional<uint32_t> bandsY;
+    std::optional<uint32_t> bandsC;
+    std::optional<float> gridCell;
+    std::optional<float> lightmapTexel;
+    LinkMode linkMode = LinkMode::Rtp;
+    HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
+    uint32_t linkSamples = 16;
+    uint32_t relaxIterations = 4;
+    uint64_t seed = 1;
+};
+
+/// Timings and counts of one bake, for the summary and benchmarks.
+struct BakeReport {
+    std::vector<std::pair<std::string, double>> seconds;  ///< per stage, in order
+    LinkStats links;
+    uint32_t gridInsideSolid = 0;
+    uint32_t gridDuplicates = 0;
+    uint32_t lightmapDuplicates = 0;
+    uint32_t lightmapRelocated = 0;
+    uint32_t lightmapRejected = 0;
+    uint64_t peakMemoryBytes = 0;
+};
+
+/// Resolves unset options from the scene's extent and area; `defaults` says how.
+Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& options,
+                                     std::map<std::string, std::string>& defaults);
+
+/// Runs every bake stage on a loaded scene.
+Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report);
+
+/// Peak resident memory of this process so far, in bytes (0 if unknown).
+uint64_t peakMemoryBytes();
+
+}  // namespace pic

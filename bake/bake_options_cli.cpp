@@ -1,0 +1,34 @@
+#include "bake/bake_options_cli.h"
+
+namespace pic {
+
+void BakeOptionFlags::addTo(CLI::App& command) {
+    mSurfelsOption = command.add_option("--surfels", mSurfels, "surfel count nS (default: from scene area and extent)");
+    mLinksOption = command.add_option("--links", mLinks, "links per cache nL (default 128)");
+    mBandsOption = command.add_option("--bands", mBands, "SH bands for luma lY, 1-8 (default 3)");
+    mChromaOption = command.add_option("--chroma-bands", mChromaBands, "SH bands for chroma lC <= lY (default 2)");
+    mGridOption = command.add_option("--grid-cell", mGridCell, "grid cell size in metres (default: largest extent / 16)");
+    mTexelOption = command.add_option("--lightmap-texel", mLightmapTexel,
+                                      "light-map texel size in metres (default: about 8k texels over the scene's area)");
+    command.add_option("--link-mode", mLinkMode, "sh or rtp (default rtp)")->check(CLI::IsMember({"sh", "rtp"}));
+    command.add_option("--hierarchy", mHierarchy, "agglomerative or kdtree (default agglomerative)")
+        ->check(CLI::IsMember({"agglomerative", "kdtree"}));
+    command.add_option("--link-samples", mOptions.linkSamples, "visibility rays per node estimate (default 16)");
+    command.add_option("--relax", mOptions.relaxIterations, "surfel relaxation iterations (default 4)");
+    command.add_option("--seed", mOptions.seed, "random seed (default 1)");
+}
+
+BakeOptions BakeOptionFlags::toOptions() const {
+    BakeOptions options = mOptions;
+    if (*mSurfelsOption) options.surfels = mSurfels;
+    if (*mLinksOption) options.links = mLinks;
+    if (*mBandsOption) options.bandsY = mBands;
+    if (*mChromaOption) options.bandsC = mChromaBands;
+    if (*mGridOption) options.gridCell = mGridCell;
+    if (*mTexelOption) options.lightmapTexel = mLightmapTexel;
+    options.linkMode = mLinkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
+    options.hierarchy = mHierarchy == "kdtree" ? HierarchyMethod::KdTree : HierarchyMethod::Agglomerative;
+    return options;
+}
+
+}  // namespace pic

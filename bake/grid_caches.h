@@ -1,0 +1,33 @@
+#pragma once
+/// Grid cache placement (paper 000 §4.4, paper 001 §5): caches at the vertices of grid
+/// cells that contain or touch geometry, dilated by one cell, never inside solid geometry.
+
+#include <cstdint>
+#include <vector>
+
+#include "bake/embree_scene.h"
+#include "core/bake_data.h"
+#include "core/error.h"
+#include "core/scene.h"
+
+namespace pic {
+
+struct GridCacheParams {
+    float cellSize = 0.0f;        ///< metres
+    uint32_t insideRays = 16;     ///< rays per vertex for the inside-solid test
+    uint64_t maxVertices = 64ull << 20;  ///< refuse grids larger than this
+};
+
+/// The grid layout and its unique caches.
+struct GridCacheSet {
+    GridLayout layout;
+    std::vector<Cache> caches;     ///< unique grid caches, kind = grid
+    uint32_t insideSolid = 0;      ///< needed vertices found inside geometry
+    uint32_t duplicates = 0;       ///< inside vertices that copy a neighbour's cache
+};
+
+/// Places grid caches; their indices start at `firstCacheIndex`.
+Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays,
+                                     uint32_t firstCacheIndex, const GridCacheParams& params);
+
+}  // namespace pic

@@ -1,0 +1,274 @@
+#include "bake/link_generation.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <queue>
+
+#include "core/color.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/sampling.h"
+#include "core/sh.h"
+
+namespace pic {
+
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+/// A visible surfel sample of a node: direction from the cache and its solid angle
+/// (already multiplied by the node's sampling weight).
+struct VisibleSample {
+    glm::vec3 direction;
+    float solidAngle;
+};
+
+/// The estimate of one node's importance for one cache.
+struct NodeEstimate {
+    uint32_t node = 0;
+    float visible = 0.0f;      ///< estimated visible solid angle, sr
+    float unoccluded = 0.0f;   ///< estimated solid angle ignoring occlusion, sr
+    glm::vec3 directionSum{0.0f};
+    uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
+    uint32_t sampleCount = 0;
+    float priority = 0.0f;     ///< refinement order: larger first
+    bool exact = false;        ///< every surfel of the node was tested
+};
+
+/// Per-thread scratch, reused across caches to avoid allocation in the hot loop.
+struct Scratch {
+    std::vector<NodeEstimate> estimates;
+    std::vector<VisibleSample> samples;
+};
+
+class CacheLinker {
+public:
+    CacheLinker(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
+                const std::vector<Node>& nodes, const LinkParams& params)
+        : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params),
+          mEpsilon(rays.epsilon()) {}
+
+    /// Fills the nL links of cache `c` starting at `out`; returns rays cast.
+    uint64_t link(uint32_t cacheIndex, const Cache& cache, Scratch& scratch,
+                  std::vector<uint32_t>& chosen) const {
+        scratch.estimates.clear();
+        scratch.samples.clear();
+        chosen.clear();
+        uint64_t rays = 0;
+        const bool hemisphere = cache.kind == gpu::kCacheKindLightmap;
+        Rng rng(mParams.seed, cacheIndex);
+
+        auto evaluate = [&](uint32_t node) {
+            NodeEstimate e = estimate(node, cache, hemisphere, rng, scratch.samples, rays);
+            scratch.estimates.push_back(e);
+            return static_cast<uint32_t>(scratch.estimates.size() - 1);
+        };
+        // Max-heap on priority; ties broken by node index for determinism.
+        auto lower = [&](uint32_t a, uint32_t b) {
+            const NodeEstimate& x = scratch.estimates[a];
+            const NodeEstimate& y = scratch.estimates[b];
+            return x.priority != y.priority ? x.priority < y.priority : x.node > y.node;
+        };
+        std::priority_queue<uint32_t, std::vector<uint32_t>, decltype(lower)> open(lower);
+        std::vector<uint32_t> closed;  // leaves: cannot be refined
+        uint32_t linkable = 0;         // estimates in the cut with visible solid angle
+
+        auto admit = [&](uint32_t e) {
+            const NodeEstimate& est = scratch.estimates[e];
+            if (est.visible > 0.0f) ++linkable;
+            // A node whose every surfel is hidden is dropped: senders the cache cannot see
+            // are never linked. Sampled nodes without a visible sample stay open while they
+            // may still hide visible parts.
+            if (est.visible <= 0.0f && est.exact) return;
+            if (mNodes[est.node].left == kNoNode) {
+                if (est.visible > 0.0f) closed.push_back(e);
+            } else {
+                open.push(e);
+            }
+        };
+
+        admit(evaluate(static_cast<uint32_t>(mNodes.size() - 1)));
+        while (linkable < mParams.linksPerCache && !open.empty()) {
+            uint32_t top = open.top();
+            open.pop();
+            if (scratch.estimates[top].visible > 0.0f) --linkable;
+            const Node& node = mNodes[scratch.estimates[top].node];
+            admit(evaluate(node.left));
+            admit(evaluate(node.right));
+        }
+        while (!open.empty()) {
+            if (scratch.estimates[open.top()].visible > 0.0f) closed.push_back(open.top());
+            open.pop();
+        }
+        chosen = std::move(closed);
+        // Links sorted by node index: neighbouring caches then read nodes in a similar order.
+        std::sort(chosen.begin(), chosen.end(), [&](uint32_t a, uint32_t b) {
+            return scratch.estimates[a].node < scratch.estimates[b].node;
+        });
+        return rays;
+    }
+
+    const NodeEstimate& estimateOf(const Scratch& scratch, uint32_t e) const {
+        return scratch.estimates[e];
+    }
+
+private:
+    /// Estimates a node's solid angle from up to K of its surfels (all of them when it has
+    /// at most K), stratified over its contiguous surfel range, one occlusion ray each.
+    NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, bool hemisphere, Rng& rng,
+                          std::vector<VisibleSample>& samples, uint64_t& rays) const {
+        const Node& node = mNodes[nodeIndex];
+        NodeEstimate e;
+        e.node = nodeIndex;
+        e.sampleBegin = static_cast<uint32_t>(samples.size());
+        const uint32_t k = mParams.samplesPerNode;
+        const uint32_t taken = std::min(node.surfelCount, k);
+        const float weight = static_cast<float>(node.surfelCount) / static_cast<float>(taken);
+        e.exact = node.surfelCount <= k;
+        for (uint32_t j = 0; j < taken; ++j) {
+            uint32_t offset = e.exact ? j
+                                      : std::min(node.surfelCount - 1,
+                                                 static_cast<uint32_t>((j + rng.uniform()) * weight));
+            const Surfel& s = mSurfels[node.firstSurfel + offset];
+            glm::vec3 v = s.position - cache.position;
+            float d2 = glm::dot(v, v);
+            if (!(d2 > 0.0f)) continue;
+            float d = std::sqrt(d2);
+            glm::vec3 w = v / d;
+            float cosSender = -glm::dot(s.normal, w);
+            if (cosSender <= 0.0f) continue;  // the surfel faces away from the cache
+            if (hemisphere && glm::dot(cache.normal, w) <= 0.0f) continue;
+            float omega = weight * discSolidAngle(d, s.radius, cosSender);
+            e.unoccluded += omega;
+            // The ray stops just short of the surfel's own surface.
+            float tFar = d * (1.0f - 1e-4f) - 4.0f * mEpsilon;
+            ++rays;
+            if (tFar > mEpsilon && mRays.occluded(cache.position, w, mEpsilon, tFar)) continue;
+            e.visible += omega;
+            e.directionSum += omega * w;
+            samples.push_back({w, omega});
+        }
+        e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
+        // An unlucky sample set may miss the visible part of a large node: give such nodes
+        // the prior that up to 1/(K+1) of them might be visible so they are still refined.
+        e.priority = e.visible > 0.0f || e.exact ? e.visible
+                                                 : e.unoccluded / static_cast<float>(k + 1);
+        return e;
+    }
+
+    const EmbreeScene& mRays;
+    const std::vector<Surfel>& mSurfels;
+    const std::vector<Node>& mNodes;
+    const LinkParams& mParams;
+    float mEpsilon;
+};
+
+}  // namespace
+
+float discSolidAngle(float distance, float radius, float cosTheta) {
+    // On-axis disc: 2π(1 − d/√(d² + r²)), written as 2π r² / (√(d²+r²)(√(d²+r²) + d))
+    // to stay accurate when the disc is far away.
+    float h = std::sqrt(distance * distance + radius * radius);
+    return 2.0f * kPi * radius * radius / (h * (h + distance)) * cosTheta;
+}
+
+Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
+                                 const std::vector<Node>& nodes, const std::vector<Cache>& caches,
+                                 const LinkParams& params) {
+    if (params.linksPerCache == 0)
+        return fail(ErrorCode::InvalidInput, "links per cache must be positive, got {}", params.linksPerCache);
+    if (params.mode == LinkMode::Sh && (params.bands < 1 || params.bands > kMaxShBands))
+        return fail(ErrorCode::InvalidInput, "SH links need 1..{} bands, got {}", kMaxShBands, params.bands);
+    if (params.samplesPerNode == 0)
+        return fail(ErrorCode::InvalidInput, "samples per node must be positive, got {}", params.samplesPerNode);
+    if (nodes.empty() || surfels.empty() || nodes.size() != 2 * surfels.size() - 1)
+        return fail(ErrorCode::InvalidInput, "hierarchy has {} nodes for {} surfels", nodes.size(), surfels.size());
+
+    const uint32_t nL = params.linksPerCache;
+    const size_t nC = caches.size();
+    const int bands = static_cast<int>(params.bands);
+    const int coefficients = shCount(bands);
+
+    LinkResult result;
+    LinkSet& links = result.links;
+    links.mode = params.mode;
+    links.linksPerCache = nL;
+    links.bands = params.mode == LinkMode::Sh ? params.bands : 0;
+    if (params.mode == LinkMode::Rtp) {
+        links.rtp.assign(nC * nL, RtpLink{0, 0.0f, 0, 0.0f});
+    } else {
+        links.shNodes.assign(nC * nL, 0u);
+        links.shCoefficients.assign(nC * nL * coefficients, 0);
+    }
+    result.visibleSolidAngle.assign(nC * nL, 0.0f);
+
+    CacheLinker linker(rays, surfels, nodes, params);
+    std::atomic<uint64_t> totalRays{0};
+    std::atomic<uint32_t> blind{0}, clamped{0};
+    std::vector<double> solidAngleSum(nC, 0.0);
+    std::vector<uint32_t> used(nC, 0);
+    Progress progress("links", nC);
+    parallelForChunks(0, nC, [&](size_t begin, size_t end) {
+        thread_local Scratch scratch;
+        thread_local std::vector<uint32_t> chosen;
+        float basis[kMaxShBands * kMaxShBands];
+        std::vector<float> sh(coefficients);
+        uint64_t rayCount = 0;
+        for (size_t c = begin; c < end; ++c) {
+            rayCount += linker.link(static_cast<uint32_t>(c), caches[c], scratch, chosen);
+            if (chosen.empty()) blind.fetch_add(1, std::memory_order_relaxed);
+            used[c] = static_cast<uint32_t>(chosen.size());
+            for (size_t l = 0; l < chosen.size(); ++l) {
+                const NodeEstimate& e = linker.estimateOf(scratch, chosen[l]);
+                const Node& node = nodes[e.node];
+                const size_t slot = c * nL + l;
+                result.visibleSolidAngle[slot] = e.visible;
+                solidAngleSum[c] += e.visible;
+                // Flux → radiance of the sender: B/π = Φ / (π·A_node) (paper 000 §4.1).
+                const float toRadiance = 1.0f / (kPi * node.area);
+                if (params.mode == LinkMode::Rtp) {
+                    RtpLink& link = links.rtp[slot];
+                    link.node = e.node;
+                    link.factor = e.visible / e.unoccluded * toRadiance;
+                    link.directionOct = encodeOctahedral(glm::normalize(e.directionSum));
+                    link.oneMinusCosAlpha = std::min(2.0f, e.unoccluded / (2.0f * kPi));
+                } else {
+                    // Eq. 2: c_i = 1/(π A) Σ_j y_i(ω_j) V_j Ω_j over the node's visible samples.
+                    std::fill(sh.begin(), sh.end(), 0.0f);
+                    for (uint32_t j = 0; j < e.sampleCount; ++j) {
+                        const VisibleSample& s = scratch.samples[e.sampleBegin + j];
+                        shEvaluate(bands, s.direction, basis);
+                        for (int i = 0; i < coefficients; ++i) sh[i] += s.solidAngle * basis[i];
+                    }
+                    links.shNodes[slot] = e.node;
+                    uint16_t* out = &links.shCoefficients[slot * coefficients];
+                    for (int i = 0; i < coefficients; ++i) {
+                        float value = sh[i] * toRadiance;
+                        if (std::abs(value) > 65504.0f) clamped.fetch_add(1, std::memory_order_relaxed);
+                        out[i] = floatToHalfClamped(value);
+                    }
+                }
+            }
+        }
+        totalRays.fetch_add(rayCount, std::memory_order_relaxed);
+        progress.advance(end - begin);
+    }, 8);
+    progress.finish();
+
+    LinkStats& stats = result.stats;
+    stats.rays = totalRays.load();
+    stats.blindCaches = blind.load();
+    stats.clampedCoefficients = clamped.load();
+    double sum = 0.0, usedSum = 0.0;
+    for (size_t c = 0; c < nC; ++c) {
+        sum += solidAngleSum[c];
+        usedSum += used[c];
+    }
+    stats.meanVisibleSolidAngle = nC ? sum / nC : 0.0;
+    stats.meanLinksUsed = nC ? usedSum / nC : 0.0;
+    return result;
+}
+
+}  // namespace pic

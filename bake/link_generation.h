@@ -1,0 +1,48 @@
+#pragma once
+/// Link generation (paper 000 §4.5-4.6): for every cache, a cut of nL hierarchy nodes
+/// refined top-down by visible solid angle (Embree occlusion rays), stored SH-projected
+/// (eq. 2) or runtime-projected (direction, cone, scalar factor).
+
+#include <cstdint>
+#include <vector>
+
+#include "bake/embree_scene.h"
+#include "core/bake_data.h"
+#include "core/error.h"
+
+namespace pic {
+
+struct LinkParams {
+    uint32_t linksPerCache = 128;  ///< nL
+    LinkMode mode = LinkMode::Rtp;
+    uint32_t bands = 3;            ///< SH bands per link in SH mode
+    uint32_t samplesPerNode = 16;  ///< visibility rays that estimate one node
+    uint64_t seed = 1;
+};
+
+/// Per-link diagnostics that the bake file does not keep (for tests and statistics).
+struct LinkStats {
+    double meanVisibleSolidAngle = 0.0;  ///< sr, mean over caches of Σ links' visible solid angle
+    double meanLinksUsed = 0.0;          ///< non-padding links per cache
+    uint64_t rays = 0;                   ///< occlusion rays cast
+    uint32_t blindCaches = 0;            ///< caches that see no surfel at all
+    uint32_t clampedCoefficients = 0;    ///< SH coefficients beyond the half-float range
+};
+
+/// Everything generateLinks returns.
+struct LinkResult {
+    LinkSet links;
+    LinkStats stats;
+    std::vector<float> visibleSolidAngle;  ///< per link (nC·nL), sr; 0 for padding
+};
+
+/// Builds the links of every cache against the hierarchy (surfels in leaf order).
+Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
+                                 const std::vector<Node>& nodes, const std::vector<Cache>& caches,
+                                 const LinkParams& params);
+
+/// Solid angle (sr) of a disc of radius r seen from distance d at cosine cosTheta between
+/// its normal and the direction to the viewer: the on-axis disc formula scaled by cosTheta.
+float discSolidAngle(float distance, float radius, float cosTheta);
+
+}  // namespace pic

@@ -1,0 +1,218 @@
+#include "bake/picbake_cli.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "bake/bake_options_cli.h"
+#include "core/bake_file.h"
+#include "core/gltf_loader.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+
+namespace pic {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+const char* toString(LinkMode mode) { return mode == LinkMode::Sh ? "sh" : "rtp"; }
+const char* toString(HierarchyMethod method) {
+    return method == HierarchyMethod::KdTree ? "kdtree" : "agglomerative";
+}
+
+std::string humanBytes(uint64_t bytes) {
+    if (bytes >= (1ull << 30)) return fmt::format("{:.2f} GiB", bytes / double(1ull << 30));
+    if (bytes >= (1ull << 20)) return fmt::format("{:.2f} MiB", bytes / double(1ull << 20));
+    if (bytes >= (1ull << 10)) return fmt::format("{:.1f} KiB", bytes / double(1ull << 10));
+    return fmt::format("{} B", bytes);
+}
+
+/// Stage timings live beside the bake, so the bake itself stays byte-identical across runs.
+std::string timingsPath(const std::string& bakePath) { return bakePath + ".timings.json"; }
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picbake: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+int runBakeCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options) {
+    using Clock = std::chrono::steady_clock;
+    auto start = Clock::now();
+    auto loaded = loadScene(scenePath);
+    if (!loaded) return reportError(loaded.error());
+    const Scene& scene = *loaded;
+    double loadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+
+    BakeReport report;
+    report.seconds.emplace_back("load", loadSeconds);
+    auto bake = runBake(scene, options, report);
+    if (!bake) return reportError(bake.error());
+
+    auto writeStart = Clock::now();
+    if (auto written = writeBakeFile(outPath, *bake); !written) return reportError(written.error());
+    report.seconds.emplace_back("write", std::chrono::duration<double>(Clock::now() - writeStart).count());
+
+    Json timings;
+    timings["seconds"] = Json::object();
+    double total = 0.0;
+    for (const auto& [stage, s] : report.seconds) {
+        timings["seconds"][stage] = s;
+        total += s;
+    }
+    timings["seconds_total"] = total;
+    timings["peak_memory_bytes"] = report.peakMemoryBytes;
+    timings["threads"] = workerCount();
+    {
+        std::string tmp = timingsPath(outPath) + ".tmp";
+        std::ofstream out(tmp);
+        out << timings.dump(2) << "\n";
+        out.close();
+        std::error_code ec;
+        std::filesystem::rename(tmp, timingsPath(outPath), ec);
+        if (!out || ec) std::fprintf(stderr, "picbake: warning: could not write %s\n", timingsPath(outPath).c_str());
+    }
+
+    auto info = inspectBakeFile(outPath);
+    if (!info) return reportError(info.error());
+    const BakeParams& p = bake->params;
+    auto withDefault = [&](const char* key, const std::string& value) {
+        auto it = bake->defaults.find(key);
+        return it == bake->defaults.end() ? value : fmt::format("{}  (default: {})", value, it->second);
+    };
+    fmt::print("pic bake: {} -> {}\n", scenePath, outPath);
+    fmt::print("  scene           {} triangles, {} materials, {} lights, {} cameras, area {:.4g} m², "
+               "extent {:.3g} x {:.3g} x {:.3g} m\n",
+               scene.triangles.size(), scene.materials.size(), scene.lights.size(), scene.cameras.size(),
+               scene.totalArea, scene.bounds.extent().x, scene.bounds.extent().y, scene.bounds.extent().z);
+    fmt::print("  surfels nS      {}\n", withDefault("surfels", std::to_string(p.surfels)));
+    fmt::print("  hierarchy       {}, {} nodes, {} levels\n", toString(p.hierarchy), bake->nodes.size(),
+               bake->levelOffsets.size() - 1);
+    fmt::print("  grid cell       {}\n", withDefault("grid_cell", fmt::format("{:.4g} m", p.gridCell)));
+    fmt::print("  grid caches     {} vertices of {}x{}x{}, {} inside solid geometry ({} copy a neighbour)\n",
+               info->gridCaches, bake->grid.dims.x, bake->grid.dims.y, bake->grid.dims.z,
+               report.gridInsideSolid, report.gridDuplicates);
+    fmt::print("  lightmap texel  {}\n", withDefault("lightmap_texel", fmt::format("{:.4g} m", p.lightmapTexel)));
+    fmt::print("  lightmap        {}x{} atlas, {} charts, {} texels with a cache ({} duplicates), "
+               "{} caches relocated, {} rejected behind geometry\n",
+               bake->lightmap.width, bake->lightmap.height, bake->lightmap.chartCount, info->lightmapCaches,
+               report.lightmapDuplicates, report.lightmapRelocated, report.lightmapRejected);
+    fmt::print("  unique caches   {}\n", bake->caches.size());
+    fmt::print("  links nL        {}\n", withDefault("links", std::to_string(p.linksPerCache)));
+    fmt::print("  link mode       {}, {} samples per node, {:.1f} links used per cache, {} blind caches, "
+               "{:.3g} sr visible per cache, {:.3g} M rays\n",
+               toString(p.linkMode), p.linkSamples, report.links.meanLinksUsed, report.links.blindCaches,
+               report.links.meanVisibleSolidAngle, report.links.rays / 1e6);
+    fmt::print("  bands           y {}, c {}{}\n", p.bandsY, p.bandsC,
+               bake->defaults.count("bands") ? "  (default)" : "");
+    fmt::print("  seed            {}\n", p.seed);
+    std::string sections;
+    for (const auto& [name, bytes] : info->sectionBytes)
+        sections += fmt::format("{}{} {}", sections.empty() ? "" : ", ", name, humanBytes(bytes));
+    fmt::print("  bytes           {} total: {}\n", humanBytes(info->fileSize), sections);
+    std::string stages;
+    for (const auto& [stage, s] : report.seconds)
+        stages += fmt::format("{}{} {:.2f}", stages.empty() ? "" : ", ", stage, s);
+    fmt::print("  seconds         {} (total {:.2f}) on {} threads\n", stages, total, workerCount());
+    fmt::print("  peak memory     {}\n", humanBytes(report.peakMemoryBytes));
+    if (report.links.clampedCoefficients)
+        fmt::print("  warning         {} SH link coefficients exceeded the half-float range and were clamped\n",
+                   report.links.clampedCoefficients);
+    return 0;
+}
+
+int runInfoCommand(const std::string& bakePath, bool json) {
+    auto info = inspectBakeFile(bakePath);
+    if (!info) return reportError(info.error());
+    Json seconds = Json::object();
+    if (std::ifstream in(timingsPath(bakePath)); in) {
+        Json timings = Json::parse(in, nullptr, false);
+        if (!timings.is_discarded() && timings.contains("seconds")) seconds = timings["seconds"];
+    }
+    const BakeParams& p = info->params;
+    Json out;
+    out["format_version"] = info->formatVersion;
+    out["scene_hash"] = fmt::format("{:016x}", info->sceneHash);
+    out["surfels"] = info->surfels;
+    out["nodes"] = info->nodes;
+    out["caches"] = {{"grid", info->gridCaches}, {"lightmap", info->lightmapCaches}, {"unique", info->caches}};
+    out["links_per_cache"] = info->linksPerCache;
+    out["link_mode"] = toString(p.linkMode);
+    out["bands"] = {{"y", p.bandsY}, {"c", p.bandsC}};
+    out["bytes"] = Json::object();
+    for (const auto& [name, bytes] : info->sectionBytes) out["bytes"][name] = bytes;
+    out["file_bytes"] = info->fileSize;
+    out["seconds"] = seconds;
+    out["params"] = {{"grid_cell", p.gridCell}, {"lightmap_texel", p.lightmapTexel},
+                     {"hierarchy", toString(p.hierarchy)}, {"link_samples", p.linkSamples},
+                     {"relax_iterations", p.relaxIterations}, {"seed", p.seed}};
+    out["defaults"] = Json::object();
+    for (const auto& [key, how] : info->defaults) out["defaults"][key] = how;
+    if (json) {
+        std::cout << out.dump(2) << "\n";
+        return 0;
+    }
+    fmt::print("{}: pic bake format {}, scene hash {}\n", bakePath, info->formatVersion,
+               out["scene_hash"].get<std::string>());
+    fmt::print("  surfels {}, nodes {}\n", info->surfels, info->nodes);
+    fmt::print("  caches: {} unique, {} grid vertices, {} light-map texels\n", info->caches,
+               info->gridCaches, info->lightmapCaches);
+    fmt::print("  links: {} per cache, {}, bands y {} c {}\n", info->linksPerCache, toString(p.linkMode),
+               p.bandsY, p.bandsC);
+    fmt::print("  grid cell {:.4g} m, light-map texel {:.4g} m, hierarchy {}, seed {}\n", p.gridCell,
+               p.lightmapTexel, toString(p.hierarchy), p.seed);
+    for (const auto& [name, bytes] : info->sectionBytes) fmt::print("  section {:<16} {}\n", name, humanBytes(bytes));
+    fmt::print("  file {}\n", humanBytes(info->fileSize));
+    for (const auto& [stage, s] : seconds.items()) fmt::print("  stage {:<14} {:.2f} s\n", stage, s.get<double>());
+    return 0;
+}
+
+}  // namespace
+
+int picbakeMain(int argc, char** argv) {
+    CLI::App app{"picbake: precomputes surfels, hierarchy, caches and links of a glTF scene"};
+    app.require_subcommand(1);
+    int threads = 0;
+    bool quiet = false;
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+    app.add_flag("--quiet", quiet, "no progress bars");
+
+    CLI::App* bakeCommand = app.add_subcommand("bake", "bake a glTF 2.0 scene (.gltf or .glb)");
+    std::string scenePath, outPath;
+    BakeOptionFlags bakeFlags;
+    bakeCommand->add_option("scene", scenePath, "scene file (.gltf or .glb)")->required();
+    bakeCommand->add_option("-o,--out", outPath, "bake file to write (.pic)")->required();
+    bakeFlags.addTo(*bakeCommand);
+
+    CLI::App* infoCommand = app.add_subcommand("info", "describe a bake file");
+    std::string infoPath;
+    bool json = false;
+    infoCommand->add_option("bake", infoPath, "bake file (.pic)")->required();
+    infoCommand->add_flag("--json", json, "print one JSON object");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+    setWorkerCount(threads);
+    Progress::setEnabled(!quiet);
+
+    if (bakeCommand->parsed()) {
+        return runBakeCommand(scenePath, outPath, bakeFlags.toOptions());
+    }
+    return runInfoCommand(infoPath, json);
+}
+
+}  // namespace pic

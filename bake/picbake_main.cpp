@@ -1,0 +1,3 @@
+#include "bake/picbake_cli.h"
+
+int main(int argc, char** argv) { return pic::picbakeMain(argc, argv); }

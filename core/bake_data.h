@@ -1,0 +1,92 @@
+#pragma once
+/// Everything a bake produces, in memory. core/bake_file.h writes and reads it
+/// (ARCHITECTURE.md §6); the runtime uploads its arrays to the GPU.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "shaders/shared/bake_layout.h"
+
+namespace pic {
+
+using gpu::Cache;
+using gpu::kNoCache;
+using gpu::kNoNode;
+using gpu::Node;
+using gpu::RtpLink;
+using gpu::Surfel;
+
+/// How links store their transport factor (paper 000 §3.1 and §4.6).
+enum class LinkMode : uint32_t {
+    Sh = 0,   ///< SH-projected: lY² half-float coefficients per link
+    Rtp = 1,  ///< runtime-projected: direction, cone and scalar factor per link
+};
+
+/// How the surfel hierarchy is built (paper 000 §4.3).
+enum class HierarchyMethod : uint32_t {
+    Agglomerative = 0,  ///< clustering with the paper's metric
+    KdTree = 1,         ///< median-split kd-tree (fast)
+};
+
+/// The parameters a bake was made with, after defaults were resolved.
+struct BakeParams {
+    uint32_t surfels = 0;            ///< nS
+    uint32_t linksPerCache = 0;      ///< nL
+    uint32_t bandsY = 3;             ///< lY
+    uint32_t bandsC = 3;             ///< lC ≤ lY
+    float gridCell = 0.0f;           ///< metres
+    float lightmapTexel = 0.0f;      ///< metres
+    LinkMode linkMode = LinkMode::Rtp;
+    HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
+    uint32_t linkSamples = 16;       ///< visibility rays per node estimate
+    uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
+    uint64_t seed = 1;
+};
+
+/// The sparse grid of caches: a cache index per grid vertex (kNoCache where none).
+struct GridLayout {
+    glm::vec3 origin{0.0f};      ///< metres, position of vertex (0, 0, 0)
+    float cellSize = 0.0f;       ///< metres
+    glm::uvec3 dims{0u};         ///< vertices per axis
+    std::vector<uint32_t> cacheIndex;  ///< x + dims.x·(y + dims.y·z) → unique cache index
+};
+
+/// The light map: a cache index per texel and the light-map UVs of every triangle.
+struct LightmapLayout {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    float texelSize = 0.0f;                ///< metres per texel on generated charts
+    std::vector<uint32_t> cacheIndex;      ///< x + width·y → unique cache index (kNoCache: empty)
+    std::vector<glm::vec2> triangleUvs;    ///< 3 per scene triangle, in [0,1]² of the atlas
+    uint32_t chartCount = 0;               ///< generated charts (0 when all meshes bring TEXCOORD_1)
+};
+
+/// Links of every unique cache; cache c owns entries [c·nL, (c+1)·nL).
+struct LinkSet {
+    LinkMode mode = LinkMode::Rtp;
+    uint32_t linksPerCache = 0;
+    uint32_t bands = 0;                    ///< SH bands stored per link (SH mode)
+    std::vector<RtpLink> rtp;              ///< RTP mode: nC·nL links
+    std::vector<uint32_t> shNodes;         ///< SH mode: nC·nL node indices (kNoNode: padding)
+    std::vector<uint16_t> shCoefficients;  ///< SH mode: nC·nL·bands² half floats, 1/(m²·sr)
+};
+
+/// A complete bake.
+struct BakeData {
+    BakeParams params;
+    uint64_t sceneHash = 0;
+    std::vector<Surfel> surfels;           ///< nS, in hierarchy leaf order
+    std::vector<Node> nodes;               ///< 2·nS − 1
+    std::vector<uint32_t> levelOffsets;    ///< inner nodes of level k are [levelOffsets[k-1], levelOffsets[k])
+    std::vector<Cache> caches;             ///< nC unique caches
+    GridLayout grid;
+    LightmapLayout lightmap;
+    LinkSet links;
+    std::map<std::string, std::string> defaults;  ///< parameter → how its default was chosen
+};
+
+}  // namespace pic

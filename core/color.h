@@ -1,0 +1,49 @@
+#pragma once
+/// Colour and storage encodings: YCoCg (paper 000 eq. 7), IEEE half floats, octahedral unit
+/// vectors in 32 bits and the shared-exponent RGB9E5 HDR format (paper 000 §4.7).
+
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+
+namespace pic {
+
+/// Linear RGB to YCoCg: Y = R/4 + G/2 + B/4, Co = (R - B)/2, Cg = (-R + 2G - B)/4.
+glm::vec3 rgbToYCoCg(const glm::vec3& rgb);
+
+/// Exact inverse of rgbToYCoCg: t = Y - Cg, R = t + Co, G = Y + Cg, B = t - Co.
+glm::vec3 yCoCgToRgb(const glm::vec3& yCoCg);
+
+/// IEEE binary16 bits of value, rounded to nearest even; subnormals are exact, magnitudes
+/// from 65520 up become ±inf, NaN stays NaN (quiet, sign and top payload bits kept).
+uint16_t floatToHalf(float value);
+
+/// Like floatToHalf but finite values and ±inf saturate to ±65504, so no inf is ever
+/// stored; NaN still maps to NaN so that upstream bugs stay visible.
+uint16_t floatToHalfClamped(float value);
+
+/// The float that binary16 bits represent (exact for every pattern, NaN payload kept).
+float halfToFloat(uint16_t bits);
+
+/// Octahedral encoding of a direction into two snorm16 values, x in the low 16 bits. The
+/// input need not be normalised; a zero or non-finite vector encodes +z.
+uint32_t encodeOctahedral(const glm::vec3& unitDir);
+
+/// Unit direction of an octahedral code from encodeOctahedral.
+glm::vec3 decodeOctahedral(uint32_t code);
+
+/// Shared-exponent RGB9E5: 9-bit mantissas R, G, B in bits 0-8, 9-17, 18-26 and a 5-bit
+/// exponent (bias 15) in bits 27-31. Negative and NaN channels store 0; values above
+/// kRgb9e5Max clamp to it. The largest channel keeps a relative error <= 2^-9.
+uint32_t packRgb9e5(const glm::vec3& rgb);
+
+/// Linear RGB of an RGB9E5 code.
+glm::vec3 unpackRgb9e5(uint32_t packed);
+
+/// Largest value an RGB9E5 channel holds: 511/512 · 2^16.
+constexpr float kRgb9e5Max = 65408.0f;
+
+/// Relative luminance of linear Rec. 709 RGB: 0.2126 R + 0.7152 G + 0.0722 B.
+float luminance(const glm::vec3& linearRgb);
+
+}  // namespace pic

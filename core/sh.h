@@ -1,0 +1,83 @@
+#pragma once
+/// Real spherical harmonics up to 8 bands and the zonal kernels of paper 000 (§3.2, §4.6,
+/// appendices B and C): clamped cosine, normalised cosine lobe and solid cone.
+///
+/// Convention. Polar axis z; a unit direction is (x, y, z) = (sinθ cosφ, sinθ sinφ, cosθ).
+/// The basis y_l^m is real and orthonormal on the sphere, stored at index i = l(l+1) + m:
+///   y_l^0  = N_l^0 P_l^0(cosθ)
+///   y_l^m  = √2 N_l^m P_l^m(cosθ) cos(mφ)    for m > 0
+///   y_l^-m = √2 N_l^m P_l^m(cosθ) sin(mφ)    for m > 0
+/// with N_l^m = sqrt((2l+1)/(4π) · (l-m)!/(l+m)!) and P_l^m the associated Legendre functions
+/// WITHOUT the Condon-Shortley phase (-1)^m. Every y_l^±l is positive-weighted in x and y, so
+/// band 1 is (y_1^-1, y_1^0, y_1^1) = sqrt(3/(4π)) · (y, z, x), and e.g.
+/// y_2^-2 = sqrt(15/(4π)) x y, y_2^2 = sqrt(15/(16π)) (x² - y²).
+///
+/// "bands" is l_max + 1: 3 bands hold 9 coefficients.
+///
+/// Zonal functions. A function g(d·ω) that depends only on the angle to an axis d projects to
+/// c_l^m = K_l · y_l^m(d) with K_l = 2π ∫_{-1}^{1} g(t) P_l(t) dt (Funk-Hecke; paper eq. 5
+/// written with K_l = sqrt(4π/(2l+1)) c_l^0 of the lobe around z). Every kernel below is such
+/// a per-band factor K_l.
+
+#include <glm/vec3.hpp>
+
+namespace pic {
+
+/// Largest supported band count (l_max = 7, 64 coefficients).
+constexpr int kMaxShBands = 8;
+
+/// Number of coefficients of an SH expansion with `bands` bands.
+constexpr int shCount(int bands) {
+    return bands * bands;
+}
+
+/// Index of coefficient (l, m), -l <= m <= l, in a coefficient array.
+constexpr int shIndex(int l, int m) {
+    return l * (l + 1) + m;
+}
+
+/// Writes the shCount(bands) basis values y_l^m(direction) to out; bands in [0, kMaxShBands],
+/// direction unit length. Polynomial recurrences in x, y, z only: no trig, no allocation.
+void shEvaluate(int bands, const glm::vec3& direction, float* out);
+
+/// K_l of the clamped cosine max(0, d·ω): its projection is K_l y_l^m(d), so the irradiance
+/// of radiance L is E(n) = Σ K_l L_l^m y_l^m(n). K_0 = π, K_1 = 2π/3, K_2 = π/4, K_3 = 0,
+/// and zero for every odd l >= 3. l >= 0.
+float clampedCosineZonal(int l);
+
+/// s_l(n) of paper 000 appendix B for the normalised lobe (n+1)/(2π) max(0, d·ω)^n, which
+/// integrates to 1 over the sphere: the lobe's projection is c_l^m = s_l(n) y_l^m(d), i.e.
+/// s_l(n) = sqrt(4π/(2l+1)) c_l^0 = (n+1) ∫_0^1 t^n P_l(t) dt. Computed by the paper's
+/// recurrence s_0 = 1, s_1 = (n+1)/(n+2), s_l = s_{l-2} (n+2-l)/(n+1+l). For n = 1 this is
+/// clampedCosineZonal(l) / π. l >= 0, n > -1.
+float cosineLobeFactor(int l, float n);
+
+/// K_l(α) of the indicator of the cone of half-angle α around d: its projection is
+/// K_l(α) y_l^m(d), K_l(α) = 2π ∫_{cos α}^{1} P_l(t) dt (paper 000 eq. 6 and appendix C).
+/// Takes u = 1 - cos α in [0, 2] and stays accurate to double rounding for tiny cones
+/// (K_l ≈ 2π u as u → 0); the full sphere u = 2 gives K_0 = 4π and K_l = 0 for l > 0. l >= 0.
+double coneZonal(int l, double oneMinusCosAlpha);
+
+/// Writes coneZonal(l, oneMinusCosAlpha) for l = 0 .. bands-1 to out (one shared recurrence).
+void coneZonalBands(int bands, double oneMinusCosAlpha, double* out);
+
+/// Adds scale · K_l(α) · y_l^m(direction) to inOut: the runtime-projected link of paper 000
+/// §4.6, i.e. the projection of `scale` times the indicator of the cone around direction.
+void shAddCone(int bands, const glm::vec3& direction, float oneMinusCosAlpha, float scale,
+               float* inOut);
+
+/// Adds the projection of scale · max(0, direction·ω) to inOut.
+void shAddClampedCosine(int bands, const glm::vec3& direction, float scale, float* inOut);
+
+/// Irradiance E(n) = ∫ L(ω) max(0, n·ω) dω = Σ K_l L_l^m y_l^m(n) of SH radiance L; a
+/// constant radiance L gives π L.
+float shIrradiance(int bands, const float* radianceSh, const glm::vec3& normal);
+
+/// Glossy lookup ∫ L(ω) (n+1)/(2π) max(0, r·ω)^n dω = Σ s_l(n) L_l^m y_l^m(r): the radiance
+/// averaged over the normalised cosine lobe of exponent n around reflectDir.
+float shGlossy(int bands, const float* radianceSh, const glm::vec3& reflectDir, float exponent);
+
+/// Inner product Σ a_i b_i of two expansions, equal to ∫ a(ω) b(ω) dω.
+float shDot(int bands, const float* a, const float* b);
+
+}  // namespace pic

@@ -1,0 +1,243 @@
+// End-to-end checks of the bake stages on the generated test scenes.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+
+#include "bake/bake.h"
+#include "bake/embree_scene.h"
+#include "bake/grid_caches.h"
+#include "bake/link_generation.h"
+#include "bake/surfel_placement.h"
+#include "core/color.h"
+#include "core/gltf_loader.h"
+#include "core/sh.h"
+
+namespace pic {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+Scene loadTestScene(const std::string& name) {
+    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf");
+    EXPECT_TRUE(scene.has_value()) << (scene ? "" : scene.error().message);
+    return scene ? std::move(*scene) : Scene{};
+}
+
+BakeOptions smallOptions() {
+    BakeOptions options;
+    options.surfels = 8192;
+    options.links = 96;
+    options.gridCell = 0.2f;
+    options.lightmapTexel = 0.1f;
+    return options;
+}
+
+TEST(SurfelPlacement, AreaIsConservedAndSurfelsLieOnTheirTriangles) {
+    Scene scene = loadTestScene("cornell");
+    ASSERT_FALSE(scene.triangles.empty());
+    auto surfels = placeSurfels(scene, SurfelParams{10000, 4, 16, 7});
+    ASSERT_TRUE(surfels) << surfels.error().message;
+    ASSERT_EQ(surfels->size(), 10000u);
+    double area = 0.0;
+    for (const Surfel& s : *surfels) {
+        area += s.area;
+        const Triangle& t = scene.triangles[s.triangle];
+        glm::vec3 a = scene.vertices[t.v[0]].position;
+        // On the triangle's plane (relaxation keeps surfels on their own triangle).
+        EXPECT_NEAR(glm::dot(s.position - a, scene.triangleNormal(s.triangle)), 0.0f, 1e-4f);
+        EXPECT_NEAR(glm::length(s.normal), 1.0f, 1e-4f);
+        EXPECT_TRUE(glm::all(glm::greaterThanEqual(s.albedo, glm::vec3(0.0f))));
+    }
+    EXPECT_NEAR(area / scene.totalArea, 1.0, 1e-3);
+}
+
+TEST(SurfelPlacement, SamplingFollowsArea) {
+    // Red and green walls have equal area: they must get about the same number of surfels.
+    Scene scene = loadTestScene("cornell");
+    auto surfels = placeSurfels(scene, SurfelParams{20000, 0, 4, 1});
+    ASSERT_TRUE(surfels);
+    int left = 0, right = 0;
+    for (const Surfel& s : *surfels) {
+        if (s.normal.x > 0.99f && s.position.x < -0.49f) ++left;
+        if (s.normal.x < -0.99f && s.position.x > 0.49f) ++right;
+    }
+    EXPECT_GT(left, 0);
+    EXPECT_NEAR(static_cast<double>(left) / right, 1.0, 0.02);
+}
+
+TEST(DiscSolidAngle, MatchesExactOnAxisAndSmallDiscLimit) {
+    // On axis: exact 2π(1 − d/√(d²+r²)); far away: ≈ πr²cosθ/d².
+    EXPECT_NEAR(discSolidAngle(1.0f, 1.0f, 1.0f), 2.0 * kPi * (1.0 - 1.0 / std::sqrt(2.0)), 1e-6);
+    EXPECT_NEAR(discSolidAngle(100.0f, 0.1f, 0.5f), kPi * 0.01 * 0.5 / 1e4, 1e-10);
+    EXPECT_NEAR(discSolidAngle(0.0f, 0.1f, 1.0f), 2.0 * kPi, 1e-5);
+}
+
+TEST(GridCaches, NoCacheOutsideAClosedRoomAndAllNearGeometry) {
+    Scene scene = loadTestScene("closed_box");
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    GridCacheParams params;
+    params.cellSize = 0.15f;
+    auto grid = placeGridCaches(scene, **rays, 0, params);
+    ASSERT_TRUE(grid) << grid.error().message;
+    ASSERT_FALSE(grid->caches.empty());
+    for (const Cache& c : grid->caches) {
+        // Inside the room: the walls are single-sided and face inwards.
+        EXPECT_TRUE(glm::all(glm::greaterThan(c.position, scene.bounds.min)) &&
+                    glm::all(glm::lessThan(c.position, scene.bounds.max)))
+            << c.position.x << "," << c.position.y << "," << c.position.z;
+    }
+    EXPECT_GT(grid->insideSolid, 0u);  // the dilation ring outside the walls was rejected
+    uint64_t withCache = 0;
+    for (uint32_t index : grid->layout.cacheIndex) withCache += index != kNoCache;
+    EXPECT_GE(withCache, grid->caches.size());
+}
+
+/// Visible solid angle summed over the links of each cache.
+std::vector<double> solidAnglePerCache(const LinkResult& links, size_t caches, uint32_t nL) {
+    std::vector<double> sums(caches, 0.0);
+    for (size_t c = 0; c < caches; ++c)
+        for (uint32_t l = 0; l < nL; ++l) sums[c] += links.visibleSolidAngle[c * nL + l];
+    return sums;
+}
+
+TEST(LinkGeneration, LinksOfACacheInAClosedBoxCoverTheSphere) {
+    Scene scene = loadTestScene("closed_box");
+    BakeReport report;
+    BakeOptions options = smallOptions();
+    options.surfels = 16384;
+    options.links = 128;
+    auto bake = runBake(scene, options, report);
+    ASSERT_TRUE(bake) << bake.error().message;
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    LinkParams params;
+    params.linksPerCache = 128;
+    auto links = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    ASSERT_TRUE(links);
+    auto sums = solidAnglePerCache(*links, bake->caches.size(), params.linksPerCache);
+    int grid = 0, lightmap = 0;
+    for (size_t c = 0; c < bake->caches.size(); ++c) {
+        const Cache& cache = bake->caches[c];
+        if (cache.kind == gpu::kCacheKindGrid) {
+            ++grid;
+            EXPECT_NEAR(sums[c] / (4.0 * kPi), 1.0, 0.05) << "grid cache " << c;
+        } else {
+            ++lightmap;
+            EXPECT_NEAR(sums[c] / (2.0 * kPi), 1.0, 0.06) << "light-map cache " << c;
+        }
+    }
+    EXPECT_GT(grid, 0);
+    EXPECT_GT(lightmap, 0);
+    EXPECT_EQ(links->stats.blindCaches, 0u);
+}
+
+TEST(LinkGeneration, RtpAndShFormsAgreeOnBandZero) {
+    // Band 0 of the SH form is Ω_vis·y00/(πA); the RTP form holds factor·K0(α)·y00.
+    Scene scene = loadTestScene("cornell");
+    BakeReport report;
+    auto bake = runBake(scene, smallOptions(), report);
+    ASSERT_TRUE(bake) << bake.error().message;
+    auto rays = EmbreeScene::create(scene);
+    LinkParams params;
+    params.linksPerCache = 32;
+    params.mode = LinkMode::Rtp;
+    auto rtp = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    params.mode = LinkMode::Sh;
+    params.bands = 3;
+    auto sh = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    ASSERT_TRUE(rtp && sh);
+    for (size_t i = 0; i < rtp->links.rtp.size(); i += 97) {
+        const RtpLink& link = rtp->links.rtp[i];
+        EXPECT_EQ(link.node, sh->links.shNodes[i]);
+        double rtpBand0 = link.factor * coneZonal(0, link.oneMinusCosAlpha);
+        float basis[64];
+        shEvaluate(1, glm::vec3(0, 0, 1), basis);
+        double shBand0 = halfToFloat(sh->links.shCoefficients[i * 9]) / basis[0];
+        EXPECT_NEAR(rtpBand0, shBand0, 2e-3 * std::abs(shBand0) + 1e-6) << "link " << i;
+    }
+}
+
+TEST(LinkGeneration, UpperRoomNeverLinksToLowerRoomOnlyNodes) {
+    Scene scene = loadTestScene("two_floors");
+    BakeReport report;
+    BakeOptions options = smallOptions();
+    options.gridCell = 0.5f;
+    options.lightmapTexel = 0.25f;
+    auto bake = runBake(scene, options, report);
+    ASSERT_TRUE(bake) << bake.error().message;
+    // The slab is the horizontal closed solid between the rooms: find its top from the
+    // surfels facing up that are not on the ground floor.
+    float slabTop = std::numeric_limits<float>::max();
+    for (const Surfel& s : bake->surfels)
+        if (s.normal.y > 0.99f && s.position.y > scene.bounds.min.y + 0.5f) slabTop = std::min(slabTop, s.position.y);
+    ASSERT_LT(slabTop, scene.bounds.max.y);
+    const uint32_t nL = bake->links.linksPerCache;
+    int upperCaches = 0;
+    for (size_t c = 0; c < bake->caches.size(); ++c) {
+        if (bake->caches[c].position.y <= slabTop) continue;
+        ++upperCaches;
+        for (uint32_t l = 0; l < nL; ++l) {
+            const RtpLink& link = bake->links.rtp[c * nL + l];
+            if (link.factor == 0.0f) continue;
+            const Node& node = bake->nodes[link.node];
+            bool hasUpper = false;
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount && !hasUpper; ++s)
+                hasUpper = bake->surfels[s].position.y >= slabTop - 1e-3f;
+            ASSERT_TRUE(hasUpper) << "cache " << c << " links node " << link.node
+                                  << " made only of lower-room surfels";
+        }
+    }
+    EXPECT_GT(upperCaches, 0);
+}
+
+TEST(Bake, IsDeterministic) {
+    Scene scene = loadTestScene("cornell");
+    BakeReport first, second;
+    auto a = runBake(scene, smallOptions(), first);
+    auto b = runBake(scene, smallOptions(), second);
+    ASSERT_TRUE(a && b);
+    ASSERT_EQ(a->surfels.size(), b->surfels.size());
+    EXPECT_EQ(0, std::memcmp(a->surfels.data(), b->surfels.data(), a->surfels.size() * sizeof(Surfel)));
+    EXPECT_EQ(0, std::memcmp(a->nodes.data(), b->nodes.data(), a->nodes.size() * sizeof(Node)));
+    ASSERT_EQ(a->caches.size(), b->caches.size());
+    EXPECT_EQ(0, std::memcmp(a->caches.data(), b->caches.data(), a->caches.size() * sizeof(Cache)));
+    ASSERT_EQ(a->links.rtp.size(), b->links.rtp.size());
+    EXPECT_EQ(0, std::memcmp(a->links.rtp.data(), b->links.rtp.data(), a->links.rtp.size() * sizeof(RtpLink)));
+}
+
+TEST(Bake, DefaultsFollowTheSceneSize) {
+    Scene small = loadTestScene("cornell");
+    Scene large = loadTestScene("atrium");
+    std::map<std::string, std::string> d1, d2;
+    auto p1 = resolveBakeParams(small, BakeOptions{}, d1);
+    auto p2 = resolveBakeParams(large, BakeOptions{}, d2);
+    ASSERT_TRUE(p1 && p2);
+    EXPECT_GT(p2->gridCell / p1->gridCell, 10.0f);
+    EXPECT_GT(p2->lightmapTexel / p1->lightmapTexel, 10.0f);
+    EXPECT_TRUE(d1.count("surfels") && d1.count("grid_cell") && d1.count("lightmap_texel"));
+}
+
+TEST(Bake, RejectsBadParameters) {
+    Scene scene = loadTestScene("cornell");
+    std::map<std::string, std::string> defaults;
+    BakeOptions options;
+    options.bandsY = 9;
+    EXPECT_FALSE(resolveBakeParams(scene, options, defaults));
+    options = {};
+    options.bandsY = 2;
+    options.bandsC = 3;
+    auto r = resolveBakeParams(scene, options, defaults);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("--chroma-bands"), std::string::npos);
+    options = {};
+    options.gridCell = -1.0f;
+    EXPECT_FALSE(resolveBakeParams(scene, options, defaults));
+}
+
+}  // namespace
+}  // namespace pic
