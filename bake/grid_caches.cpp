@@ -137,13 +137,18 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
             uint64_t v = candidates[i];
             glm::uvec3 c(v % grid.dims.x, (v / grid.dims.x) % grid.dims.y, v / (uint64_t(grid.dims.x) * grid.dims.y));
             glm::vec3 p = grid.origin + glm::vec3(c) * cell;
-            uint32_t back = 0;
+            uint32_t back = 0, front = 0;
             for (const glm::vec3& d : dirs) {
                 auto hit = rays.intersect(p, d, 0.0f, std::numeric_limits<float>::infinity());
-                if (hit && hit->backFace && !scene.materials[scene.triangles[hit->triangle].material].doubleSided)
+                if (!hit) continue;
+                if (hit->backFace && !scene.materials[scene.triangles[hit->triangle].material].doubleSided)
                     ++back;
+                else
+                    ++front;
             }
-            inside[i] = back * 4 > dirs.size();  // more than a quarter of the sphere is "inside"
+            // Inside when more than a quarter of the sphere shows back faces, and useless when
+            // no front face is in sight (e.g. outside a closed room).
+            inside[i] = back * 4 > dirs.size() || front == 0;
             if ((i & 1023) == 0) progress.advance(std::min<size_t>(1024, candidates.size() - i));
         }, 64);
     }

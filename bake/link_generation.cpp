@@ -151,10 +151,20 @@ private:
             samples.push_back({w, omega});
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
-        // An unlucky sample set may miss the visible part of a large node: give such nodes
-        // the prior that up to 1/(K+1) of them might be visible so they are still refined.
-        e.priority = e.visible > 0.0f || e.exact ? e.visible
-                                                 : e.unoccluded / static_cast<float>(k + 1);
+        // An unlucky sample set may miss the visible part of a node (e.g. a few wall surfels
+        // in a node that is mostly coplanar with a light-map cache). Such nodes keep the
+        // prior that 1/(K+1) of their bounding sphere's solid angle might be visible, so
+        // nodes near the cache are still refined until their samples are exact.
+        if (e.visible > 0.0f || e.exact) {
+            e.priority = e.visible;
+        } else {
+            glm::vec3 toCentre = node.center - cache.position;
+            float d2 = glm::dot(toCentre, toCentre);
+            float r2 = node.radius * node.radius;
+            float bound = d2 <= r2 ? 4.0f * kPi
+                                   : 2.0f * kPi * r2 / (d2 * (1.0f + std::sqrt(1.0f - r2 / d2)));
+            e.priority = bound / static_cast<float>(k + 1);
+        }
         return e;
     }
 

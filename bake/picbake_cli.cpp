@@ -178,6 +178,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
 int picbakeMain(int argc, char** argv) {
     CLI::App app{"picbake: precomputes surfels, hierarchy, caches and links of a glTF scene"};
     app.require_subcommand(1);
+    app.fallthrough();  // global flags may follow the subcommand
     int threads = 0;
     bool quiet = false;
     app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);

@@ -63,8 +63,10 @@ void relaxOnce(const Scene& scene, std::vector<Surfel>& surfels, float spacing) 
         grid.forNeighbours(s.position, [&](uint32_t j) {
             if (j == i) return;
             const Surfel& o = surfels[j];
-            // Surfels on the other side of a wall or at a crease do not repel each other.
-            if (glm::dot(s.normal, o.normal) < 0.7f) return;
+            // Surfels on the other side of a thin wall do not repel each other; those across
+            // a crease do, so that edges push surfels away as much as neighbours in the plane
+            // (without it, surfels pile up on the edges of their triangles).
+            if (glm::dot(s.normal, o.normal) < -0.5f) return;
             glm::vec3 d = s.position - o.position;
             float dist = glm::length(d);
             if (dist >= spacing || dist <= 0.0f) return;
@@ -73,10 +75,12 @@ void relaxOnce(const Scene& scene, std::vector<Surfel>& surfels, float spacing) 
         // Keep the move in the tangent plane and small enough to converge.
         push -= s.normal * glm::dot(push, s.normal);
         glm::vec3 p = s.position + 0.25f * push;
+        // A move that would leave the surfel's triangle is not taken: clamping it to the
+        // border instead would pile surfels up along edges and thin them out beside.
         const Triangle& t = scene.triangles[s.triangle];
-        moved[i] = closestPointOnTriangle(p, scene.vertices[t.v[0]].position,
-                                          scene.vertices[t.v[1]].position,
-                                          scene.vertices[t.v[2]].position);
+        glm::vec3 w = barycentric(p, scene.vertices[t.v[0]].position, scene.vertices[t.v[1]].position,
+                                  scene.vertices[t.v[2]].position);
+        moved[i] = glm::all(glm::greaterThanEqual(w, glm::vec3(0.0f))) ? p : s.position;
     }, 256);
     for (size_t i = 0; i < surfels.size(); ++i) surfels[i].position = moved[i];
 }

@@ -12,6 +12,7 @@ namespace pic {
 int picbenchMain(int argc, char** argv) {
     CLI::App app{"picbench: pic benchmarks (timings, memory, bytes) printed and written as JSON"};
     app.require_subcommand(1);
+    app.fallthrough();  // global flags may follow the subcommand
     int threads = 0;
     bool quiet = false;
     app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);

@@ -120,17 +120,24 @@ TEST(LinkGeneration, LinksOfACacheInAClosedBoxCoverTheSphere) {
     auto links = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
     ASSERT_TRUE(links);
     auto sums = solidAnglePerCache(*links, bake->caches.size(), params.linksPerCache);
+    // Grid caches see the whole sphere, light-map caches the hemisphere above their surface.
+    // A light-map cache 5 cm from a corner sees the near walls through a handful of surfels,
+    // so single light-map caches deviate more (surfel noise, not the cut): they are checked
+    // on average and with a looser bound each.
     int grid = 0, lightmap = 0;
+    double lightmapMean = 0.0;
     for (size_t c = 0; c < bake->caches.size(); ++c) {
         const Cache& cache = bake->caches[c];
         if (cache.kind == gpu::kCacheKindGrid) {
             ++grid;
-            EXPECT_NEAR(sums[c] / (4.0 * kPi), 1.0, 0.05) << "grid cache " << c;
+            EXPECT_NEAR(sums[c] / (4.0 * kPi), 1.0, 0.04) << "grid cache " << c;
         } else {
             ++lightmap;
-            EXPECT_NEAR(sums[c] / (2.0 * kPi), 1.0, 0.06) << "light-map cache " << c;
+            lightmapMean += sums[c] / (2.0 * kPi);
+            EXPECT_NEAR(sums[c] / (2.0 * kPi), 1.0, 0.1) << "light-map cache " << c;
         }
     }
+    EXPECT_NEAR(lightmapMean / lightmap, 1.0, 0.02);
     EXPECT_GT(grid, 0);
     EXPECT_GT(lightmap, 0);
     EXPECT_EQ(links->stats.blindCaches, 0u);
@@ -170,26 +177,24 @@ TEST(LinkGeneration, UpperRoomNeverLinksToLowerRoomOnlyNodes) {
     options.lightmapTexel = 0.25f;
     auto bake = runBake(scene, options, report);
     ASSERT_TRUE(bake) << bake.error().message;
-    // The slab is the horizontal closed solid between the rooms: find its top from the
-    // surfels facing up that are not on the ground floor.
-    float slabTop = std::numeric_limits<float>::max();
-    for (const Surfel& s : bake->surfels)
-        if (s.normal.y > 0.99f && s.position.y > scene.bounds.min.y + 0.5f) slabTop = std::min(slabTop, s.position.y);
-    ASSERT_LT(slabTop, scene.bounds.max.y);
+    // tests/scenes: the lower room is y in [0, 2.5], the 2 cm slab y in [2.5, 2.52] (it
+    // reaches 5 cm past the walls), the upper room y in [2.52, 5.02], walls at |x|, |z| = 2.
+    const float slabBottom = 2.5f, slabTop = 2.52f, halfWidth = 2.0f;
     const uint32_t nL = bake->links.linksPerCache;
     int upperCaches = 0;
     for (size_t c = 0; c < bake->caches.size(); ++c) {
-        if (bake->caches[c].position.y <= slabTop) continue;
+        const glm::vec3 p = bake->caches[c].position;
+        if (p.y <= slabTop || std::abs(p.x) >= halfWidth || std::abs(p.z) >= halfWidth) continue;
         ++upperCaches;
         for (uint32_t l = 0; l < nL; ++l) {
             const RtpLink& link = bake->links.rtp[c * nL + l];
             if (link.factor == 0.0f) continue;
             const Node& node = bake->nodes[link.node];
-            bool hasUpper = false;
-            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount && !hasUpper; ++s)
-                hasUpper = bake->surfels[s].position.y >= slabTop - 1e-3f;
-            ASSERT_TRUE(hasUpper) << "cache " << c << " links node " << link.node
-                                  << " made only of lower-room surfels";
+            bool lowerOnly = true;
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount && lowerOnly; ++s)
+                lowerOnly = bake->surfels[s].position.y < slabBottom - 1e-3f;
+            ASSERT_FALSE(lowerOnly) << "cache " << c << " links node " << link.node
+                                    << " made only of lower-room surfels";
         }
     }
     EXPECT_GT(upperCaches, 0);
