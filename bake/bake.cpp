@@ -173,6 +173,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     report.lightmapDuplicates = lightmap.duplicateTexels;
     report.lightmapRelocated = lightmap.relocated;
     report.lightmapRejected = lightmap.rejected;
+    report.lightmapGridShaded = lightmap.gridShadedTriangles;
     lightmapTimer.stop();
 
     StageTimer linkTimer(report, "links");

@@ -38,6 +38,7 @@ struct BakeReport {
     uint32_t lightmapDuplicates = 0;
     uint32_t lightmapRelocated = 0;
     uint32_t lightmapRejected = 0;
+    uint32_t lightmapGridShaded = 0;  ///< triangles too small for the light map (grid-shaded)
     uint64_t peakMemoryBytes = 0;
 };
 

@@ -219,8 +219,12 @@ ChartCaches placeChart(const Placement& placement, uint32_t chartIndex,
             }
     }
     // A triangle covering no centre gets its centroid's texel when that is free, so every
-    // triangle is represented.
-    for (size_t i = 0; i < triangles.size(); ++i) {
+    // triangle of a light-mapped chart is represented. A chart none of whose triangles
+    // covers a centre is too small for the light map: it is shaded from the grid, like
+    // detailed geometry in paper 000 §3.2, instead of costing one cache per triangle.
+    const bool lightmapped =
+        std::any_of(coversCentre.begin(), coversCentre.end(), [](uint8_t c) { return c != 0; });
+    for (size_t i = 0; lightmapped && i < triangles.size(); ++i) {
         uint32_t t = triangles[i];
         if (coversCentre[i] || placement.normal[t] == glm::vec3(0.0f)) continue;
         AtlasTriangle at = atlasTriangle(t);
@@ -440,6 +444,17 @@ Result<LightmapCacheSet> placeLightmapCaches(const Scene& scene, const EmbreeSce
                         firstCacheIndex + cacheBase[c] + result.owner[local];
         },
         16);
+
+    // Triangles of charts without any cache (too small, or buried in other geometry) are
+    // marked for grid shading.
+    for (size_t c = 0; c < chartTotal; ++c) {
+        if (!perChart[c].caches.empty()) continue;
+        for (uint32_t i = chartStart[c]; i < chartStart[c + 1]; ++i) {
+            uint32_t t = chartTriangles[i];
+            for (int k = 0; k < 3; ++k) charts.triangleUvs[3 * t + k] = glm::vec2(kNotLightmapped);
+            ++set.gridShadedTriangles;
+        }
+    }
 
     set.layout.width = charts.width;
     set.layout.height = charts.height;

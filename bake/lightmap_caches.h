@@ -26,13 +26,16 @@ struct LightmapCacheSet {
     uint32_t duplicateTexels = 0;  ///< texels filled by dilation with a neighbour's cache
     uint32_t relocated = 0;        ///< caches moved off an enclosed texel centre
     uint32_t rejected = 0;         ///< texels whose every candidate point was enclosed
+    uint32_t gridShadedTriangles = 0;  ///< triangles of charts without caches (UVs kNotLightmapped)
 };
 
 /// Places the light-map caches of `charts` (moved into the layout).
 ///
 /// Every texel whose centre lies inside a triangle gets a unique cache at that point (the
 /// first triangle in scene order wins a shared centre); a triangle covering no centre gets
-/// one at its centroid's texel if that texel is free. A point inside or under other
+/// one at its centroid's texel if that texel is free, unless no triangle of its chart covers
+/// a centre: such charts get no cache and their triangles' UVs are set to kNotLightmapped
+/// (shaded from the grid). A point inside or under other
 /// geometry (its rays mostly see back faces, or its normal ray hits something within
 /// 10·epsilon) moves to another point of the triangle inside the texel, or is dropped.
 /// Cache positions are lifted 2·rays.epsilon() along the triangle's geometric normal so

@@ -100,9 +100,11 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                report.gridInsideSolid, report.gridDuplicates);
     fmt::print("  lightmap texel  {}\n", withDefault("lightmap_texel", fmt::format("{:.4g} m", p.lightmapTexel)));
     fmt::print("  lightmap        {}x{} atlas, {} charts, {} texels with a cache ({} duplicates), "
-               "{} caches relocated, {} rejected behind geometry\n",
+               "{} caches relocated, {} rejected behind geometry, {} triangles too small for it "
+               "(shaded from the grid)\n",
                bake->lightmap.width, bake->lightmap.height, bake->lightmap.chartCount, info->lightmapCaches,
-               report.lightmapDuplicates, report.lightmapRelocated, report.lightmapRejected);
+               report.lightmapDuplicates, report.lightmapRelocated, report.lightmapRejected,
+               report.lightmapGridShaded);
     fmt::print("  unique caches   {}\n", bake->caches.size());
     fmt::print("  links nL        {}\n", withDefault("links", std::to_string(p.linksPerCache)));
     fmt::print("  link mode       {}, {} samples per node, {:.1f} links used per cache, {} blind caches, "

@@ -55,13 +55,17 @@ struct GridLayout {
     std::vector<uint32_t> cacheIndex;  ///< x + dims.x·(y + dims.y·z) → unique cache index
 };
 
+/// Light-map UV of triangles that are not light-mapped and are shaded from the grid.
+inline constexpr float kNotLightmapped = -1.0f;
+
 /// The light map: a cache index per texel and the light-map UVs of every triangle.
 struct LightmapLayout {
     uint32_t width = 0;
     uint32_t height = 0;
     float texelSize = 0.0f;                ///< metres per texel on generated charts
     std::vector<uint32_t> cacheIndex;      ///< x + width·y → unique cache index (kNoCache: empty)
-    std::vector<glm::vec2> triangleUvs;    ///< 3 per scene triangle, in [0,1]² of the atlas
+    std::vector<glm::vec2> triangleUvs;    ///< 3 per scene triangle, in [0,1]² of the atlas, or
+                                           ///< kNotLightmapped for grid-shaded triangles
     uint32_t chartCount = 0;               ///< generated charts (0 when all meshes bring TEXCOORD_1)
 };
 
@@ -70,8 +74,8 @@ struct LinkSet {
     LinkMode mode = LinkMode::Rtp;
     uint32_t linksPerCache = 0;
     uint32_t bands = 0;                    ///< SH bands stored per link (SH mode)
-    std::vector<RtpLink> rtp;              ///< RTP mode: nC·nL links
-    std::vector<uint32_t> shNodes;         ///< SH mode: nC·nL node indices (kNoNode: padding)
+    std::vector<RtpLink> rtp;              ///< RTP mode: nC·nL links (padding: node 0, factor 0)
+    std::vector<uint32_t> shNodes;         ///< SH mode: nC·nL node indices (padding: node 0, zero coefficients)
     std::vector<uint16_t> shCoefficients;  ///< SH mode: nC·nL·bands² half floats, 1/(m²·sr)
 };
 
