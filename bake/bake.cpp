@@ -48,6 +48,45 @@ constexpr uint32_t kDefaultBandsC = 2;
 
 }  // namespace
 
+uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidAngle) {
+    const uint32_t nL = bake.links.linksPerCache;
+    const size_t nC = bake.caches.size();
+    // Links of a cache are packed from its first slot, so a cache is blind when its first
+    // link sees nothing.
+    std::vector<uint32_t> remap(nC, kNoCache);
+    uint32_t kept = 0;
+    for (size_t c = 0; c < nC; ++c)
+        if (visibleSolidAngle[c * nL] > 0.0f) remap[c] = kept++;
+    const uint32_t dropped = static_cast<uint32_t>(nC - kept);
+    if (dropped == 0) return 0;
+
+    LinkSet& links = bake.links;
+    const size_t coefficients = links.mode == LinkMode::Sh ? size_t{links.bands} * links.bands : 0;
+    for (size_t c = 0; c < nC; ++c) {
+        if (remap[c] == kNoCache) continue;
+        const size_t to = remap[c];
+        bake.caches[to] = bake.caches[c];
+        if (links.mode == LinkMode::Rtp) {
+            std::copy_n(links.rtp.begin() + c * nL, nL, links.rtp.begin() + to * nL);
+        } else {
+            std::copy_n(links.shNodes.begin() + c * nL, nL, links.shNodes.begin() + to * nL);
+            std::copy_n(links.shCoefficients.begin() + c * nL * coefficients, nL * coefficients,
+                        links.shCoefficients.begin() + to * nL * coefficients);
+        }
+    }
+    bake.caches.resize(kept);
+    if (links.mode == LinkMode::Rtp) {
+        links.rtp.resize(size_t{kept} * nL);
+    } else {
+        links.shNodes.resize(size_t{kept} * nL);
+        links.shCoefficients.resize(size_t{kept} * nL * coefficients);
+    }
+    for (std::vector<uint32_t>* index : {&bake.grid.cacheIndex, &bake.lightmap.cacheIndex})
+        for (uint32_t& i : *index)
+            if (i != kNoCache) i = remap[i];
+    return dropped;
+}
+
 uint64_t peakMemoryBytes() {
     std::ifstream status("/proc/self/status");
     std::string line;
@@ -186,6 +225,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams));
     bake.links = std::move(links.links);
     report.links = links.stats;
+    report.blindCachesDropped = dropBlindCaches(bake, links.visibleSolidAngle);
     linkTimer.stop();
 
     report.peakMemoryBytes = peakMemoryBytes();

@@ -39,6 +39,7 @@ struct BakeReport {
     uint32_t lightmapRelocated = 0;
     uint32_t lightmapRejected = 0;
     uint32_t lightmapGridShaded = 0;  ///< triangles too small for the light map (grid-shaded)
+    uint32_t blindCachesDropped = 0;  ///< caches that saw no surfel, removed after linking
     uint64_t peakMemoryBytes = 0;
 };
 
@@ -48,6 +49,11 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
 
 /// Runs every bake stage on a loaded scene.
 Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report);
+
+/// Removes caches whose links see no surfel (e.g. on the outside of a room's walls): their
+/// radiance is zero whatever the lights, so their grid vertices and light-map texels become
+/// kNoCache, which the runtime reads as zero. Returns how many were dropped.
+uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidAngle);
 
 /// Peak resident memory of this process so far, in bytes (0 if unknown).
 uint64_t peakMemoryBytes();

@@ -105,11 +105,12 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                bake->lightmap.width, bake->lightmap.height, bake->lightmap.chartCount, info->lightmapCaches,
                report.lightmapDuplicates, report.lightmapRelocated, report.lightmapRejected,
                report.lightmapGridShaded);
-    fmt::print("  unique caches   {}\n", bake->caches.size());
+    fmt::print("  unique caches   {} ({} that see no surface were dropped)\n", bake->caches.size(),
+               report.blindCachesDropped);
     fmt::print("  links nL        {}\n", withDefault("links", std::to_string(p.linksPerCache)));
-    fmt::print("  link mode       {}, {} samples per node, {:.1f} links used per cache, {} blind caches, "
+    fmt::print("  link mode       {}, {} samples per node, {:.1f} links used per cache, "
                "{:.3g} sr visible per cache, {:.3g} M rays\n",
-               toString(p.linkMode), p.linkSamples, report.links.meanLinksUsed, report.links.blindCaches,
+               toString(p.linkMode), p.linkSamples, report.links.meanLinksUsed,
                report.links.meanVisibleSolidAngle, report.links.rays / 1e6);
     fmt::print("  bands           y {}, c {}{}\n", p.bandsY, p.bandsC,
                bake->defaults.count("bands") ? "  (default)" : "");

@@ -53,6 +53,7 @@ struct GridLayout {
     float cellSize = 0.0f;       ///< metres
     glm::uvec3 dims{0u};         ///< vertices per axis
     std::vector<uint32_t> cacheIndex;  ///< x + dims.x·(y + dims.y·z) → unique cache index
+                                       ///< (kNoCache: no cache, read as zero radiance)
 };
 
 /// Light-map UV of triangles that are not light-mapped and are shaded from the grid.

@@ -215,6 +215,31 @@ TEST(Bake, IsDeterministic) {
     EXPECT_EQ(0, std::memcmp(a->links.rtp.data(), b->links.rtp.data(), a->links.rtp.size() * sizeof(RtpLink)));
 }
 
+TEST(Bake, BlindCachesAreDroppedAndIndicesStayValid) {
+    // cornell is open at the front: grid vertices outside its walls see no surface.
+    Scene scene = loadTestScene("cornell");
+    BakeReport report;
+    auto bake = runBake(scene, smallOptions(), report);
+    ASSERT_TRUE(bake) << bake.error().message;
+    const uint32_t nL = bake->links.linksPerCache;
+    ASSERT_EQ(bake->links.rtp.size(), bake->caches.size() * nL);
+    for (size_t c = 0; c < bake->caches.size(); ++c) EXPECT_GT(bake->links.rtp[c * nL].factor, 0.0f) << c;
+    std::vector<int> referenced(bake->caches.size(), 0);
+    for (const auto* index : {&bake->grid.cacheIndex, &bake->lightmap.cacheIndex})
+        for (uint32_t i : *index) {
+            if (i == kNoCache) continue;
+            ASSERT_LT(i, bake->caches.size());
+            referenced[i] = 1;
+        }
+    // Every unique cache is still used by its own grid vertex or texel.
+    for (size_t c = 0; c < bake->caches.size(); ++c) EXPECT_TRUE(referenced[c]) << c;
+    for (size_t c = 0; c < bake->caches.size(); ++c) {
+        const Cache& cache = bake->caches[c];
+        const auto& index = cache.kind == gpu::kCacheKindGrid ? bake->grid.cacheIndex : bake->lightmap.cacheIndex;
+        EXPECT_EQ(index[cache.texel], c);
+    }
+}
+
 TEST(Bake, DefaultsFollowTheSceneSize) {
     Scene small = loadTestScene("cornell");
     Scene large = loadTestScene("atrium");
