@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 
@@ -268,6 +269,38 @@ TEST(Bake, RejectsBadParameters) {
     options.gridCell = -1.0f;
     EXPECT_FALSE(resolveBakeParams(scene, options, defaults));
 }
+
+}  // namespace
+}  // namespace pic
+
+namespace pic {
+namespace {
+
+/// The real scenes shipped in ../shared/scenes (made by other people) must bake.
+class RealScenes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RealScenes, Bake) {
+    std::string path = std::string(PIC_SHARED_SCENE_DIR) + "/" + GetParam();
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not present";
+    auto scene = loadScene(path);
+    ASSERT_TRUE(scene) << scene.error().message;
+    BakeOptions options;
+    options.surfels = 8192;
+    options.links = 32;
+    BakeReport report;
+    auto bake = runBake(*scene, options, report);
+    ASSERT_TRUE(bake) << bake.error().message;
+    EXPECT_EQ(bake->surfels.size(), 8192u);
+    EXPECT_GT(bake->caches.size(), 1000u);
+    double area = 0.0;
+    for (const Surfel& s : bake->surfels) area += s.area;
+    EXPECT_NEAR(area / scene->totalArea, 1.0, 1e-3);
+    // Most caches see a good part of their surroundings.
+    EXPECT_GT(report.links.meanVisibleSolidAngle, 2.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedScenes, RealScenes,
+                         ::testing::Values("living_room_sh3d.glb", "openarena_oa_rpg3dm2.glb"));
 
 }  // namespace
 }  // namespace pic
