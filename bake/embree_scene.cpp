@@ -33,6 +33,24 @@ const char* embreeErrorName(RTCError error) {
     return "RTC_ERROR_?";
 }
 
+/// An Embree ray over (tNear, tFar) that every geometry mask accepts.
+RTCRay makeRay(const glm::vec3& origin, const glm::vec3& direction, float tNear, float tFar) {
+    RTCRay ray;
+    ray.org_x = origin.x;
+    ray.org_y = origin.y;
+    ray.org_z = origin.z;
+    ray.tnear = tNear;
+    ray.dir_x = direction.x;
+    ray.dir_y = direction.y;
+    ray.dir_z = direction.z;
+    ray.time = 0.0f;
+    ray.tfar = tFar;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    return ray;
+}
+
 }  // namespace
 
 EmbreeScene::~EmbreeScene() = default;
@@ -96,19 +114,7 @@ bool EmbreeScene::occluded(const glm::vec3& origin, const glm::vec3& direction, 
                            float tFar) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.tnear = tNear;
-    ray.dir_x = direction.x;
-    ray.dir_y = direction.y;
-    ray.dir_z = direction.z;
-    ray.time = 0.0f;
-    ray.tfar = tFar;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = makeRay(origin, direction, tNear, tFar);
     rtcOccluded1(mImpl->scene, &context, &ray);
     // Embree marks an occluded ray by setting tfar to -inf.
     return ray.tfar < 0.0f;
@@ -119,19 +125,8 @@ std::optional<RayHit> EmbreeScene::intersect(const glm::vec3& origin, const glm:
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rayHit;
-    RTCRay& ray = rayHit.ray;
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.tnear = tNear;
-    ray.dir_x = direction.x;
-    ray.dir_y = direction.y;
-    ray.dir_z = direction.z;
-    ray.time = 0.0f;
-    ray.tfar = tFar;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
+    rayHit.ray = makeRay(origin, direction, tNear, tFar);
+    const RTCRay& ray = rayHit.ray;
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayHit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(mImpl->scene, &context, &rayHit);

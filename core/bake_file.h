@@ -36,7 +36,7 @@
 ///   lightmap_uvs     3 per scene triangle × f32[2]
 ///   links            u32 link mode, u32 nL, u32 SH bands per link, u32 zero
 ///   links_rtp        RTP mode: nC·nL × gpu::RtpLink (16 bytes); SH mode: empty
-///   links_sh_nodes   SH mode: nC·nL × u32 node index (kNoNode: padding); RTP mode: empty
+///   links_sh_nodes   SH mode: nC·nL × u32 node index (padding: node 0 with zero coefficients)
 ///   links_sh_coeffs  SH mode: nC·nL·bands² × u16 half float; RTP mode: empty
 ///
 /// Both directions check that the counts agree and that every node and cache index is in range
