@@ -407,9 +407,17 @@ Result<LightmapCacheSet> placeLightmapCaches(const Scene& scene, const EmbreeSce
         1);
     progress.finish();
 
+    // Charts without any cache (too small for a texel centre, or buried in other geometry)
+    // leave the light map and are shaded from the grid; the rest are packed again.
+    LightmapCacheSet set;
+    {
+        std::vector<uint8_t> keep(chartTotal);
+        for (size_t c = 0; c < chartTotal; ++c) keep[c] = !perChart[c].caches.empty();
+        set.gridShadedTriangles = repackLightmapCharts(charts, keep);
+    }
+
     // Unique caches are numbered by chart, then by texel; every chart writes only the
     // texels of its own rectangle.
-    LightmapCacheSet set;
     std::vector<uint32_t> cacheBase(chartTotal + 1, 0);
     for (size_t c = 0; c < chartTotal; ++c) {
         cacheBase[c + 1] = cacheBase[c] + static_cast<uint32_t>(perChart[c].caches.size());
@@ -444,17 +452,6 @@ Result<LightmapCacheSet> placeLightmapCaches(const Scene& scene, const EmbreeSce
                         firstCacheIndex + cacheBase[c] + result.owner[local];
         },
         16);
-
-    // Triangles of charts without any cache (too small, or buried in other geometry) are
-    // marked for grid shading.
-    for (size_t c = 0; c < chartTotal; ++c) {
-        if (!perChart[c].caches.empty()) continue;
-        for (uint32_t i = chartStart[c]; i < chartStart[c + 1]; ++i) {
-            uint32_t t = chartTriangles[i];
-            for (int k = 0; k < 3; ++k) charts.triangleUvs[3 * t + k] = glm::vec2(kNotLightmapped);
-            ++set.gridShadedTriangles;
-        }
-    }
 
     set.layout.width = charts.width;
     set.layout.height = charts.height;

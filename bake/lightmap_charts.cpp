@@ -597,4 +597,45 @@ Result<LightmapCharts> buildLightmapCharts(const Scene& scene, const LightmapCha
     return charts;
 }
 
+uint32_t repackLightmapCharts(LightmapCharts& charts, const std::vector<uint8_t>& keep) {
+    PIC_CHECK_EQ(keep.size(), charts.charts.size());
+    // Kept charts move by whole texels, so their texel centres stay where they were on the
+    // surface; a packing of fewer rectangles of the same sizes always fits again.
+    std::vector<uint32_t> kept;
+    std::vector<glm::uvec2> sizes;
+    for (uint32_t c = 0; c < charts.charts.size(); ++c)
+        if (keep[c]) {
+            kept.push_back(c);
+            sizes.emplace_back(charts.charts[c].width, charts.charts[c].height);
+        }
+    std::optional<Packing> packing =
+        packShelves(sizes, std::max({charts.width, charts.height, 1u}));
+    if (!packing) return 0;
+
+    std::vector<glm::ivec2> shift(charts.charts.size(), glm::ivec2(0));
+    for (size_t i = 0; i < kept.size(); ++i) {
+        LightmapChart& chart = charts.charts[kept[i]];
+        shift[kept[i]] = glm::ivec2(packing->origins[i]) - glm::ivec2(chart.x, chart.y);
+        chart.x = packing->origins[i].x;
+        chart.y = packing->origins[i].y;
+    }
+    const glm::dvec2 oldSize(charts.width, charts.height);
+    const glm::dvec2 newSize(std::max(packing->width, 1u), std::max(packing->height, 1u));
+    uint32_t dropped = 0;
+    for (size_t t = 0; t < charts.triangleChart.size(); ++t) {
+        uint32_t c = charts.triangleChart[t];
+        for (int k = 0; k < 3; ++k) {
+            glm::vec2& uv = charts.triangleUvs[3 * t + k];
+            uv = keep[c] ? glm::vec2((glm::dvec2(uv) * oldSize + glm::dvec2(shift[c])) / newSize)
+                         : glm::vec2(kNotLightmapped);
+        }
+        dropped += keep[c] ? 0 : 1;
+    }
+    for (uint32_t c = 0; c < charts.charts.size(); ++c)
+        if (!keep[c]) charts.charts[c] = LightmapChart{0, 0, 0, 0, charts.charts[c].fromUv1};
+    charts.width = static_cast<uint32_t>(newSize.x);
+    charts.height = static_cast<uint32_t>(newSize.y);
+    return dropped;
+}
+
 }  // namespace pic

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/bake_data.h"
 #include "core/error.h"
 #include "core/scene.h"
 
@@ -49,5 +50,11 @@ struct LightmapCharts {
 /// are grouped into planar charts of edge-connected triangles facing the same way. Fails
 /// with InvalidInput on bad parameters or when the atlas would exceed maxAtlasSize².
 Result<LightmapCharts> buildLightmapCharts(const Scene& scene, const LightmapChartParams& params);
+
+/// Packs the atlas again with only the charts whose `keep` flag is set (they move by whole
+/// texels, so their texel layout on the surface is unchanged); the triangles of the other
+/// charts get kNotLightmapped UVs and those charts an empty rectangle. Returns how many
+/// triangles were dropped from the light map.
+uint32_t repackLightmapCharts(LightmapCharts& charts, const std::vector<uint8_t>& keep);
 
 }  // namespace pic

@@ -574,3 +574,33 @@ TEST(LightmapCharts, BadParametersAreErrors) {
 
 }  // namespace
 }  // namespace pic
+
+namespace pic {
+namespace {
+
+TEST(LightmapCaches, ChartsWithoutCachesLeaveTheRepackedAtlas) {
+    // Debris triangles too small for a texel centre are shaded from the grid; the atlas is
+    // packed again without them, and every light-mapped lookup still reads filled texels.
+    Scene scene = clutteredScene();
+    LightmapCharts before = charts(scene, 0.05f);
+    Baked baked = bake(scene, 0.05f);
+    const LightmapCacheSet& set = baked.set;
+    EXPECT_GT(set.gridShadedTriangles, 0u);
+    EXPECT_LT(uint64_t{set.layout.width} * set.layout.height, uint64_t{before.width} * before.height);
+    std::vector<uint32_t> lightmapped;
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+        bool mapped = set.layout.triangleUvs[3 * t] != glm::vec2(kNotLightmapped);
+        for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(set.layout.triangleUvs[3 * t + k] != glm::vec2(kNotLightmapped), mapped);
+        if (mapped) lightmapped.push_back(t);
+    }
+    EXPECT_EQ(lightmapped.size() + set.gridShadedTriangles, scene.triangles.size());
+    EXPECT_EQ(emptyBilinearReads(set.layout, lightmapped, 500), 0);
+    for (uint32_t i = 0; i < set.caches.size(); ++i) {
+        ASSERT_LT(set.caches[i].texel, set.layout.cacheIndex.size());
+        EXPECT_EQ(set.layout.cacheIndex[set.caches[i].texel], i);
+    }
+}
+
+}  // namespace
+}  // namespace pic
