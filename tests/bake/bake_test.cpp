@@ -70,6 +70,42 @@ TEST(SurfelPlacement, SamplingFollowsArea) {
     EXPECT_NEAR(static_cast<double>(left) / right, 1.0, 0.02);
 }
 
+TEST(SurfelPlacement, EmissionAndTexturedAlbedoComeFromTheMaterial) {
+    // cornell_area: the ceiling panel emits 10 W/(m²·sr); nothing else emits.
+    Scene area = loadTestScene("cornell_area");
+    auto lit = placeSurfels(area, SurfelParams{20000, 2, 16, 3});
+    ASSERT_TRUE(lit);
+    int emitting = 0;
+    for (const Surfel& s : *lit) {
+        if (area.materials[s.material].name == "light") {
+            ++emitting;
+            EXPECT_NEAR(s.emission.x, 10.0f, 1e-3f);
+        } else {
+            EXPECT_EQ(s.emission, glm::vec3(0.0f));
+        }
+    }
+    EXPECT_GT(emitting, 0);
+
+    // textured_quad: the floor's 8×8 checker of two sRGB colours averages, over all floor
+    // surfels, to the mean of their linear values (0.791 / 0.021 in red and blue).
+    Scene quad = loadTestScene("textured_quad");
+    auto textured = placeSurfels(quad, SurfelParams{4000, 2, 16, 3});
+    ASSERT_TRUE(textured);
+    glm::dvec3 sum(0.0);
+    int floor = 0;
+    for (const Surfel& s : *textured) {
+        if (s.normal.y < 0.99f) continue;
+        sum += glm::dvec3(s.albedo);
+        ++floor;
+    }
+    ASSERT_GT(floor, 100);
+    glm::dvec3 mean = sum / double(floor);
+    const double expected = 0.5 * (0.791298 + 0.021219);
+    EXPECT_NEAR(mean.x, expected, 0.02);
+    EXPECT_NEAR(mean.z, expected, 0.02);
+    EXPECT_NEAR(mean.y, 0.021219, 1e-3);
+}
+
 TEST(DiscSolidAngle, MatchesExactOnAxisAndSmallDiscLimit) {
     // On axis: exact 2π(1 − d/√(d²+r²)); far away: ≈ πr²cosθ/d².
     EXPECT_NEAR(discSolidAngle(1.0f, 1.0f, 1.0f), 2.0 * kPi * (1.0 - 1.0 / std::sqrt(2.0)), 1e-6);
