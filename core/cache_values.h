@@ -1,0 +1,52 @@
+#pragma once
+/// Cache radiance as the runtime produces it (paper 000 §4.8, paper 001): per unique cache,
+/// incident radiance as real SH (core/sh.h basis) in YCoCg, Y with lY bands and Co, Cg with
+/// lC ≤ lY bands; and the lookups a renderer does with it (paper 000 §3.2).
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/bake_data.h"
+
+namespace pic {
+
+/// Incident radiance SH of every unique cache, W/(m²·sr), in YCoCg.
+struct CacheValues {
+    uint32_t bandsY = 0;    ///< lY
+    uint32_t bandsC = 0;    ///< lC
+    std::vector<float> y;   ///< nC·lY² luma coefficients, cache-major
+    std::vector<float> co;  ///< nC·lC² orange chroma coefficients
+    std::vector<float> cg;  ///< nC·lC² green chroma coefficients
+
+    /// Zero-filled values for `caches` caches.
+    static CacheValues zeros(size_t caches, uint32_t bandsY, uint32_t bandsC);
+    size_t cacheCount() const { return bandsY ? y.size() / (size_t{bandsY} * bandsY) : 0; }
+};
+
+/// Incident radiance at one point as RGB SH with lY bands (chroma bands above lC are zero).
+struct RadianceSh {
+    uint32_t bands = 0;
+    float rgb[3][64] = {};  ///< per channel R, G, B: bands² coefficients
+};
+
+/// Interpolates the caches around a surface point the way every renderer of pic does:
+/// bilinearly from the 4 light-map texels around the triangle's light-map UV when the
+/// triangle is light-mapped (triangleUvs != kNotLightmapped), else trilinearly from the 8
+/// grid vertices around the position. Texels and vertices without a cache (kNoCache) take
+/// no weight and the others are renormalised; no valid neighbour gives zero radiance.
+/// `b1`, `b2` are the point's barycentric weights of vertices 1 and 2 of `triangle`.
+RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values,
+                                 uint32_t triangle, float b1, float b2,
+                                 const glm::vec3& position);
+
+/// Trilinear grid lookup only (for points off the light-mapped surfaces).
+RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
+                              const glm::vec3& position);
+
+/// Irradiance (W/m², RGB) from interpolated radiance on a surface with unit normal n:
+/// E = Σ K_l L_lm y_lm(n) per channel (clamped-cosine convolution, paper 000 §3.2).
+glm::vec3 irradiance(const RadianceSh& radiance, const glm::vec3& normal);
+
+}  // namespace pic

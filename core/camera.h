@@ -1,0 +1,38 @@
+#pragma once
+/// Pinhole cameras from the command line (`--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy`) or the
+/// scene (`--scene-camera N`), and their primary rays.
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// Parses the 10 comma-separated numbers of --camera; InvalidInput names the text when there
+/// are not 10 finite numbers, eye == target, up is parallel to the view direction or fovy is
+/// outside (0, 180).
+Result<Camera> parseCamera(const std::string& text);
+
+/// The scene's N-th camera (0-based); InvalidInput if it has fewer.
+Result<Camera> sceneCamera(const Scene& scene, int index);
+
+/// Primary rays of a camera for an image of width × height pixels (square pixels,
+/// vertical field of view fovy).
+class CameraRays {
+public:
+    CameraRays(const Camera& camera, uint32_t width, uint32_t height);
+    /// Unit direction through image point (x, y) in pixels, (0,0) the top-left corner of the
+    /// top-left pixel; pixel centres are at +0.5.
+    glm::vec3 direction(float x, float y) const;
+    const glm::vec3& origin() const { return mEye; }
+
+private:
+    glm::vec3 mEye, mForward, mRight, mUp;
+    float mTanHalfFovy, mAspect;
+    uint32_t mWidth, mHeight;
+};
+
+}  // namespace pic

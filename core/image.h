@@ -1,0 +1,45 @@
+#pragma once
+/// Linear RGB images and their files: OpenEXR (half or float, linear) for measurement and
+/// PNG (sRGB, clamped) for people, written with OpenImageIO.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+
+namespace pic {
+
+/// A linear RGB float image, row 0 at the top.
+struct Image {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<glm::vec3> pixels;  ///< width·height, row-major
+
+    Image() = default;
+    Image(uint32_t w, uint32_t h) : width(w), height(h), pixels(size_t{w} * h, glm::vec3(0.0f)) {}
+    glm::vec3& at(uint32_t x, uint32_t y) { return pixels[size_t{y} * width + x]; }
+    const glm::vec3& at(uint32_t x, uint32_t y) const { return pixels[size_t{y} * width + x]; }
+};
+
+/// Writes by extension: .exr as 32-bit float linear RGB; .png as 8-bit sRGB of
+/// exposure·pixel clamped to [0,1]; .hdr/.tif via OpenImageIO as float. Atomic (temp + rename).
+Result<void> writeImage(const std::string& path, const Image& image, float exposure = 1.0f);
+
+/// Reads an image as linear RGB (PNG/JPEG are converted from sRGB).
+Result<Image> readImage(const std::string& path);
+
+/// Parses "WxH" (e.g. "640x480"); InvalidInput naming the text otherwise, sizes 1..16384.
+Result<glm::uvec2> parseImageSize(const std::string& text);
+
+/// Image comparison metrics against a reference (same size required).
+struct ImageError {
+    double rmse = 0.0;          ///< root mean square error over all pixels and channels
+    double relativeRmse = 0.0;  ///< rmse / mean of the reference
+    double meanRatio = 0.0;     ///< mean luminance of image / mean luminance of reference
+};
+Result<ImageError> compareImages(const Image& image, const Image& reference);
+
+}  // namespace pic

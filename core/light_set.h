@@ -1,0 +1,55 @@
+#pragma once
+/// Light sets (ARCHITECTURE.md §4): the lights and emissive scales a client sets, read from
+/// and written to the JSON form
+/// {"lights":[{"id","type","position","direction","color","intensity","innerConeAngle",
+///  "outerConeAngle","range"}], "emissiveScale":{"<material name>": s}}.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// Most lights one set may hold.
+inline constexpr size_t kMaxLights = 256;
+
+/// The dynamic lighting of a scene: punctual lights plus a scale per emissive material.
+struct LightSet {
+    std::vector<Light> lights;
+    std::map<std::string, float> emissiveScale;  ///< material name → factor on its emission (default 1)
+
+    /// Emission scale of a material (1 when not listed).
+    float emissiveScaleOf(const std::string& material) const;
+};
+
+/// The scene's own lights (KHR_lights_punctual), no emissive scaling.
+LightSet defaultLightSet(const Scene& scene);
+
+/// Parses and validates a light set from JSON text. Errors (InvalidInput) name the field
+/// and value: unknown type, NaN/Inf anywhere, negative intensity or colour, zero-length
+/// direction for spot/directional lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with
+/// outer > 0, negative range, more than kMaxLights lights, duplicate ids, unknown keys,
+/// negative or non-finite emissive scales. Directions are normalised.
+Result<LightSet> parseLightSet(const std::string& json);
+
+/// Reads a light set from a JSON file (NotFound if missing).
+Result<LightSet> readLightSet(const std::string& path);
+
+/// Serialises a light set to the same JSON form (round-trips through parseLightSet).
+std::string toJson(const LightSet& lights);
+
+/// Checks a light set against a scene: every emissiveScale key names a material of the scene.
+Result<void> checkLightSet(const LightSet& lights, const Scene& scene);
+
+/// Irradiance (W/m², RGB) that light `light` delivers at `position` on a surface with unit
+/// normal `normal`, ignoring occlusion: I·cosθ/d² for point and spot lights (with the
+/// KHR_lights_punctual spot falloff and range window), E·cosθ for directional lights.
+/// Also returns the unit direction towards the light and the distance to it (infinity for
+/// directional lights) for a shadow ray.
+glm::vec3 lightIrradiance(const Light& light, const glm::vec3& position, const glm::vec3& normal,
+                          glm::vec3& toLight, float& distance);
+
+}  // namespace pic

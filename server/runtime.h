@@ -1,0 +1,42 @@
+#pragma once
+/// The runtime of paper 000 Figure 2 behind one API with two backends (GPU, CPU twin):
+/// a light change in, cache radiance out.
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "core/bake_data.h"
+#include "core/cache_values.h"
+#include "core/error.h"
+#include "core/light_set.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// How many bounces the runtime computes.
+struct BounceParams {
+    int bounces = -1;                 ///< ≥ 0: exactly this many cache passes; −1: progressive
+    float convergence = 0.005f;       ///< progressive: stop when a bounce adds less than this fraction of flux
+    int maxBounces = 8;               ///< progressive: at most this many
+};
+
+/// Timings and counts of one update.
+struct UpdateStats {
+    int bounces = 0;                          ///< cache passes run
+    std::map<std::string, double> passMs;     ///< milliseconds per pass, summed over bounces
+    double totalMs = 0.0;
+    double surfelFlux = 0.0;                  ///< W, luminance of the last bounce's surfel flux
+};
+
+/// A runtime backend over one bake of one scene.
+class Runtime {
+public:
+    virtual ~Runtime() = default;
+    /// Relights the scene with `lights` and returns the caches' incident radiance.
+    virtual Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats = nullptr) = 0;
+    /// Backend name for logs ("cpu", "gpu").
+    virtual const char* name() const = 0;
+};
+
+}  // namespace pic
