@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bake/bake_options_cli.h"
+#include "bench/accuracy_benchmark.h"
 #include "bench/bake_benchmark.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -27,6 +28,26 @@ int picbenchMain(int argc, char** argv) {
     bake->add_option("--json", params.jsonPath, "write the figures to this JSON file");
     flags.addTo(*bake);
 
+    CLI::App* accuracy = app.add_subcommand("accuracy", "error of the cache term against a path-traced reference");
+    AccuracyParams accuracyParams;
+    BakeOptionFlags accuracyFlags;
+    accuracy->add_option("--scene", accuracyParams.scenePath, "scene file (.gltf or .glb)")->required();
+    accuracy->add_option("--lights", accuracyParams.lightsPath, "light set JSON (default: the scene's lights)");
+    auto* cameraOption = accuracy->add_option("--camera", accuracyParams.camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
+    accuracy->add_option("--scene-camera", accuracyParams.sceneCamera, "the scene's N-th camera (default 0)")
+        ->excludes(cameraOption);
+    accuracy->add_option("--size", accuracyParams.size, "image size WxH (default 256x256)");
+    accuracy->add_option("--spp", accuracyParams.spp, "reference samples per pixel (default 256)")->check(CLI::PositiveNumber);
+    accuracy->add_option("--probe-samples", accuracyParams.probeSamples, "path-traced directions per ideal cache (default 1024)")
+        ->check(CLI::PositiveNumber);
+    accuracy->add_option("--shade-spp", accuracyParams.shadeSpp, "subsamples per pixel when shading from caches (default 4)")
+        ->check(CLI::PositiveNumber);
+    accuracy->add_option("--bounces", accuracyParams.bounces, "bounces (default: converged / unlimited)");
+    accuracy->add_option("--out-dir", accuracyParams.outDir, "folder for images and JSON (default accuracy)");
+    accuracy->add_option("--json", accuracyParams.jsonPath, "JSON file (default <out-dir>/<scene>_accuracy.json)");
+    accuracy->add_option("--ref-seed", accuracyParams.seed, "path tracer seed (default 1)");
+    accuracyFlags.addTo(*accuracy);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -37,6 +58,10 @@ int picbenchMain(int argc, char** argv) {
     }
     setWorkerCount(threads);
     Progress::setEnabled(!quiet);
+    if (accuracy->parsed()) {
+        accuracyParams.bake = accuracyFlags.toOptions();
+        return runAccuracyBenchmark(accuracyParams);
+    }
     params.options = flags.toOptions();
     return runBakeBenchmark(params);
 }

@@ -1,0 +1,141 @@
+#pragma once
+/// The reference path tracer of `picref` (ARCHITECTURE.md §5): unbiased Lambertian path tracing
+/// of the pic scene model with next-event estimation for punctual lights and emissive
+/// triangles, multiple importance sampling for emitters and Russian roulette.
+///
+/// Paths are counted by their reflections: light that left a light or an emitter and reflected
+/// off k surfaces before arriving at the path's origin. A camera sees emitters with k = 0,
+/// direct light with k = 1 and indirect light with k ≥ 2; `--bounces B` keeps k ≤ B + 1, the
+/// camera-visible surface's own reflection not being counted as a bounce.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/embree_scene.h"
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/light_set.h"
+#include "core/sampling.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// What a path-traced image holds and how it is sampled.
+struct PathTraceParams {
+    /// Which paths count: Full = k ≥ 0 reflections (directly visible emitters included),
+    /// Direct = exactly one reflection, Indirect = k ≥ 2 reflections.
+    enum class Component { Full, Direct, Indirect };
+
+    uint32_t width = 0;
+    uint32_t height = 0;
+    uint32_t spp = 1;  ///< samples per pixel, jittered over the pixel (box filter)
+    int bounces = -1;  ///< B ≥ 0 keeps paths of at most B + 1 reflections; −1: unlimited
+    Component component = Component::Full;
+    uint64_t seed = 1;
+};
+
+/// What a run of the path tracer did.
+struct PathTraceStats {
+    uint64_t samples = 0;   ///< paths traced
+    uint64_t rejected = 0;  ///< paths whose estimate was NaN, infinite or negative (counted as 0)
+    double seconds = 0.0;   ///< wall time of the tracing
+};
+
+/// Everything paths share: the scene, its Embree BVH, the light set and the distributions that
+/// sample emissive triangles (in proportion to area × emitted luminance) and light vertices.
+/// Thread-safe queries.
+///
+/// Strategies. Every path of k reflections is sampled by BSDF sampling (emission found by a
+/// ray) and by next-event estimation (a shadow ray to a punctual light or to a sampled emitter
+/// point), weighted by the power heuristic where both apply. Light that reflects off a spot
+/// lit by a nearby point or spot light (a lamp under a ceiling) makes BSDF sampling alone noisy
+/// with rare, bright hits, so paths of k ≥ 2 reflections are also sampled from the light side:
+/// one light vertex per path (a ray from a point or spot light chosen by power to the first
+/// surface it hits) connected to every camera-path vertex, combined by MIS with BSDF sampling
+/// of that same vertex.
+class PathTracer {
+public:
+    /// The scene and Embree scene must outlive the tracer; the light set is copied.
+    PathTracer(const Scene& scene, const EmbreeScene& rays, const LightSet& lights);
+
+    /// Monte Carlo estimate of the radiance arriving at `origin` from unit `direction`, counting
+    /// paths of [min, max] reflections with min = 0, 1, 2 for Full, Direct, Indirect and
+    /// max = `maxReflections` for Full and Indirect (−1: unlimited with Russian roulette),
+    /// 1 for Direct (but at most `maxReflections`). The first ray starts at `origin` itself:
+    /// callers on a surface offset it. Never NaN, infinite or negative unless the scene is.
+    glm::vec3 traceRadiance(const glm::vec3& origin, const glm::vec3& direction, int maxReflections,
+                            PathTraceParams::Component component, Rng& rng) const;
+
+    /// Number of triangles that emit (with a non-zero emissive scale).
+    size_t emitterCount() const { return mEmitters.size(); }
+
+    const Scene& scene() const { return *mScene; }
+    const EmbreeScene& rays() const { return *mRays; }
+    const LightSet& lights() const { return mLights; }
+
+private:
+    /// A surface point lit directly by a punctual light, sampled from that light.
+    struct LightVertex {
+        glm::vec3 position{0.0f};
+        glm::vec3 normal{0.0f};  // unit, facing the light
+        glm::vec3 weight{0.0f};  // reflected radiance (ρ/π)·E divided by areaPdf
+        float areaPdf = 0.0f;    // density of the point per m² (light choice included)
+    };
+    struct Emitter {
+        uint32_t triangle;
+        float area;        // m²
+        glm::vec3 normal;  // unit; the side it emits to
+    };
+
+    /// Emitted radiance of triangle t at (b1, b2) with its material's emissive scale.
+    glm::vec3 emission(uint32_t t, float b1, float b2) const;
+    /// Direct light (punctual lights and a sampled emitter point) reflected at a surface point,
+    /// per unit albedo: ∫ L_light cosθ / π. `bsdfAreaPdf` is the density per m² with which the
+    /// previous vertex's BSDF sampling found this point, or negative when the point was not
+    /// reached from a surface (no light-vertex strategy competes for its paths then).
+    glm::vec3 directLight(const glm::vec3& position, const glm::vec3& normal, float bsdfAreaPdf,
+                          Rng& rng) const;
+    /// Light reflected once at `vertex` towards a surface point, per unit albedo of the point:
+    /// the light-vertex strategy's MIS-weighted estimate.
+    glm::vec3 connectLightVertex(const glm::vec3& position, const glm::vec3& normal,
+                                 const LightVertex& vertex) const;
+    /// Samples a light vertex, if the scene has point or spot lights and the ray hits something.
+    std::optional<LightVertex> sampleLightVertex(Rng& rng) const;
+    /// Density per m² with which sampleLightVertex finds the point at `distance` from light l
+    /// in unit direction `fromLight`, its normal making cosine `cosLight` with the light.
+    float lightVertexPdf(size_t l, const glm::vec3& fromLight, float distance,
+                         float cosLight) const;
+    /// Solid-angle density with which directLight samples the emitter point seen at distance
+    /// `distance` on triangle t under cosine `cosLight` at the emitter.
+    float emitterPdf(uint32_t t, float distance, float cosLight) const;
+
+    const Scene* mScene;
+    const EmbreeScene* mRays;
+    LightSet mLights;
+    std::vector<float> mMaterialEmissionScale;  // per material: LightSet emissive scale
+    std::vector<Emitter> mEmitters;             // emissive triangles
+    std::vector<float> mEmitterCdf;             // running sum of their selection probabilities
+    std::vector<float> mEmitterAreaPdf;         // per scene triangle: selection probability / area
+                                                // (area density of a sampled point), 0 if dark
+    std::vector<uint32_t> mVertexLights;        // point and spot lights that seed light vertices
+    std::vector<float> mVertexLightCdf;         // running sum of their selection probabilities
+    std::vector<float> mVertexLightPdf;         // per light: selection probability × direction
+                                                // density (1/sr, uniform over the sphere or the
+                                                // outer cone); 0 for the others
+};
+
+/// True if every channel is finite and non-negative: the guard every estimate passes.
+bool isValidRadiance(const glm::vec3& radiance);
+
+/// Path-traces an image of `camera` with one independent random stream per pixel sample, so
+/// the image depends on the seed only, not on the thread count. InvalidInput for zero sizes or
+/// spp, bounces < −1. Progress per row on stderr; `stats` (if given) receives the counts.
+Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
+                        const Camera& camera, const PathTraceParams& params,
+                        PathTraceStats* stats = nullptr);
+
+}  // namespace pic

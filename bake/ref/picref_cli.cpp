@@ -1,0 +1,362 @@
+#include "bake/ref/picref_cli.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bake/embree_scene.h"
+#include "bake/ref/path_tracer.h"
+#include "bake/ref/probes.h"
+#include "core/bake_file.h"
+#include "core/camera.h"
+#include "core/gltf_loader.h"
+#include "core/image.h"
+#include "core/light_set.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+
+namespace pic {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picref: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// InvalidInput unless `path` has one of `extensions` and its directory exists, so that a
+/// long run never ends in an unwritable output.
+Result<void> checkOutputPath(const std::string& path, const std::vector<std::string>& extensions,
+                             const char* option) {
+    std::string extension = fs::path(path).extension().string();
+    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (std::find(extensions.begin(), extensions.end(), extension) == extensions.end())
+        return fail(ErrorCode::InvalidInput, "{} '{}' has extension '{}'; expected one of {}",
+                    option, path, extension, fmt::join(extensions, ", "));
+    fs::path directory = fs::path(path).parent_path();
+    std::error_code ec;
+    if (!directory.empty() && !fs::is_directory(directory, ec))
+        return fail(ErrorCode::InvalidInput, "{} '{}': directory '{}' does not exist", option, path,
+                    directory.string());
+    return {};
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+Result<void> writeFileAtomically(const std::string& path, const std::string& bytes) {
+    std::string temporary = path + ".tmp";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+        if (!out) return fail(ErrorCode::Io, "cannot write '{}'", temporary);
+    }
+    std::error_code ec;
+    fs::rename(temporary, path, ec);
+    if (ec)
+        return fail(ErrorCode::Io, "cannot rename '{}' to '{}': {}", temporary, path, ec.message());
+    return {};
+}
+
+/// The scene's own lights, or the light set of `lightsPath` checked against the scene.
+Result<LightSet> loadLights(const std::string& lightsPath, const Scene& scene) {
+    if (lightsPath.empty()) return defaultLightSet(scene);
+    PIC_TRY_ASSIGN(LightSet lights, readLightSet(lightsPath));
+    if (auto checked = checkLightSet(lights, scene); !checked)
+        return std::unexpected(checked.error());
+    return lights;
+}
+
+/// The flags of `picref SCENE …`.
+struct RenderArgs {
+    std::string scenePath;
+    std::string cameraText;
+    std::optional<int> sceneCamera;
+    std::string sizeText;
+    uint32_t spp = 0;
+    int bounces = -1;
+    std::string component = "full";
+    std::string lightsPath;
+    uint64_t seed = 1;
+    float exposure = 1.0f;
+    std::string outPath;
+};
+
+int runRender(const RenderArgs& args) {
+    auto size = parseImageSize(args.sizeText);
+    if (!size) return reportError(size.error());
+    if (args.spp == 0)
+        return reportError({ErrorCode::InvalidInput, "--spp must be at least 1, got 0"});
+    if (args.bounces < -1)
+        return reportError(
+            {ErrorCode::InvalidInput,
+             fmt::format("--bounces must be -1 (unlimited) or >= 0, got {}", args.bounces)});
+    if (!(args.exposure > 0.0f) || !std::isfinite(args.exposure))
+        return reportError(
+            {ErrorCode::InvalidInput,
+             fmt::format("--exposure must be a positive number, got {}", args.exposure)});
+    if (auto ok = checkOutputPath(args.outPath, {".exr", ".png", ".hdr", ".tif", ".tiff"}, "--out");
+        !ok)
+        return reportError(ok.error());
+    std::optional<Camera> commandLineCamera;
+    if (!args.cameraText.empty()) {
+        auto camera = parseCamera(args.cameraText);
+        if (!camera) return reportError(camera.error());
+        commandLineCamera = *camera;
+    }
+
+    auto scene = loadScene(args.scenePath);
+    if (!scene) return reportError(scene.error());
+    Camera camera;
+    if (commandLineCamera) {
+        camera = *commandLineCamera;
+    } else {
+        auto fromScene = sceneCamera(*scene, *args.sceneCamera);
+        if (!fromScene) return reportError(fromScene.error());
+        camera = *fromScene;
+    }
+    auto lights = loadLights(args.lightsPath, *scene);
+    if (!lights) return reportError(lights.error());
+    auto rays = EmbreeScene::create(*scene);
+    if (!rays) return reportError(rays.error());
+
+    PathTraceParams params;
+    params.width = size->x;
+    params.height = size->y;
+    params.spp = args.spp;
+    params.bounces = args.bounces;
+    params.component = args.component == "direct"     ? PathTraceParams::Component::Direct
+                       : args.component == "indirect" ? PathTraceParams::Component::Indirect
+                                                      : PathTraceParams::Component::Full;
+    params.seed = args.seed;
+    PathTraceStats stats;
+    auto image = pathTrace(*scene, **rays, *lights, camera, params, &stats);
+    if (!image) return reportError(image.error());
+    if (auto written = writeImage(args.outPath, *image, args.exposure); !written)
+        return reportError(written.error());
+
+    std::fprintf(
+        stderr,
+        "picref: %ux%u, %u spp, %s, bounces %d: %.3f s, %.3f M samples/s on %d threads -> %s\n",
+        params.width, params.height, params.spp, args.component.c_str(), params.bounces,
+        stats.seconds, double(stats.samples) / stats.seconds / 1e6, workerCount(),
+        args.outPath.c_str());
+    if (stats.rejected)
+        std::fprintf(stderr,
+                     "picref: warning: %llu of %llu samples were NaN, infinite or negative "
+                     "and counted as zero\n",
+                     static_cast<unsigned long long>(stats.rejected),
+                     static_cast<unsigned long long>(stats.samples));
+    return 0;
+}
+
+/// The flags of `picref probes BAKE.pic …`.
+struct ProbeArgs {
+    std::string bakePath;
+    std::string scenePath;
+    std::string lightsPath;
+    ProbeParams params;
+    std::string outPath;
+    std::string binaryPath;
+};
+
+/// The binary form of the ideal caches (--binary): no header, little-endian float32 arrays
+/// in CacheValues order, one after the other: y (nC·lY² values), co (nC·lC²), cg (nC·lC²),
+/// each cache-major; nC, lY and lC are in the JSON written beside it.
+std::string binaryCacheValues(const CacheValues& values) {
+    std::string bytes;
+    for (const std::vector<float>* array : {&values.y, &values.co, &values.cg})
+        bytes.append(reinterpret_cast<const char*>(array->data()), array->size() * sizeof(float));
+    return bytes;
+}
+
+int runProbes(const ProbeArgs& args) {
+    if (args.params.samples == 0)
+        return reportError({ErrorCode::InvalidInput, "--samples must be at least 1, got 0"});
+    if (args.params.bounces < -1)
+        return reportError(
+            {ErrorCode::InvalidInput,
+             fmt::format("--bounces must be -1 (unlimited) or >= 0, got {}", args.params.bounces)});
+    if (auto ok = checkOutputPath(args.outPath, {".json"}, "--out"); !ok)
+        return reportError(ok.error());
+    if (!args.binaryPath.empty())
+        if (auto ok = checkOutputPath(args.binaryPath, {".bin"}, "--binary"); !ok)
+            return reportError(ok.error());
+
+    auto info = inspectBakeFile(args.bakePath);
+    if (!info) return reportError(info.error());
+    auto scene = loadScene(args.scenePath);
+    if (!scene) return reportError(scene.error());
+    if (auto matches = checkSceneMatches(*info, scene->hash, args.scenePath); !matches)
+        return reportError(matches.error());
+    auto bake = readBakeFile(args.bakePath);
+    if (!bake) return reportError(bake.error());
+    auto lights = loadLights(args.lightsPath, *scene);
+    if (!lights) return reportError(lights.error());
+    auto rays = EmbreeScene::create(*scene);
+    if (!rays) return reportError(rays.error());
+
+    PathTraceStats stats;
+    auto values = pathTraceProbes(*scene, **rays, *bake, *lights, args.params, &stats);
+    if (!values) return reportError(values.error());
+
+    Json out;
+    out["bake"] = args.bakePath;
+    out["scene"] = args.scenePath;
+    out["bands"] = {{"y", values->bandsY}, {"c", values->bandsC}};
+    out["samples"] = args.params.samples;
+    out["bounces"] = args.params.bounces;
+    out["seed"] = args.params.seed;
+    out["indirect_only"] = args.params.indirectOnly;
+    if (!args.binaryPath.empty()) out["binary"] = args.binaryPath;
+    Json caches = Json::array();
+    const size_t countY = size_t(values->bandsY) * values->bandsY;
+    const size_t countC = size_t(values->bandsC) * values->bandsC;
+    for (size_t c = 0; c < bake->caches.size(); ++c) {
+        const Cache& cache = bake->caches[c];
+        Json entry;
+        entry["position"] = {cache.position.x, cache.position.y, cache.position.z};
+        entry["kind"] = cache.kind == gpu::kCacheKindLightmap ? "lightmap" : "grid";
+        if (cache.kind == gpu::kCacheKindLightmap)
+            entry["normal"] = {cache.normal.x, cache.normal.y, cache.normal.z};
+        entry["y"] = std::vector<float>(values->y.begin() + std::ptrdiff_t(c * countY),
+                                        values->y.begin() + std::ptrdiff_t((c + 1) * countY));
+        entry["co"] = std::vector<float>(values->co.begin() + std::ptrdiff_t(c * countC),
+                                         values->co.begin() + std::ptrdiff_t((c + 1) * countC));
+        entry["cg"] = std::vector<float>(values->cg.begin() + std::ptrdiff_t(c * countC),
+                                         values->cg.begin() + std::ptrdiff_t((c + 1) * countC));
+        caches.push_back(std::move(entry));
+    }
+    out["caches"] = std::move(caches);
+
+    if (!args.binaryPath.empty())
+        if (auto written = writeFileAtomically(args.binaryPath, binaryCacheValues(*values));
+            !written)
+            return reportError(written.error());
+    if (auto written = writeFileAtomically(args.outPath, out.dump(1) + "\n"); !written)
+        return reportError(written.error());
+
+    std::fprintf(
+        stderr,
+        "picref: %zu caches, %u samples each: %.3f s, %.3f M samples/s on %d threads -> %s\n",
+        bake->caches.size(), args.params.samples, stats.seconds,
+        double(stats.samples) / std::max(stats.seconds, 1e-9) / 1e6, workerCount(),
+        args.outPath.c_str());
+    if (stats.rejected)
+        std::fprintf(stderr,
+                     "picref: warning: %llu of %llu samples were NaN, infinite or negative "
+                     "and counted as zero\n",
+                     static_cast<unsigned long long>(stats.rejected),
+                     static_cast<unsigned long long>(stats.samples));
+    return 0;
+}
+
+}  // namespace
+
+int picrefMain(int argc, char** argv) {
+    CLI::App app{
+        "picref: path-traced reference images (picref SCENE …) and ideal caches "
+        "(picref probes BAKE.pic …)"};
+    app.require_subcommand(0, 1);
+    app.fallthrough();  // global flags may follow the subcommand
+    int threads = 0;
+    bool quiet = false;
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--quiet", quiet, "no progress bars");
+
+    RenderArgs render;
+    int sceneCameraIndex = 0;
+    std::vector<CLI::Option*> renderOnly = {
+        app.add_option("scene", render.scenePath, "scene file (.gltf or .glb)"),
+        app.add_option("--camera", render.cameraText,
+                       "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy (fovy in degrees)"),
+        app.add_option("--scene-camera", sceneCameraIndex, "use the glTF's N-th camera (0-based)"),
+        app.add_option("--size", render.sizeText, "image size WxH"),
+        app.add_option("--spp", render.spp, "samples per pixel"),
+        app.add_option("--bounces", render.bounces,
+                       "indirect bounces B: 0 = direct light only, -1 = unlimited (default)"),
+        app.add_option("--component", render.component, "full (default), direct or indirect")
+            ->check(CLI::IsMember({"full", "direct", "indirect"})),
+        app.add_option("--lights", render.lightsPath,
+                       "light set JSON (default: the glTF's lights)"),
+        app.add_option("--seed", render.seed, "random seed (default 1)"),
+        app.add_option("--exposure", render.exposure,
+                       "scale applied before PNG encoding (default 1)"),
+        app.add_option("--out", render.outPath, "image to write (.exr linear float, .png sRGB)"),
+    };
+    CLI::Option* cameraOption = renderOnly[1];
+    CLI::Option* sceneCameraOption = renderOnly[2];
+    cameraOption->excludes(sceneCameraOption);
+
+    CLI::App* probesCommand =
+        app.add_subcommand("probes", "path-traced incident radiance SH at every cache of a bake");
+    ProbeArgs probes;
+    probesCommand->add_option("bake", probes.bakePath, "bake file (.pic)")->required();
+    probesCommand->add_option("--scene", probes.scenePath, "the scene the bake was made from")
+        ->required();
+    probesCommand->add_option("--lights", probes.lightsPath,
+                              "light set JSON (default: the glTF's lights)");
+    probesCommand->add_option("--samples", probes.params.samples,
+                              "directions per cache (default 1024)");
+    probesCommand->add_option(
+        "--bounces", probes.params.bounces,
+        "reflections B before light reaches a cache (0 = emitters only, -1 = unlimited)");
+    probesCommand->add_option("--seed", probes.params.seed, "random seed (default 1)");
+    bool withPunctual = false;
+    probesCommand->add_flag("--with-punctual", withPunctual,
+                            "also project the punctual lights' direct light (as deltas)");
+    probesCommand->add_option("--out", probes.outPath, "JSON file to write")->required();
+    probesCommand->add_option("--binary", probes.binaryPath,
+                              "also write the raw float32 arrays y, co, cg");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+    setWorkerCount(threads);
+    Progress::setEnabled(!quiet);
+
+    if (probesCommand->parsed()) {
+        // Options of the image form that reached the parent are mistakes, not silently ignored.
+        for (const CLI::Option* option : renderOnly)
+            if (option->count() > 0)
+                return reportError(
+                    {ErrorCode::InvalidInput,
+                     fmt::format("{} does not apply to `picref probes`", option->get_name())});
+        probes.params.indirectOnly = !withPunctual;
+        return runProbes(probes);
+    }
+
+    if (render.scenePath.empty())
+        return reportError(
+            {ErrorCode::InvalidInput,
+             "missing SCENE: picref SCENE (--camera … | --scene-camera N) --size WxH "
+             "--spp N --out FILE, or picref probes / picref shade"});
+    for (const char* name : {"--size", "--spp", "--out"})
+        if (app.get_option(name)->count() == 0)
+            return reportError({ErrorCode::InvalidInput, fmt::format("{} is required", name)});
+    if (cameraOption->count() == 0 && sceneCameraOption->count() == 0)
+        return reportError(
+            {ErrorCode::InvalidInput, "one of --camera or --scene-camera is required"});
+    if (sceneCameraOption->count() > 0) render.sceneCamera = sceneCameraIndex;
+    return runRender(render);
+}
+
+}  // namespace pic

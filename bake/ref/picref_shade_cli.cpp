@@ -1,0 +1,210 @@
+#include "bake/ref/picref_shade_cli.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "bake/embree_scene.h"
+#include "core/bake_file.h"
+#include "core/camera.h"
+#include "core/gltf_loader.h"
+#include "core/image.h"
+#include "core/light_set.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "server/cpu/cache_shading.h"
+#include "server/cpu/cpu_runtime.h"
+
+namespace pic {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picref shade: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// What the command line asked for, before any file is read.
+struct ShadeCommand {
+    std::string scenePath;
+    std::string bakePath;
+    std::string backend = "cpu";
+    std::string lightsPath;
+    std::string cameraText;
+    int sceneCameraIndex = -1;  ///< used when --camera is not given
+    std::string sizeText;
+    std::string component = "full";
+    int bounces = -1;
+    uint32_t spp = 1;
+    float glossyExponent = 0.0f;
+    float glossyWeight = 0.0f;
+    std::string outPath;
+    float exposure = 1.0f;
+};
+
+/// Checks what can be checked without reading files, so that usage errors come first.
+Result<void> checkUsage(const ShadeCommand& command) {
+    if (command.backend == "gpu")
+        return fail(ErrorCode::Unsupported,
+                    "the GPU backend is not built yet (issue 4); use --backend cpu");
+    if (command.bounces < -1)
+        return fail(ErrorCode::InvalidInput, "--bounces {} must be ≥ 0 (or −1: until converged)",
+                    command.bounces);
+    const std::string extension = std::filesystem::path(command.outPath).extension().string();
+    if (extension != ".exr" && extension != ".png" && extension != ".hdr" && extension != ".tif")
+        return fail(ErrorCode::InvalidInput,
+                    "--out {} must end in .exr (linear) or .png (sRGB), or .hdr or .tif",
+                    command.outPath);
+    if (!(std::isfinite(command.exposure) && command.exposure > 0.0f))
+        return fail(ErrorCode::InvalidInput, "--exposure {} must be a finite number > 0",
+                    command.exposure);
+    return {};
+}
+
+ShadeComponent toComponent(const std::string& name) {
+    if (name == "direct") return ShadeComponent::Direct;
+    if (name == "indirect") return ShadeComponent::Indirect;
+    return ShadeComponent::Full;
+}
+
+/// Loads everything, relights through the CPU runtime, shades and writes the image.
+int runShade(const ShadeCommand& command) {
+    if (auto usage = checkUsage(command); !usage) return reportError(usage.error());
+    auto size = parseImageSize(command.sizeText);
+    if (!size) return reportError(size.error());
+    std::optional<Camera> cliCamera;
+    if (!command.cameraText.empty()) {
+        auto parsed = parseCamera(command.cameraText);
+        if (!parsed) return reportError(parsed.error());
+        cliCamera = *parsed;
+    }
+
+    auto scene = loadScene(command.scenePath);
+    if (!scene) return reportError(scene.error());
+    // The cheap header check first: a bake of another scene is refused before its arrays load.
+    auto info = inspectBakeFile(command.bakePath);
+    if (!info) return reportError(info.error());
+    if (auto match = checkSceneMatches(*info, scene->hash, command.scenePath); !match)
+        return reportError(match.error());
+    auto bake = readBakeFile(command.bakePath);
+    if (!bake) return reportError(bake.error());
+
+    Camera camera;
+    if (cliCamera) {
+        camera = *cliCamera;
+    } else {
+        auto fromScene = sceneCamera(*scene, command.sceneCameraIndex);
+        if (!fromScene) return reportError(fromScene.error());
+        camera = *fromScene;
+    }
+
+    LightSet lights = defaultLightSet(*scene);
+    if (!command.lightsPath.empty()) {
+        auto read = readLightSet(command.lightsPath);
+        if (!read) return reportError(read.error());
+        if (auto ok = checkLightSet(*read, *scene); !ok) return reportError(ok.error());
+        lights = std::move(*read);
+    }
+
+    auto rays = EmbreeScene::create(*scene);
+    if (!rays) return reportError(rays.error());
+    auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{command.bounces});
+    if (!runtime) return reportError(runtime.error());
+
+    UpdateStats stats;
+    auto values = (*runtime)->setLights(lights, &stats);
+    if (!values) return reportError(values.error());
+    std::string passes;
+    for (const auto& [pass, ms] : stats.passMs)
+        passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", pass, ms);
+    std::fprintf(stderr, "picref shade: update on %s: %d bounces, %.1f ms (ms per pass: %s)\n",
+                 (*runtime)->name(), stats.bounces, stats.totalMs, passes.c_str());
+
+    ShadeParams params;
+    params.width = size->x;
+    params.height = size->y;
+    params.component = toComponent(command.component);
+    params.glossyExponent = command.glossyExponent;
+    params.glossyWeight = command.glossyWeight;
+    params.samplesPerPixel = command.spp;
+    const auto shadeStart = Clock::now();
+    auto image = shadeFromCaches(*scene, **rays, *bake, **values, lights, camera, params);
+    if (!image) return reportError(image.error());
+    const double shadeMs = millisecondsSince(shadeStart);
+
+    if (auto written = writeImage(command.outPath, *image, command.exposure); !written)
+        return reportError(written.error());
+    std::fprintf(stderr, "picref shade: shading %ux%u, %u spp, %s: %.1f ms on %d threads -> %s\n",
+                 params.width, params.height, params.samplesPerPixel, command.component.c_str(),
+                 shadeMs, workerCount(), command.outPath.c_str());
+    return 0;
+}
+
+}  // namespace
+
+int picrefShadeMain(int argc, char** argv) {
+    CLI::App app{
+        "picref shade: relights a bake with the runtime passes on one backend and shades "
+        "a camera view from its caches on the CPU"};
+    app.name("picref shade");
+    ShadeCommand command;
+    int threads = 0;
+    bool quiet = false;
+    app.add_option("scene", command.scenePath, "scene file (.gltf or .glb)")->required();
+    app.add_option("--bake", command.bakePath, "bake file of this scene (.pic)")->required();
+    app.add_option("--backend", command.backend, "runtime backend")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    app.add_option("--lights", command.lightsPath, "light set JSON (default: the scene's lights)");
+    auto* cameraOption = app.add_option("--camera", command.cameraText,
+                                        "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
+    auto* sceneCameraOption = app.add_option("--scene-camera", command.sceneCameraIndex,
+                                             "the glTF's N-th camera (0-based)");
+    cameraOption->excludes(sceneCameraOption);
+    app.add_option("--size", command.sizeText, "image size WxH")->required();
+    app.add_option("--component", command.component, "what the image holds")
+        ->check(CLI::IsMember({"full", "direct", "indirect"}));
+    app.add_option("--bounces", command.bounces,
+                   "cache passes: 0 = direct light only, B = up to B reflections (default: until "
+                   "a bounce adds < 0.5 % of the flux, at most 8)");
+    app.add_option("--spp", command.spp, "subsamples per pixel (box filter)")
+        ->check(CLI::Range(1u, 4096u));
+    auto* glossyOption = app.add_option("--glossy", command.glossyExponent,
+                                        "Phong exponent of an added glossy lobe (> 0)")
+                             ->check(CLI::PositiveNumber);
+    auto* glossyWeightOption = app.add_option("--glossy-weight", command.glossyWeight,
+                                              "factor on the glossy lobe's radiance (≥ 0)")
+                                   ->check(CLI::NonNegativeNumber);
+    glossyOption->needs(glossyWeightOption);
+    glossyWeightOption->needs(glossyOption);
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--quiet", quiet, "no progress bars");
+    app.add_option("--out", command.outPath, "image to write (.exr linear, .png sRGB)")->required();
+    app.add_option("--exposure", command.exposure, "factor applied before PNG quantisation");
+
+    try {
+        app.parse(argc, argv);
+        if (cameraOption->count() == 0 && sceneCameraOption->count() == 0)
+            throw CLI::RequiredError("--camera or --scene-camera");
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+    setWorkerCount(threads);
+    Progress::setEnabled(!quiet);
+    return runShade(command);
+}
+
+}  // namespace pic

@@ -1,0 +1,215 @@
+#include "bench/accuracy_benchmark.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "bake/embree_scene.h"
+#include "bake/ref/path_tracer.h"
+#include "bake/ref/probes.h"
+#include "core/camera.h"
+#include "core/color.h"
+#include "core/gltf_loader.h"
+#include "core/image.h"
+#include "core/light_set.h"
+#include "server/cpu/cache_shading.h"
+#include "server/cpu/cpu_runtime.h"
+
+namespace pic {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Error heat map: |luminance difference| / mean reference luminance, 0 → black, 0.5 → red,
+/// ≥ 1 → yellow-white.
+Image heatMap(const Image& image, const Image& reference) {
+    double mean = 0.0;
+    for (const glm::vec3& p : reference.pixels) mean += luminance(p);
+    mean = std::max(mean / double(reference.pixels.size()), 1e-30);
+    Image heat(image.width, image.height);
+    for (size_t i = 0; i < heat.pixels.size(); ++i) {
+        float e = static_cast<float>(std::abs(luminance(image.pixels[i]) - luminance(reference.pixels[i])) / mean);
+        heat.pixels[i] = glm::vec3(glm::clamp(2.0f * e, 0.0f, 1.0f), glm::clamp(2.0f * e - 1.0f, 0.0f, 1.0f),
+                                   glm::clamp(4.0f * e - 3.0f, 0.0f, 1.0f));
+    }
+    return heat;
+}
+
+/// Images placed left to right (all the same height); the heat map is not exposed.
+Image sideBySide(const std::vector<Image>& images, const std::vector<float>& scales) {
+    uint32_t width = 0;
+    for (const Image& image : images) width += image.width;
+    Image out(width, images.front().height);
+    uint32_t x0 = 0;
+    for (size_t k = 0; k < images.size(); ++k) {
+        for (uint32_t y = 0; y < images[k].height; ++y)
+            for (uint32_t x = 0; x < images[k].width; ++x) out.at(x0 + x, y) = images[k].at(x, y) * scales[k];
+        x0 += images[k].width;
+    }
+    return out;
+}
+
+float exposureFor(const Image& reference) {
+    double mean = 0.0;
+    for (const glm::vec3& p : reference.pixels) mean += luminance(p);
+    mean /= double(reference.pixels.size());
+    return mean > 0.0 ? static_cast<float>(0.25 / mean) : 1.0f;
+}
+
+Json errorJson(const ImageError& e) {
+    return {{"relative_rmse", e.relativeRmse}, {"rmse", e.rmse}, {"mean_ratio", e.meanRatio}};
+}
+
+}  // namespace
+
+int runAccuracyBenchmark(const AccuracyParams& params) {
+    auto failWith = [](const Error& error) {
+        std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
+        return exitCode(error);
+    };
+    auto size = parseImageSize(params.size);
+    if (!size) return failWith(size.error());
+    auto scene = loadScene(params.scenePath);
+    if (!scene) return failWith(scene.error());
+    auto camera = params.camera.empty() ? sceneCamera(*scene, params.sceneCamera) : parseCamera(params.camera);
+    if (!camera) return failWith(camera.error());
+    LightSet lights = defaultLightSet(*scene);
+    if (!params.lightsPath.empty()) {
+        auto read = readLightSet(params.lightsPath);
+        if (!read) return failWith(read.error());
+        lights = std::move(*read);
+    }
+    if (auto ok = checkLightSet(lights, *scene); !ok) return failWith(ok.error());
+
+    Json seconds;
+    auto start = Clock::now();
+    BakeReport bakeReport;
+    auto bake = runBake(*scene, params.bake, bakeReport);
+    if (!bake) return failWith(bake.error());
+    seconds["bake"] = secondsSince(start);
+
+    auto rays = EmbreeScene::create(*scene);
+    if (!rays) return failWith(rays.error());
+    start = Clock::now();
+    auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{params.bounces});
+    if (!runtime) return failWith(runtime.error());
+    UpdateStats update;
+    auto values = (*runtime)->setLights(lights, &update);
+    if (!values) return failWith(values.error());
+    seconds["runtime_cpu"] = secondsSince(start);
+
+    ShadeParams shade;
+    shade.width = size->x;
+    shade.height = size->y;
+    shade.samplesPerPixel = params.shadeSpp;
+    auto shadeBoth = [&](const CacheValues& caches, Image& full, Image& indirect) -> Result<void> {
+        shade.component = ShadeComponent::Full;
+        PIC_TRY_ASSIGN(full, shadeFromCaches(*scene, **rays, *bake, caches, lights, *camera, shade));
+        shade.component = ShadeComponent::Indirect;
+        PIC_TRY_ASSIGN(indirect, shadeFromCaches(*scene, **rays, *bake, caches, lights, *camera, shade));
+        return {};
+    };
+    Image oursFull, oursIndirect;
+    start = Clock::now();
+    if (auto ok = shadeBoth(**values, oursFull, oursIndirect); !ok) return failWith(ok.error());
+    seconds["shade"] = secondsSince(start);
+
+    PathTraceParams trace;
+    trace.width = size->x;
+    trace.height = size->y;
+    trace.spp = params.spp;
+    trace.bounces = params.bounces;
+    trace.seed = params.seed;
+    trace.component = PathTraceParams::Component::Full;
+    start = Clock::now();
+    auto refFull = pathTrace(*scene, **rays, lights, *camera, trace);
+    if (!refFull) return failWith(refFull.error());
+    seconds["reference_full"] = secondsSince(start);
+    trace.component = PathTraceParams::Component::Indirect;
+    start = Clock::now();
+    auto refIndirect = pathTrace(*scene, **rays, lights, *camera, trace);
+    if (!refIndirect) return failWith(refIndirect.error());
+    seconds["reference_indirect"] = secondsSince(start);
+
+    ProbeParams probe;
+    probe.samples = params.probeSamples;
+    probe.bounces = params.bounces;
+    probe.seed = params.seed;
+    start = Clock::now();
+    auto ideal = pathTraceProbes(*scene, **rays, *bake, lights, probe);
+    if (!ideal) return failWith(ideal.error());
+    seconds["probes"] = secondsSince(start);
+    Image idealFull, idealIndirect;
+    start = Clock::now();
+    if (auto ok = shadeBoth(*ideal, idealFull, idealIndirect); !ok) return failWith(ok.error());
+    seconds["shade_ideal"] = secondsSince(start);
+
+    auto compare = [&](const Image& a, const Image& b) { return compareImages(a, b); };
+    auto eIndirect = compare(oursIndirect, *refIndirect);
+    auto eFull = compare(oursFull, *refFull);
+    auto eIdealIndirect = compare(idealIndirect, *refIndirect);
+    auto eIdealFull = compare(idealFull, *refFull);
+    for (const auto* e : {&eIndirect, &eFull, &eIdealIndirect, &eIdealFull})
+        if (!*e) return failWith(e->error());
+
+    std::error_code ec;
+    std::filesystem::create_directories(params.outDir, ec);
+    const std::string stem = std::filesystem::path(params.scenePath).stem().string();
+    const std::string base = (std::filesystem::path(params.outDir) / stem).string();
+    const float exposureIndirect = exposureFor(*refIndirect), exposureFull = exposureFor(*refFull);
+    for (const auto& [name, image] : std::vector<std::pair<std::string, const Image*>>{
+             {"_ours_full.exr", &oursFull}, {"_ours_indirect.exr", &oursIndirect},
+             {"_ref_full.exr", &*refFull}, {"_ref_indirect.exr", &*refIndirect},
+             {"_ideal_indirect.exr", &idealIndirect}})
+        if (auto ok = writeImage(base + name, *image); !ok) return failWith(ok.error());
+    Image indirectSide = sideBySide({oursIndirect, idealIndirect, *refIndirect, heatMap(oursIndirect, *refIndirect)},
+                                    {exposureIndirect, exposureIndirect, exposureIndirect, 1.0f});
+    Image fullSide = sideBySide({oursFull, idealFull, *refFull, heatMap(oursFull, *refFull)},
+                                {exposureFull, exposureFull, exposureFull, 1.0f});
+    if (auto ok = writeImage(base + "_indirect_side.png", indirectSide); !ok) return failWith(ok.error());
+    if (auto ok = writeImage(base + "_full_side.png", fullSide); !ok) return failWith(ok.error());
+
+    Json json;
+    json["scene"] = params.scenePath;
+    json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
+    json["size"] = params.size;
+    json["reference_spp"] = params.spp;
+    json["probe_samples"] = params.probeSamples;
+    json["bake"] = {{"surfels", bake->params.surfels}, {"links_per_cache", bake->params.linksPerCache},
+                    {"link_mode", bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp"},
+                    {"bands_y", bake->params.bandsY}, {"bands_c", bake->params.bandsC},
+                    {"grid_cell", bake->params.gridCell}, {"lightmap_texel", bake->params.lightmapTexel},
+                    {"unique_caches", bake->caches.size()}};
+    json["runtime_bounces"] = update.bounces;
+    json["indirect"] = errorJson(*eIndirect);
+    json["full"] = errorJson(*eFull);
+    json["ideal_indirect"] = errorJson(*eIdealIndirect);
+    json["ideal_full"] = errorJson(*eIdealFull);
+    json["seconds"] = seconds;
+    json["images"] = {base + "_indirect_side.png", base + "_full_side.png"};
+    const std::string jsonPath = params.jsonPath.empty() ? base + "_accuracy.json" : params.jsonPath;
+    std::ofstream(jsonPath) << json.dump(2) << "\n";
+
+    std::printf("%s: %ux%u, reference %u spp, %d runtime bounces, %zu caches\n", stem.c_str(), size->x,
+                size->y, params.spp, update.bounces, bake->caches.size());
+    std::printf("  %-22s %14s %12s\n", "", "relative RMSE", "mean ratio");
+    std::printf("  %-22s %14.4f %12.4f\n", "indirect (linked)", eIndirect->relativeRmse, eIndirect->meanRatio);
+    std::printf("  %-22s %14.4f %12.4f\n", "indirect (ideal)", eIdealIndirect->relativeRmse, eIdealIndirect->meanRatio);
+    std::printf("  %-22s %14.4f %12.4f\n", "full (linked)", eFull->relativeRmse, eFull->meanRatio);
+    std::printf("  %-22s %14.4f %12.4f\n", "full (ideal)", eIdealFull->relativeRmse, eIdealFull->meanRatio);
+    std::printf("  seconds: %s\n", seconds.dump().c_str());
+    std::printf("  wrote %s, %s_indirect_side.png, %s_full_side.png (ours | ideal caches | path traced | error)\n",
+                jsonPath.c_str(), base.c_str(), base.c_str());
+    return 0;
+}
+
+}  // namespace pic

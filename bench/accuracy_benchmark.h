@@ -1,0 +1,33 @@
+#pragma once
+/// `picbench accuracy`: bakes a scene, runs the runtime's CPU twin, shades from the caches,
+/// path-traces the same view as ground truth, and reports the error (relative RMSE, mean
+/// luminance ratio) of the indirect component and of the full image, for the linked caches
+/// and for the ideal (path-traced) caches, with the wall time of every step. Writes JSON and
+/// side-by-side PNGs with an error heat map. Never asserts.
+
+#include <string>
+
+#include "bake/bake.h"
+
+namespace pic {
+
+struct AccuracyParams {
+    std::string scenePath;
+    std::string lightsPath;   ///< empty: the scene's own lights
+    std::string camera;       ///< --camera text; empty: use sceneCamera
+    int sceneCamera = 0;
+    std::string size = "256x256";
+    uint32_t spp = 256;           ///< path-traced reference samples per pixel
+    uint32_t probeSamples = 1024; ///< path-traced directions per ideal cache
+    uint32_t shadeSpp = 4;        ///< subsamples per pixel when shading from caches
+    int bounces = -1;             ///< runtime and reference bounces (−1: converged / unlimited)
+    BakeOptions bake;
+    std::string outDir = "accuracy";
+    std::string jsonPath;         ///< empty: <outDir>/<scene>_accuracy.json
+    uint64_t seed = 1;
+};
+
+/// Runs the comparison; returns the process exit code.
+int runAccuracyBenchmark(const AccuracyParams& params);
+
+}  // namespace pic

@@ -1,0 +1,161 @@
+#include "core/cache_values.h"
+
+#include <algorithm>
+
+#include "core/color.h"
+#include "core/error.h"
+#include "core/sh.h"
+
+namespace pic {
+namespace {
+
+/// Up to 8 caches around a point with their interpolation weights.
+struct CacheStencil {
+    uint32_t cache[8];
+    float weight[8];
+    int count = 0;
+
+    /// Adds a neighbour; neighbours without a cache take no weight.
+    void add(uint32_t cacheIndex, float w) {
+        if (cacheIndex == kNoCache) return;
+        cache[count] = cacheIndex;
+        weight[count] = w;
+        ++count;
+    }
+};
+
+/// Blends the stencil's caches into RGB SH. The weights are renormalised over the caches that
+/// exist; when all of those carry zero weight (the point sits exactly on a missing vertex or
+/// texel, whose own weight is 1) they are averaged equally instead, so that such a point still
+/// sees the radiance of its neighbours rather than a black speck.
+RadianceSh blend(const CacheValues& values, const CacheStencil& stencil) {
+    RadianceSh out;
+    out.bands = values.bandsY;
+    if (stencil.count == 0) return out;
+
+    float total = 0.0f;
+    for (int k = 0; k < stencil.count; ++k) total += stencil.weight[k];
+    float weights[8];
+    for (int k = 0; k < stencil.count; ++k)
+        weights[k] = total > 0.0f ? stencil.weight[k] / total : 1.0f / float(stencil.count);
+
+    // Interpolate in YCoCg first (the conversion is linear), then convert once per coefficient.
+    const size_t countY = shCount(int(values.bandsY));
+    const size_t countC = shCount(int(values.bandsC));
+    float y[shCount(kMaxShBands)] = {};
+    float co[shCount(kMaxShBands)] = {};
+    float cg[shCount(kMaxShBands)] = {};
+    for (int k = 0; k < stencil.count; ++k) {
+        const size_t cache = stencil.cache[k];
+        PIC_DCHECK(cache < values.cacheCount());
+        const float w = weights[k];
+        const float* srcY = values.y.data() + cache * countY;
+        for (size_t i = 0; i < countY; ++i) y[i] += w * srcY[i];
+        const float* srcCo = values.co.data() + cache * countC;
+        const float* srcCg = values.cg.data() + cache * countC;
+        for (size_t i = 0; i < countC; ++i) {
+            co[i] += w * srcCo[i];
+            cg[i] += w * srcCg[i];
+        }
+    }
+    // Chroma bands above lC stay zero: those coefficients are grey (R = G = B = Y).
+    for (size_t i = 0; i < countY; ++i) {
+        const glm::vec3 rgb = yCoCgToRgb(glm::vec3(y[i], co[i], cg[i]));
+        out.rgb[0][i] = rgb.r;
+        out.rgb[1][i] = rgb.g;
+        out.rgb[2][i] = rgb.b;
+    }
+    return out;
+}
+
+/// Lower vertex index and fraction along one grid axis of a (clamped) vertex coordinate.
+void gridAxis(float coordinate, uint32_t vertices, uint32_t& lower, float& fraction) {
+    if (vertices < 2) {
+        lower = 0;
+        fraction = 0.0f;
+        return;
+    }
+    // Points outside the grid take the value of the nearest point on its boundary (the
+    // negated comparison also sends NaN to vertex 0 rather than into an out-of-range index).
+    const float c = !(coordinate > 0.0f) ? 0.0f : std::min(coordinate, float(vertices - 1));
+    lower = std::min(uint32_t(c), vertices - 2);
+    fraction = c - float(lower);
+}
+
+}  // namespace
+
+CacheValues CacheValues::zeros(size_t caches, uint32_t bandsY, uint32_t bandsC) {
+    PIC_CHECK(bandsC <= bandsY && bandsY <= uint32_t(kMaxShBands));
+    CacheValues values;
+    values.bandsY = bandsY;
+    values.bandsC = bandsC;
+    values.y.assign(caches * bandsY * bandsY, 0.0f);
+    values.co.assign(caches * bandsC * bandsC, 0.0f);
+    values.cg.assign(caches * bandsC * bandsC, 0.0f);
+    return values;
+}
+
+RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
+                              const glm::vec3& position) {
+    const GridLayout& grid = bake.grid;
+    CacheStencil stencil;
+    if (grid.cellSize > 0.0f && !grid.cacheIndex.empty()) {
+        const glm::vec3 p = (position - grid.origin) / grid.cellSize;
+        uint32_t lower[3];
+        float fraction[3];
+        for (int a = 0; a < 3; ++a) gridAxis(p[a], grid.dims[a], lower[a], fraction[a]);
+        for (uint32_t corner = 0; corner < 8; ++corner) {
+            uint32_t v[3];
+            float w = 1.0f;
+            bool exists = true;
+            for (int a = 0; a < 3; ++a) {
+                const uint32_t upper = (corner >> a) & 1u;
+                // A one-vertex axis has no upper neighbour.
+                exists = exists && !(upper && grid.dims[a] < 2);
+                v[a] = lower[a] + upper;
+                w *= upper ? fraction[a] : 1.0f - fraction[a];
+            }
+            if (!exists) continue;
+            const size_t index = v[0] + size_t{grid.dims.x} * (v[1] + size_t{grid.dims.y} * v[2]);
+            stencil.add(grid.cacheIndex[index], w);
+        }
+    }
+    return blend(values, stencil);
+}
+
+RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values, uint32_t triangle,
+                                 float b1, float b2, const glm::vec3& position) {
+    const LightmapLayout& map = bake.lightmap;
+    const size_t first = size_t{triangle} * 3;
+    if (first + 2 >= map.triangleUvs.size() || map.triangleUvs[first].x == kNotLightmapped ||
+        map.width == 0 || map.height == 0)
+        return lookupGridRadiance(bake, values, position);
+
+    const glm::vec2 uv = (1.0f - b1 - b2) * map.triangleUvs[first] +
+                         b1 * map.triangleUvs[first + 1] + b2 * map.triangleUvs[first + 2];
+    // Texel centres sit at (x + 0.5, y + 0.5) in texel units.
+    const glm::vec2 p = uv * glm::vec2(float(map.width), float(map.height)) - 0.5f;
+    const glm::vec2 base = glm::floor(p);
+    const glm::vec2 f = p - base;
+    CacheStencil stencil;
+    for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+            const float x = base.x + float(dx);
+            const float y = base.y + float(dy);
+            // Texels outside the atlas do not exist: they take no weight.
+            if (!(x >= 0.0f && y >= 0.0f && x < float(map.width) && y < float(map.height)))
+                continue;
+            const float w = (dx ? f.x : 1.0f - f.x) * (dy ? f.y : 1.0f - f.y);
+            stencil.add(map.cacheIndex[size_t(x) + size_t{map.width} * size_t(y)], w);
+        }
+    }
+    return blend(values, stencil);
+}
+
+glm::vec3 irradiance(const RadianceSh& radiance, const glm::vec3& normal) {
+    glm::vec3 e;
+    for (int c = 0; c < 3; ++c) e[c] = shIrradiance(int(radiance.bands), radiance.rgb[c], normal);
+    return e;
+}
+
+}  // namespace pic

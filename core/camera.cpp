@@ -1,0 +1,102 @@
+#include "core/camera.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <string_view>
+#include <system_error>
+
+namespace pic {
+
+namespace {
+
+/// Text without leading and trailing spaces and tabs.
+std::string_view trimmed(std::string_view text) {
+    size_t begin = text.find_first_not_of(" \t");
+    if (begin == std::string_view::npos) return {};
+    size_t end = text.find_last_not_of(" \t");
+    return text.substr(begin, end - begin + 1);
+}
+
+}  // namespace
+
+Result<Camera> parseCamera(const std::string& text) {
+    constexpr const char* kUsage = "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy";
+    std::array<float, 10> values{};
+    size_t count = 0;
+    std::string_view rest = text;
+    while (true) {
+        size_t comma = rest.find(',');
+        std::string_view field = trimmed(rest.substr(0, comma));
+        if (count == values.size())
+            return fail(ErrorCode::InvalidInput, "--camera needs 10 numbers {}, got more in \"{}\"",
+                        kUsage, text);
+        float& value = values[count++];
+        auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+        if (field.empty() || ec != std::errc() || end != field.data() + field.size() ||
+            !std::isfinite(value))
+            return fail(ErrorCode::InvalidInput,
+                        "--camera needs 10 finite numbers {}, field {} is \"{}\" in \"{}\"", kUsage,
+                        count, field, text);
+        if (comma == std::string_view::npos) break;
+        rest.remove_prefix(comma + 1);
+    }
+    if (count != values.size())
+        return fail(ErrorCode::InvalidInput, "--camera needs 10 numbers {}, got {} in \"{}\"",
+                    kUsage, count, text);
+
+    Camera camera;
+    camera.name = "--camera";
+    camera.eye = {values[0], values[1], values[2]};
+    camera.target = {values[3], values[4], values[5]};
+    camera.up = {values[6], values[7], values[8]};
+    camera.fovyDegrees = values[9];
+
+    glm::vec3 view = camera.target - camera.eye;
+    if (!(glm::length(view) > 0.0f))
+        return fail(ErrorCode::InvalidInput, "--camera eye and target are the same point in \"{}\"",
+                    text);
+    // Relative test, so that scenes in millimetres or kilometres behave alike.
+    float upLength = glm::length(camera.up);
+    if (!(upLength > 0.0f) ||
+        glm::length(glm::cross(view / glm::length(view), camera.up / upLength)) < 1e-4f)
+        return fail(ErrorCode::InvalidInput,
+                    "--camera up vector is zero or parallel to the view direction in \"{}\"", text);
+    if (!(camera.fovyDegrees > 0.0f && camera.fovyDegrees < 180.0f))
+        return fail(ErrorCode::InvalidInput,
+                    "--camera fovy must be in (0, 180) degrees, got {} in \"{}\"",
+                    camera.fovyDegrees, text);
+    return camera;
+}
+
+Result<Camera> sceneCamera(const Scene& scene, int index) {
+    if (index < 0 || size_t(index) >= scene.cameras.size())
+        return fail(ErrorCode::InvalidInput, "--scene-camera {} does not exist: {} has {} camera{}",
+                    index, scene.sourcePath.empty() ? "the scene" : scene.sourcePath,
+                    scene.cameras.size(), scene.cameras.size() == 1 ? "" : "s");
+    return scene.cameras[size_t(index)];
+}
+
+CameraRays::CameraRays(const Camera& camera, uint32_t width, uint32_t height)
+    : mEye(camera.eye),
+      mTanHalfFovy(std::tan(glm::radians(camera.fovyDegrees) * 0.5f)),
+      mAspect(float(width) / float(height)),
+      mWidth(width),
+      mHeight(height) {
+    PIC_CHECK(width > 0 && height > 0);
+    // Right-handed: right = forward × up, and the given up is only a hint, re-orthogonalised.
+    mForward = glm::normalize(camera.target - camera.eye);
+    mRight = glm::normalize(glm::cross(mForward, camera.up));
+    mUp = glm::cross(mRight, mForward);
+    PIC_CHECK(std::isfinite(mRight.x + mRight.y + mRight.z) && std::isfinite(mTanHalfFovy));
+}
+
+glm::vec3 CameraRays::direction(float x, float y) const {
+    // Normalised device coordinates in [-1, 1]; image y grows downward, camera up is +1.
+    float ndcX = 2.0f * x / float(mWidth) - 1.0f;
+    float ndcY = 1.0f - 2.0f * y / float(mHeight);
+    return glm::normalize(mForward + (ndcX * mAspect * mTanHalfFovy) * mRight +
+                          (ndcY * mTanHalfFovy) * mUp);
+}
+
+}  // namespace pic

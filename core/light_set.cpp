@@ -1,0 +1,395 @@
+#include "core/light_set.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <set>
+#include <string_view>
+#include <system_error>
+
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
+
+namespace pic {
+
+namespace {
+
+// Input keeps the order it was written in, so errors about unknown keys name the first one.
+using Json = nlohmann::ordered_json;
+// Output prints numbers as float, the type Light holds: each prints in its shortest form
+// ("0.1", not "0.10000000149011612") and still parses back to the same float.
+using FloatJson = nlohmann::basic_json<nlohmann::ordered_map, std::vector, std::string, bool,
+                                       std::int64_t, std::uint64_t, float>;
+
+const char* typeName(LightType type) {
+    switch (type) {
+    case LightType::Point:
+        return "point";
+    case LightType::Spot:
+        return "spot";
+    case LightType::Directional:
+        return "directional";
+    }
+    return "point";
+}
+
+/// The float a JSON number holds, or NaN when it is not a finite float (1e39 is a finite
+/// double but Inf as a float).
+float finiteFloat(const Json& number) {
+    double value = number.get<double>();
+    if (!std::isfinite(value) || std::abs(value) > double(std::numeric_limits<float>::max()))
+        return std::numeric_limits<float>::quiet_NaN();
+    return float(value);
+}
+
+/// Short form of a JSON value for messages, cut so a huge value cannot flood the terminal.
+std::string shown(const Json& value) {
+    std::string text = value.dump();
+    constexpr size_t kMaxShown = 60;
+    if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...";
+    return text;
+}
+
+/// Reads the fields of one JSON object, naming each by its path ("lights[2].intensity") in
+/// errors, and reports keys that were never asked for.
+class FieldReader {
+public:
+    FieldReader(const Json& object, std::string path) : mObject(object), mPath(std::move(path)) {}
+
+    const std::string& path() const { return mPath; }
+    std::string fieldPath(std::string_view key) const { return fmt::format("{}.{}", mPath, key); }
+
+    /// The value under key, or null when absent; marks the key as known.
+    const Json* find(std::string_view key) {
+        mKnown.insert(std::string(key));
+        auto it = mObject.find(key);
+        return it == mObject.end() ? nullptr : &*it;
+    }
+
+    Result<float> number(std::string_view key, float fallback) {
+        const Json* value = find(key);
+        if (!value) return fallback;
+        if (!value->is_number())
+            return fail(ErrorCode::InvalidInput, "{} must be a number, got {}", fieldPath(key),
+                        shown(*value));
+        float number = finiteFloat(*value);
+        if (!std::isfinite(number))
+            return fail(ErrorCode::InvalidInput, "{} must be finite, got {}", fieldPath(key),
+                        shown(*value));
+        return number;
+    }
+
+    Result<glm::vec3> vec3(std::string_view key, const glm::vec3& fallback) {
+        const Json* value = find(key);
+        if (!value) return fallback;
+        if (!value->is_array() || value->size() != 3)
+            return fail(ErrorCode::InvalidInput, "{} must be an array of 3 numbers, got {}",
+                        fieldPath(key), shown(*value));
+        glm::vec3 v;
+        for (int i = 0; i < 3; ++i) {
+            const Json& element = (*value)[size_t(i)];
+            if (!element.is_number())
+                return fail(ErrorCode::InvalidInput, "{}[{}] must be a number, got {}",
+                            fieldPath(key), i, shown(element));
+            v[i] = finiteFloat(element);
+            if (!std::isfinite(v[i]))
+                return fail(ErrorCode::InvalidInput, "{}[{}] must be finite, got {}",
+                            fieldPath(key), i, shown(element));
+        }
+        return v;
+    }
+
+    /// Fails on the first key that no find() asked for: a misspelt field must not silently
+    /// fall back to its default.
+    Result<void> rejectUnknown() const {
+        for (auto it = mObject.begin(); it != mObject.end(); ++it)
+            if (!mKnown.contains(it.key()))
+                return fail(ErrorCode::InvalidInput, "{} has unknown key \"{}\"", mPath, it.key());
+        return {};
+    }
+
+private:
+    const Json& mObject;
+    std::string mPath;
+    std::set<std::string, std::less<>> mKnown;
+};
+
+/// Fields that only some light types use; naming one on another type is almost certainly a
+/// mistake in the type (a "point" light with cone angles was meant to be a spot).
+Result<void> rejectInapplicable(FieldReader& fields, LightType type,
+                                std::initializer_list<std::string_view> keys) {
+    for (std::string_view key : keys)
+        if (fields.find(key))
+            return fail(ErrorCode::InvalidInput, "{} does not apply to a {} light",
+                        fields.fieldPath(key), typeName(type));
+    return {};
+}
+
+Result<Light> parseLight(const Json& value, size_t index) {
+    std::string path = fmt::format("lights[{}]", index);
+    if (!value.is_object())
+        return fail(ErrorCode::InvalidInput, "{} must be an object, got {}", path, shown(value));
+    FieldReader fields(value, path);
+    Light light;
+
+    if (const Json* id = fields.find("id")) {
+        if (!id->is_string() || id->get<std::string>().empty())
+            return fail(ErrorCode::InvalidInput, "{} must be a non-empty string, got {}",
+                        fields.fieldPath("id"), shown(*id));
+        light.id = id->get<std::string>();
+    } else {
+        light.id = fmt::format("light_{}", index);
+    }
+
+    const Json* type = fields.find("type");
+    if (!type)
+        return fail(ErrorCode::InvalidInput,
+                    "{} is missing; it must be \"point\", \"spot\" or \"directional\"",
+                    fields.fieldPath("type"));
+    if (*type == "point")
+        light.type = LightType::Point;
+    else if (*type == "spot")
+        light.type = LightType::Spot;
+    else if (*type == "directional")
+        light.type = LightType::Directional;
+    else
+        return fail(ErrorCode::InvalidInput,
+                    "{} must be \"point\", \"spot\" or \"directional\", got {}",
+                    fields.fieldPath("type"), shown(*type));
+
+    // Defaults are those of KHR_lights_punctual, which Light's initialisers already hold.
+    PIC_TRY_ASSIGN(light.color, fields.vec3("color", light.color));
+    if (glm::any(glm::lessThan(light.color, glm::vec3(0.0f))))
+        return fail(ErrorCode::InvalidInput, "{} must be non-negative, got [{}, {}, {}]",
+                    fields.fieldPath("color"), light.color.x, light.color.y, light.color.z);
+
+    PIC_TRY_ASSIGN(light.intensity, fields.number("intensity", light.intensity));
+    if (light.intensity < 0.0f)
+        return fail(ErrorCode::InvalidInput, "{} must be finite and ≥ 0, got {}",
+                    fields.fieldPath("intensity"), light.intensity);
+
+    if (light.type != LightType::Directional) {
+        PIC_TRY_ASSIGN(light.position, fields.vec3("position", light.position));
+        PIC_TRY_ASSIGN(light.range, fields.number("range", light.range));
+        if (!(light.range > 0.0f))
+            return fail(ErrorCode::InvalidInput, "{} must be > 0 (absent for no cut-off), got {}",
+                        fields.fieldPath("range"), light.range);
+    } else {
+        if (auto rejected = rejectInapplicable(fields, light.type, {"position", "range"});
+            !rejected)
+            return std::unexpected(rejected.error());
+    }
+
+    if (light.type != LightType::Point) {
+        PIC_TRY_ASSIGN(glm::vec3 direction, fields.vec3("direction", light.direction));
+        float length = glm::length(direction);
+        if (!(length > 0.0f) || !std::isfinite(length))
+            return fail(ErrorCode::InvalidInput, "{} must have a non-zero length, got [{}, {}, {}]",
+                        fields.fieldPath("direction"), direction.x, direction.y, direction.z);
+        light.direction = direction / length;
+    } else {
+        if (auto rejected = rejectInapplicable(fields, light.type, {"direction"}); !rejected)
+            return std::unexpected(rejected.error());
+    }
+
+    if (light.type == LightType::Spot) {
+        PIC_TRY_ASSIGN(light.innerConeAngle, fields.number("innerConeAngle", light.innerConeAngle));
+        PIC_TRY_ASSIGN(light.outerConeAngle, fields.number("outerConeAngle", light.outerConeAngle));
+        float inner = light.innerConeAngle;
+        float outer = light.outerConeAngle;
+        if (!(outer > 0.0f && outer <= glm::half_pi<float>()))
+            return fail(ErrorCode::InvalidInput, "{} must be in (0, π/2], got {}",
+                        fields.fieldPath("outerConeAngle"), outer);
+        if (!(inner >= 0.0f && inner <= outer))
+            return fail(ErrorCode::InvalidInput, "{} must be in [0, outerConeAngle = {}], got {}",
+                        fields.fieldPath("innerConeAngle"), outer, inner);
+    } else {
+        if (auto rejected =
+                rejectInapplicable(fields, light.type, {"innerConeAngle", "outerConeAngle"});
+            !rejected)
+            return std::unexpected(rejected.error());
+    }
+
+    if (auto known = fields.rejectUnknown(); !known) return std::unexpected(known.error());
+    return light;
+}
+
+Result<std::map<std::string, float>> parseEmissiveScale(const Json& value) {
+    if (!value.is_object())
+        return fail(ErrorCode::InvalidInput, "emissiveScale must be an object, got {}",
+                    shown(value));
+    std::map<std::string, float> scales;
+    for (auto it = value.begin(); it != value.end(); ++it) {
+        const Json& scale = it.value();
+        float value = scale.is_number() ? finiteFloat(scale) : -1.0f;
+        if (!(value >= 0.0f))
+            return fail(ErrorCode::InvalidInput,
+                        "emissiveScale[\"{}\"] must be a finite number ≥ 0, got {}", it.key(),
+                        shown(scale));
+        scales[it.key()] = value;
+    }
+    return scales;
+}
+
+FloatJson vec3Json(const glm::vec3& v) {
+    return FloatJson::array({v.x, v.y, v.z});
+}
+
+}  // namespace
+
+float LightSet::emissiveScaleOf(const std::string& material) const {
+    auto it = emissiveScale.find(material);
+    return it == emissiveScale.end() ? 1.0f : it->second;
+}
+
+LightSet defaultLightSet(const Scene& scene) {
+    LightSet set;
+    set.lights = scene.lights;
+    return set;
+}
+
+Result<LightSet> parseLightSet(const std::string& json) {
+    // nlohmann reports syntax errors and number overflow only as exceptions; none leaves here.
+    Json root;
+    try {
+        root = Json::parse(json);
+    } catch (const Json::exception& error) {
+        return fail(ErrorCode::InvalidInput, "light set is not valid JSON: {}", error.what());
+    }
+    if (!root.is_object())
+        return fail(ErrorCode::InvalidInput, "light set must be a JSON object, got {}",
+                    shown(root));
+
+    FieldReader fields(root, "light set");
+    LightSet set;
+    if (const Json* lights = fields.find("lights")) {
+        if (!lights->is_array())
+            return fail(ErrorCode::InvalidInput, "lights must be an array, got {}", shown(*lights));
+        if (lights->size() > kMaxLights)
+            return fail(ErrorCode::InvalidInput, "lights holds {} lights, at most {} are allowed",
+                        lights->size(), kMaxLights);
+        std::set<std::string> ids;
+        for (size_t i = 0; i < lights->size(); ++i) {
+            PIC_TRY_ASSIGN(Light light, parseLight((*lights)[i], i));
+            // Sessions address lights by id, so two lights must never share one.
+            if (!ids.insert(light.id).second)
+                return fail(ErrorCode::InvalidInput, "lights[{}].id \"{}\" is used twice", i,
+                            light.id);
+            set.lights.push_back(std::move(light));
+        }
+    }
+    if (const Json* scales = fields.find("emissiveScale")) {
+        PIC_TRY_ASSIGN(set.emissiveScale, parseEmissiveScale(*scales));
+    }
+    if (auto known = fields.rejectUnknown(); !known) return std::unexpected(known.error());
+    return set;
+}
+
+Result<LightSet> readLightSet(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        return fail(ErrorCode::NotFound, "light set file {} does not exist", path);
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return fail(ErrorCode::Io, "cannot open light set file {}", path);
+    std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    if (file.bad()) return fail(ErrorCode::Io, "cannot read light set file {}", path);
+    auto set = parseLightSet(text);
+    if (!set) return fail(set.error().code, "{}: {}", path, set.error().message);
+    return set;
+}
+
+std::string toJson(const LightSet& set) {
+    FloatJson lights = FloatJson::array();
+    for (const Light& light : set.lights) {
+        // Only the fields the type uses, so the output parses back under the same rules.
+        FloatJson object;
+        object["id"] = light.id;
+        object["type"] = typeName(light.type);
+        if (light.type != LightType::Directional) object["position"] = vec3Json(light.position);
+        if (light.type != LightType::Point) object["direction"] = vec3Json(light.direction);
+        object["color"] = vec3Json(light.color);
+        object["intensity"] = light.intensity;
+        if (light.type == LightType::Spot) {
+            object["innerConeAngle"] = light.innerConeAngle;
+            object["outerConeAngle"] = light.outerConeAngle;
+        }
+        // JSON cannot hold infinity: an absent range means no cut-off.
+        if (light.type != LightType::Directional && std::isfinite(light.range))
+            object["range"] = light.range;
+        lights.push_back(std::move(object));
+    }
+    FloatJson root;
+    root["lights"] = std::move(lights);
+    FloatJson scales = FloatJson::object();
+    for (const auto& [material, scale] : set.emissiveScale) scales[material] = scale;
+    root["emissiveScale"] = std::move(scales);
+    return root.dump(2);
+}
+
+Result<void> checkLightSet(const LightSet& set, const Scene& scene) {
+    std::set<std::string, std::less<>> materials;
+    for (const Material& material : scene.materials) materials.insert(material.name);
+    for (const auto& [material, scale] : set.emissiveScale) {
+        if (!materials.contains(material)) {
+            std::string known;
+            for (const std::string& name : materials)
+                known += fmt::format("{}\"{}\"", known.empty() ? "" : ", ", name);
+            return fail(ErrorCode::InvalidInput,
+                        "emissiveScale names material \"{}\", which the scene does not have "
+                        "(materials: {})",
+                        material, known.empty() ? "none" : known);
+        }
+    }
+    return {};
+}
+
+glm::vec3 lightIrradiance(const Light& light, const glm::vec3& position, const glm::vec3& normal,
+                          glm::vec3& toLight, float& distance) {
+    if (light.type == LightType::Directional) {
+        toLight = -light.direction;
+        distance = std::numeric_limits<float>::infinity();
+        return light.intensity * light.color * std::max(0.0f, glm::dot(normal, toLight));
+    }
+
+    glm::vec3 offset = light.position - position;
+    distance = glm::length(offset);
+    // A point on the light itself receives no defined irradiance; report none rather than Inf.
+    if (!(distance > 0.0f)) {
+        toLight = normal;
+        distance = 0.0f;
+        return glm::vec3(0.0f);
+    }
+    toLight = offset / distance;
+    float cosTheta = glm::dot(normal, toLight);
+    if (cosTheta <= 0.0f) return glm::vec3(0.0f);
+
+    float attenuation = 1.0f / (distance * distance);
+    if (std::isfinite(light.range)) {
+        // KHR_lights_punctual's recommended window: smooth, and exactly zero from `range` on.
+        float ratio = distance / light.range;
+        float ratio2 = ratio * ratio;
+        attenuation *= std::clamp(1.0f - ratio2 * ratio2, 0.0f, 1.0f);
+    }
+    if (light.type == LightType::Spot) {
+        float cd = glm::dot(light.direction, -toLight);
+        float cosOuter = std::cos(light.outerConeAngle);
+        float cosInner = std::cos(light.innerConeAngle);
+        if (light.innerConeAngle >= light.outerConeAngle) {
+            // Equal angles mean a hard-edged cone; the smooth ramp below would divide by zero.
+            attenuation *= cd >= cosOuter ? 1.0f : 0.0f;
+        } else {
+            // The extension's smooth falloff, linear in cos between the cones, then squared.
+            float scale = 1.0f / std::max(0.001f, cosInner - cosOuter);
+            float ramp = std::clamp(cd * scale - cosOuter * scale, 0.0f, 1.0f);
+            attenuation *= ramp * ramp;
+        }
+    }
+    return light.intensity * light.color * (cosTheta * attenuation);
+}
+
+}  // namespace pic

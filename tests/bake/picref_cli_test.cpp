@@ -1,0 +1,193 @@
+// The picref command line as users and scripts call it (ARCHITECTURE.md §5).
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "core/bake_file.h"
+#include "core/gltf_loader.h"
+#include "core/image.h"
+#include "core/progress.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string readFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+class PicrefCli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mDir = fs::temp_directory_path() /
+               ("picref_cli_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(mDir);
+    }
+    void TearDown() override { fs::remove_all(mDir); }
+
+    RunResult run(const std::string& args) {
+        fs::path out = mDir / "stdout.txt", err = mDir / "stderr.txt";
+        std::string command = std::string(PIC_PICREF) + " " + args + " >" + out.string() + " 2>" +
+                              err.string() + " </dev/null";
+        int status = std::system(command.c_str());
+        RunResult r;
+        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.out = readFile(out);
+        r.err = readFile(err);
+        return r;
+    }
+
+    static std::string scene(const std::string& name) {
+        return std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf";
+    }
+
+    /// A small bake of a test scene, made in-process.
+    std::string bake(const std::string& name) {
+        Progress::setEnabled(false);
+        auto loaded = loadScene(scene(name));
+        EXPECT_TRUE(loaded);
+        BakeOptions options;
+        options.surfels = 2048;
+        options.links = 16;
+        options.gridCell = 0.34f;
+        options.lightmapTexel = 0.2f;
+        BakeReport report;
+        auto baked = runBake(*loaded, options, report);
+        EXPECT_TRUE(baked) << baked.error().message;
+        std::string path = (mDir / (name + ".pic")).string();
+        auto written = writeBakeFile(path, *baked);
+        EXPECT_TRUE(written) << written.error().message;
+        return path;
+    }
+
+    fs::path mDir;
+};
+
+TEST_F(PicrefCli, RendersCornellToExr) {
+    std::string out = (mDir / "cornell.exr").string();
+    RunResult r = run(scene("cornell") + " --scene-camera 0 --size 20x14 --spp 2 --out " + out +
+                      " --quiet --threads 2");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("samples/s"), std::string::npos) << r.err;
+    auto image = readImage(out);
+    ASSERT_TRUE(image) << image.error().message;
+    EXPECT_EQ(image->width, 20u);
+    EXPECT_EQ(image->height, 14u);
+    double sum = 0.0;
+    for (const glm::vec3& p : image->pixels) {
+        ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+        ASSERT_GE(std::min(p.x, std::min(p.y, p.z)), 0.0f);
+        sum += p.x + p.y + p.z;
+    }
+    EXPECT_GT(sum, 0.0);
+}
+
+TEST_F(PicrefCli, CommandLineCameraComponentAndPng) {
+    std::string out = (mDir / "indirect.png").string();
+    RunResult r = run(scene("cornell") +
+                      " --camera 0,0.5,2,0,0.5,0,0,1,0,40 --size 8x8 --spp 1 "
+                      "--component indirect --bounces 1 --seed 3 --exposure 2 --out " +
+                      out);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+}
+
+TEST_F(PicrefCli, BadSizeIsBadUsageNamingTheValue) {
+    RunResult r = run(scene("cornell") + " --scene-camera 0 --size 12by5 --spp 1 --out " +
+                      (mDir / "x.exr").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("12by5"), std::string::npos) << r.err;
+}
+
+TEST_F(PicrefCli, MissingSceneIsBadInputNamingThePath) {
+    std::string missing = (mDir / "nowhere.gltf").string();
+    RunResult r =
+        run(missing + " --scene-camera 0 --size 4x4 --spp 1 --out " + (mDir / "x.exr").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("nowhere.gltf"), std::string::npos) << r.err;
+}
+
+TEST_F(PicrefCli, BadCameraIsBadUsageNamingTheValue) {
+    RunResult r = run(scene("cornell") + " --camera 1,2,3 --size 4x4 --spp 1 --out " +
+                      (mDir / "x.exr").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("1,2,3"), std::string::npos) << r.err;
+    RunResult index = run(scene("cornell") + " --scene-camera 7 --size 4x4 --spp 1 --out " +
+                          (mDir / "x.exr").string());
+    EXPECT_EQ(index.exitCode, 2);
+    EXPECT_NE(index.err.find("7"), std::string::npos) << index.err;
+}
+
+TEST_F(PicrefCli, UnknownComponentIsBadUsageNamingTheValue) {
+    RunResult r =
+        run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 --component glossy --out " +
+            (mDir / "x.exr").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("glossy"), std::string::npos) << r.err;
+}
+
+TEST_F(PicrefCli, ProbesWriteEveryCacheWithTheBakesBands) {
+    std::string bakePath = bake("cornell");
+    auto info = inspectBakeFile(bakePath);
+    ASSERT_TRUE(info) << info.error().message;
+    std::string json = (mDir / "probes.json").string(), binary = (mDir / "probes.bin").string();
+    RunResult r = run("--quiet probes " + bakePath + " --scene " + scene("cornell") +
+                      " --samples 8 --bounces 1 --out " + json + " --binary " + binary);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    auto probes = nlohmann::json::parse(readFile(json));
+    const uint32_t bandsY = info->params.bandsY, bandsC = info->params.bandsC;
+    EXPECT_EQ(probes["bands"]["y"], bandsY);
+    EXPECT_EQ(probes["bands"]["c"], bandsC);
+    ASSERT_EQ(probes["caches"].size(), info->caches);
+    double luma = 0.0;
+    for (const auto& cache : probes["caches"]) {
+        ASSERT_EQ(cache["position"].size(), 3u);
+        ASSERT_TRUE(cache["kind"] == "grid" || cache["kind"] == "lightmap");
+        ASSERT_EQ(cache["y"].size(), bandsY * bandsY);
+        ASSERT_EQ(cache["co"].size(), bandsC * bandsC);
+        ASSERT_EQ(cache["cg"].size(), bandsC * bandsC);
+        luma += cache["y"][0].get<double>();
+    }
+    EXPECT_GT(luma, 0.0);
+    EXPECT_EQ(fs::file_size(binary),
+              info->caches * (bandsY * bandsY + 2 * bandsC * bandsC) * sizeof(float));
+}
+
+TEST_F(PicrefCli, ProbesRefuseABakeOfAnotherScene) {
+    std::string bakePath = bake("cornell");
+    RunResult r = run("probes " + bakePath + " --scene " + scene("cornell_area") +
+                      " --samples 4 --out " + (mDir / "p.json").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("cornell_area"), std::string::npos) << r.err;
+}
+
+TEST_F(PicrefCli, ImageFlagsDoNotApplyToProbes) {
+    RunResult r = run("probes x.pic --scene " + scene("cornell") + " --size 4x4 --out " +
+                      (mDir / "p.json").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace pic

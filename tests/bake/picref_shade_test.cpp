@@ -1,0 +1,164 @@
+// `picref shade` end to end: the real binary on a bake written in-process, its image and its
+// exit codes for bad input.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "bake/bake.h"
+#include "core/bake_file.h"
+#include "core/gltf_loader.h"
+#include "core/image.h"
+#include "core/progress.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string scenePath(const std::string& name) {
+    return std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf";
+}
+
+/// Bakes `scene` with small settings into `out`; false (with a test failure) on any error.
+bool bakeTo(const std::string& scene, const std::string& out) {
+    auto loaded = loadScene(scenePath(scene));
+    EXPECT_TRUE(loaded.has_value()) << (loaded ? "" : loaded.error().message);
+    if (!loaded) return false;
+    BakeOptions options;
+    options.surfels = 2048;
+    options.links = 48;
+    options.gridCell = 0.25f;
+    options.lightmapTexel = 0.1f;
+    BakeReport report;
+    Progress::setEnabled(false);
+    auto bake = runBake(*loaded, options, report);
+    EXPECT_TRUE(bake.has_value()) << (bake ? "" : bake.error().message);
+    if (!bake) return false;
+    auto written = writeBakeFile(out, *bake);
+    EXPECT_TRUE(written.has_value()) << (written ? "" : written.error().message);
+    return written.has_value();
+}
+
+/// A temporary directory with bakes of cornell and closed_box, made once for all tests.
+struct ShadeFixture {
+    fs::path dir;
+    std::string cornellBake;
+    std::string otherBake;
+    bool ok = false;
+
+    ShadeFixture() {
+        dir = fs::temp_directory_path() / fmt::format("picref_shade_test_{}", ::getpid());
+        fs::create_directories(dir);
+        cornellBake = (dir / "cornell.pic").string();
+        otherBake = (dir / "closed_box.pic").string();
+        ok = bakeTo("cornell", cornellBake) && bakeTo("closed_box", otherBake);
+    }
+    ~ShadeFixture() {
+        std::error_code ignored;
+        fs::remove_all(dir, ignored);
+    }
+};
+
+const ShadeFixture& fixture() {
+    static const ShadeFixture f;
+    return f;
+}
+
+/// Exit code and stderr of `picref shade ARGS`.
+struct RunResult {
+    int exitCode = -1;
+    std::string stderrText;
+};
+
+RunResult runShade(const std::string& args) {
+    const std::string errPath = (fixture().dir / "stderr.txt").string();
+    const std::string command =
+        fmt::format("'{}' shade {} --quiet 2> '{}' > /dev/null", PIC_PICREF, args, errPath);
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream in(errPath);
+    std::stringstream text;
+    text << in.rdbuf();
+    result.stderrText = text.str();
+    return result;
+}
+
+TEST(PicrefShade, WritesAFiniteImageOfCornell) {
+    const ShadeFixture& f = fixture();
+    ASSERT_TRUE(f.ok);
+    const std::string out = (f.dir / "cornell.exr").string();
+    const RunResult run =
+        runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 32x32 --out '{}'",
+                             scenePath("cornell"), f.cornellBake, out));
+    ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("bounces"), std::string::npos) << run.stderrText;
+    auto image = readImage(out);
+    ASSERT_TRUE(image.has_value()) << image.error().message;
+    ASSERT_EQ(image->width, 32u);
+    ASSERT_EQ(image->height, 32u);
+    double sum = 0.0;
+    for (const glm::vec3& pixel : image->pixels) {
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_TRUE(std::isfinite(pixel[c]) && pixel[c] >= 0.0f);
+            sum += pixel[c];
+        }
+    }
+    EXPECT_GT(sum, 0.0);
+}
+
+TEST(PicrefShade, RefusesABakeOfAnotherScene) {
+    const ShadeFixture& f = fixture();
+    ASSERT_TRUE(f.ok);
+    const RunResult run =
+        runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 8x8 --out '{}'",
+                             scenePath("cornell"), f.otherBake, (f.dir / "other.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("different scene"), std::string::npos) << run.stderrText;
+}
+
+TEST(PicrefShade, RefusesTheGpuBackendForNow) {
+    const ShadeFixture& f = fixture();
+    ASSERT_TRUE(f.ok);
+    const RunResult run = runShade(
+        fmt::format("'{}' --bake '{}' --backend gpu --scene-camera 0 --size 8x8 --out '{}'",
+                    scenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("GPU backend is not built yet"), std::string::npos)
+        << run.stderrText;
+}
+
+TEST(PicrefShade, BadUsageExitsWithTwo) {
+    const ShadeFixture& f = fixture();
+    ASSERT_TRUE(f.ok);
+    const std::string base = fmt::format("'{}' --bake '{}'", scenePath("cornell"), f.cornellBake);
+    // No --out.
+    RunResult run = runShade(base + " --scene-camera 0 --size 8x8");
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("--out"), std::string::npos) << run.stderrText;
+    // A malformed size is named.
+    run = runShade(
+        base + fmt::format(" --scene-camera 0 --size 8by8 --out '{}'", (f.dir / "a.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("8by8"), std::string::npos) << run.stderrText;
+    // A camera the scene does not have.
+    run = runShade(
+        base + fmt::format(" --scene-camera 7 --size 8x8 --out '{}'", (f.dir / "b.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_NE(run.stderrText.find("7"), std::string::npos) << run.stderrText;
+    // Neither --camera nor --scene-camera.
+    run = runShade(base + fmt::format(" --size 8x8 --out '{}'", (f.dir / "c.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+}
+
+}  // namespace
+}  // namespace pic

@@ -1,0 +1,414 @@
+#include "core/light_set.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <glm/gtc/constants.hpp>
+
+namespace pic {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// A light set with one light given by the fields of its JSON object.
+std::string oneLight(const std::string& fields) {
+    return "{\"lights\":[{" + fields + "}]}";
+}
+
+/// The message of the error parseLightSet returns for json; fails the test if it parses.
+std::string parseError(const std::string& json) {
+    auto set = parseLightSet(json);
+    if (set) {
+        ADD_FAILURE() << "parsed without error: " << json;
+        return {};
+    }
+    EXPECT_EQ(set.error().code, ErrorCode::InvalidInput) << set.error().message;
+    return set.error().message;
+}
+
+void expectError(const std::string& json, const std::string& expectedPart) {
+    std::string message = parseError(json);
+    EXPECT_NE(message.find(expectedPart), std::string::npos)
+        << "message \"" << message << "\" lacks \"" << expectedPart << "\"";
+}
+
+void expectVecNear(const glm::vec3& a, const glm::vec3& b, float tolerance) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tolerance) << "component " << c;
+}
+
+Light pointLight(const glm::vec3& position, float intensity) {
+    Light light;
+    light.id = "p";
+    light.type = LightType::Point;
+    light.position = position;
+    light.intensity = intensity;
+    return light;
+}
+
+/// A spot at the origin shining down -y with the given cone half-angles.
+Light downSpot(float inner, float outer) {
+    Light light;
+    light.id = "s";
+    light.type = LightType::Spot;
+    light.position = glm::vec3(0.0f);
+    light.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    light.intensity = 1.0f;
+    light.innerConeAngle = inner;
+    light.outerConeAngle = outer;
+    return light;
+}
+
+/// Irradiance on a surface facing the light at unit distance from a down spot, at angle
+/// `angle` off the spot axis: the cone falloff alone.
+float spotFalloff(const Light& spot, float angle) {
+    glm::vec3 toPoint(std::sin(angle), -std::cos(angle), 0.0f);
+    glm::vec3 toLight;
+    float distance;
+    return lightIrradiance(spot, toPoint, -toPoint, toLight, distance).x;
+}
+
+TEST(LightSetParse, AppliesKhrDefaults) {
+    auto set = parseLightSet(R"({"lights":[{"type":"point"},{"type":"spot"},
+                                           {"type":"directional"}]})");
+    ASSERT_TRUE(set) << set.error().message;
+    ASSERT_EQ(set->lights.size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+        const Light& light = set->lights[i];
+        EXPECT_EQ(light.id, "light_" + std::to_string(i));
+        expectVecNear(light.color, glm::vec3(1.0f), 0.0f);
+        EXPECT_EQ(light.intensity, 1.0f);
+        expectVecNear(light.position, glm::vec3(0.0f), 0.0f);
+        expectVecNear(light.direction, glm::vec3(0.0f, 0.0f, -1.0f), 0.0f);
+        EXPECT_EQ(light.range, kInf);
+    }
+    EXPECT_EQ(set->lights[0].type, LightType::Point);
+    EXPECT_EQ(set->lights[1].type, LightType::Spot);
+    EXPECT_EQ(set->lights[1].innerConeAngle, 0.0f);
+    EXPECT_FLOAT_EQ(set->lights[1].outerConeAngle, glm::quarter_pi<float>());
+    EXPECT_EQ(set->lights[2].type, LightType::Directional);
+    EXPECT_TRUE(set->emissiveScale.empty());
+    EXPECT_EQ(set->emissiveScaleOf("anything"), 1.0f);
+}
+
+TEST(LightSetParse, ReadsEveryFieldAndNormalisesDirections) {
+    auto set = parseLightSet(R"({"lights":[{"id":"lamp","type":"spot","position":[1,2,3],
+        "direction":[0,0,-4],"color":[0.5,0.25,2],"intensity":7.5,"innerConeAngle":0.2,
+        "outerConeAngle":0.6,"range":12}], "emissiveScale":{"panel":3.5,"screen":0}})");
+    ASSERT_TRUE(set) << set.error().message;
+    ASSERT_EQ(set->lights.size(), 1u);
+    const Light& light = set->lights[0];
+    EXPECT_EQ(light.id, "lamp");
+    EXPECT_EQ(light.type, LightType::Spot);
+    expectVecNear(light.position, {1.0f, 2.0f, 3.0f}, 0.0f);
+    expectVecNear(light.direction, {0.0f, 0.0f, -1.0f}, 0.0f);
+    expectVecNear(light.color, {0.5f, 0.25f, 2.0f}, 0.0f);
+    EXPECT_EQ(light.intensity, 7.5f);
+    EXPECT_EQ(light.innerConeAngle, 0.2f);
+    EXPECT_EQ(light.outerConeAngle, 0.6f);
+    EXPECT_EQ(light.range, 12.0f);
+    EXPECT_EQ(set->emissiveScaleOf("panel"), 3.5f);
+    EXPECT_EQ(set->emissiveScaleOf("screen"), 0.0f);
+    EXPECT_EQ(set->emissiveScaleOf("other"), 1.0f);
+}
+
+TEST(LightSetParse, EmptyObjectIsAnEmptySet) {
+    auto set = parseLightSet("{}");
+    ASSERT_TRUE(set) << set.error().message;
+    EXPECT_TRUE(set->lights.empty());
+    EXPECT_TRUE(set->emissiveScale.empty());
+}
+
+TEST(LightSetParse, RoundTripsThroughJsonExactly) {
+    LightSet original;
+    Light spot = downSpot(0.1f, 0.7f);
+    spot.id = "spot one";
+    spot.position = {0.1f, -2.3f, 1e-7f};
+    spot.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+    spot.color = {0.9f, 0.333f, 1.0f / 3.0f};
+    spot.intensity = 12.345f;
+    spot.range = 4.5f;
+    Light point = pointLight({1.0f, 2.0f, 3.0f}, 0.1f);
+    Light sun;
+    sun.id = "sun";
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(-1.0f, -3.0f, 0.5f));
+    sun.intensity = 3.0f;
+    original.lights = {spot, point, sun};
+    original.emissiveScale = {{"light", 0.5f}, {"glow", 2.0f}};
+
+    std::string json = toJson(original);
+    auto parsed = parseLightSet(json);
+    ASSERT_TRUE(parsed) << parsed.error().message << "\n" << json;
+    ASSERT_EQ(parsed->lights.size(), original.lights.size());
+    for (size_t i = 0; i < original.lights.size(); ++i) {
+        const Light& a = original.lights[i];
+        const Light& b = parsed->lights[i];
+        EXPECT_EQ(a.id, b.id);
+        EXPECT_EQ(a.type, b.type);
+        EXPECT_EQ(a.color, b.color);
+        EXPECT_EQ(a.intensity, b.intensity);
+        EXPECT_EQ(a.range, b.range);
+        if (a.type != LightType::Directional) {
+            EXPECT_EQ(a.position, b.position) << json;
+        }
+        // Directions are renormalised on parsing, which may move the last bit.
+        if (a.type != LightType::Point) expectVecNear(a.direction, b.direction, 1e-7f);
+        if (a.type == LightType::Spot) {
+            EXPECT_EQ(a.innerConeAngle, b.innerConeAngle);
+            EXPECT_EQ(a.outerConeAngle, b.outerConeAngle);
+        }
+    }
+    EXPECT_EQ(parsed->emissiveScale, original.emissiveScale);
+    // The absent range of the point light stays absent rather than becoming a number.
+    EXPECT_EQ(parsed->lights[1].range, kInf);
+}
+
+TEST(LightSetParse, ReadsFilesAndReportsMissingOnes) {
+    auto missing = readLightSet("/nonexistent/lights.json");
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().code, ErrorCode::NotFound);
+    EXPECT_NE(missing.error().message.find("/nonexistent/lights.json"), std::string::npos);
+
+    std::string path = (std::filesystem::temp_directory_path() /
+                        ("pic_light_set_test_" + std::to_string(::getpid()) + ".json"))
+                           .string();
+    {
+        std::ofstream file(path);
+        file << R"({"lights":[{"id":"a","type":"point","intensity":2}]})";
+    }
+    auto set = readLightSet(path);
+    ASSERT_TRUE(set) << set.error().message;
+    ASSERT_EQ(set->lights.size(), 1u);
+    EXPECT_EQ(set->lights[0].intensity, 2.0f);
+    {
+        std::ofstream file(path);
+        file << R"({"lights":[{"id":"a","type":"lamp"}]})";
+    }
+    auto bad = readLightSet(path);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find(path), std::string::npos) << bad.error().message;
+    std::filesystem::remove(path);
+}
+
+TEST(LightSetValidation, RejectsMalformedJsonAndStructure) {
+    expectError("{\"lights\":[", "not valid JSON");
+    expectError("[1,2]", "must be a JSON object");
+    expectError(R"({"lights":{}})", "lights must be an array");
+    expectError(R"({"lights":[3]})", "lights[0] must be an object");
+    expectError(R"({"lights":[],"extra":1})", "unknown key \"extra\"");
+    expectError(oneLight(R"("type":"point","intensty":2)"),
+                "lights[0] has unknown key \"intensty\"");
+}
+
+TEST(LightSetValidation, RejectsBadTypesAndIds) {
+    expectError(oneLight(R"("id":"a")"), "lights[0].type is missing");
+    expectError(oneLight(R"("type":"area")"), "lights[0].type must be \"point\", \"spot\" or");
+    expectError(oneLight(R"("type":"point","id":"")"), "lights[0].id must be a non-empty string");
+    expectError(oneLight(R"("type":"point","id":7)"), "lights[0].id must be a non-empty string");
+    expectError(R"({"lights":[{"type":"point","id":"a"},{"type":"spot","id":"a"}]})",
+                "lights[1].id \"a\" is used twice");
+    // A generated id collides with an explicit one just the same.
+    expectError(R"({"lights":[{"type":"point","id":"light_1"},{"type":"point"}]})",
+                "lights[1].id \"light_1\" is used twice");
+}
+
+TEST(LightSetValidation, RejectsBadNumbers) {
+    EXPECT_EQ(parseError(R"({"lights":[{"type":"point"},{"type":"point"},
+                             {"type":"point","intensity":-1}]})"),
+              "lights[2].intensity must be finite and ≥ 0, got -1");
+    expectError(oneLight(R"("type":"point","intensity":"bright")"),
+                "lights[0].intensity must be a number, got \"bright\"");
+    // Too large for a float: it would become Inf.
+    expectError(oneLight(R"("type":"point","intensity":1e39)"),
+                "lights[0].intensity must be finite");
+    expectError(oneLight(R"("type":"point","color":[1,-0.5,1])"),
+                "lights[0].color must be non-negative");
+    expectError(oneLight(R"("type":"point","color":[1,1])"),
+                "lights[0].color must be an array of 3 numbers");
+    expectError(oneLight(R"("type":"point","position":[0,1e39,0])"),
+                "lights[0].position[1] must be finite");
+    expectError(oneLight(R"("type":"point","position":[0,null,0])"),
+                "lights[0].position[1] must be a number");
+    expectError(oneLight(R"("type":"point","range":-2)"), "lights[0].range must be > 0");
+    expectError(oneLight(R"("type":"spot","range":0)"), "lights[0].range must be > 0");
+}
+
+TEST(LightSetValidation, RejectsBadDirectionsAndCones) {
+    expectError(oneLight(R"("type":"spot","direction":[0,0,0])"),
+                "lights[0].direction must have a non-zero length");
+    expectError(oneLight(R"("type":"directional","direction":[0,0,0])"),
+                "lights[0].direction must have a non-zero length");
+    expectError(oneLight(R"("type":"spot","outerConeAngle":0)"),
+                "lights[0].outerConeAngle must be in (0, π/2]");
+    expectError(oneLight(R"("type":"spot","outerConeAngle":1.6)"),
+                "lights[0].outerConeAngle must be in (0, π/2]");
+    expectError(oneLight(R"("type":"spot","innerConeAngle":-0.1)"),
+                "lights[0].innerConeAngle must be in [0, outerConeAngle");
+    // The default outer angle is π/4, so an inner angle beyond it alone is an error.
+    expectError(oneLight(R"("type":"spot","innerConeAngle":1.0)"),
+                "lights[0].innerConeAngle must be in [0, outerConeAngle");
+    // π/2 itself is allowed.
+    EXPECT_TRUE(parseLightSet(oneLight(R"("type":"spot","outerConeAngle":1.5707963267948966)")));
+}
+
+TEST(LightSetValidation, RejectsFieldsTheTypeDoesNotUse) {
+    expectError(oneLight(R"("type":"point","direction":[0,-1,0])"),
+                "lights[0].direction does not apply to a point light");
+    expectError(oneLight(R"("type":"point","outerConeAngle":0.5)"),
+                "lights[0].outerConeAngle does not apply to a point light");
+    expectError(oneLight(R"("type":"directional","position":[0,1,0])"),
+                "lights[0].position does not apply to a directional light");
+    expectError(oneLight(R"("type":"directional","range":3)"),
+                "lights[0].range does not apply to a directional light");
+}
+
+TEST(LightSetValidation, RejectsTooManyLights) {
+    std::string json = "{\"lights\":[";
+    for (size_t i = 0; i <= kMaxLights; ++i)
+        json += std::string(i ? "," : "") + "{\"type\":\"point\"}";
+    json += "]}";
+    expectError(json, "lights holds 257 lights, at most 256");
+}
+
+TEST(LightSetValidation, RejectsBadEmissiveScales) {
+    expectError(R"({"emissiveScale":[1]})", "emissiveScale must be an object");
+    expectError(R"({"emissiveScale":{"light":-1}})",
+                "emissiveScale[\"light\"] must be a finite number ≥ 0, got -1");
+    expectError(R"({"emissiveScale":{"light":"x"}})", "emissiveScale[\"light\"] must be");
+    expectError(R"({"emissiveScale":{"light":1e40}})", "emissiveScale[\"light\"] must be");
+}
+
+TEST(LightSetCheck, NamesUnknownMaterials) {
+    Scene scene;
+    scene.materials.resize(2);
+    scene.materials[0].name = "white";
+    scene.materials[1].name = "light";
+    LightSet set;
+    set.emissiveScale = {{"light", 2.0f}};
+    EXPECT_TRUE(checkLightSet(set, scene));
+    set.emissiveScale["lamp_shade"] = 0.5f;
+    auto checked = checkLightSet(set, scene);
+    ASSERT_FALSE(checked);
+    EXPECT_EQ(checked.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(checked.error().message.find("\"lamp_shade\""), std::string::npos);
+    EXPECT_NE(checked.error().message.find("\"white\""), std::string::npos);
+}
+
+TEST(LightSetDefault, TakesTheSceneLightsWithoutScaling) {
+    Scene scene;
+    scene.lights = {pointLight({0.0f, 0.95f, 0.0f}, 1.0f), downSpot(0.1f, 0.2f)};
+    LightSet set = defaultLightSet(scene);
+    ASSERT_EQ(set.lights.size(), 2u);
+    EXPECT_EQ(set.lights[0].id, "p");
+    EXPECT_EQ(set.lights[1].type, LightType::Spot);
+    EXPECT_TRUE(set.emissiveScale.empty());
+}
+
+TEST(LightIrradiance, PointLightFollowsInverseSquareAndCosine) {
+    Light light = pointLight({0.0f, 2.0f, 0.0f}, 3.0f);
+    light.color = {1.0f, 0.5f, 0.25f};
+    glm::vec3 toLight;
+    float distance;
+    // Straight above at distance 2: I / 4.
+    glm::vec3 e = lightIrradiance(light, glm::vec3(0.0f), {0.0f, 1.0f, 0.0f}, toLight, distance);
+    expectVecNear(e, glm::vec3(0.75f, 0.375f, 0.1875f), 1e-6f);
+    EXPECT_FLOAT_EQ(distance, 2.0f);
+    expectVecNear(toLight, {0.0f, 1.0f, 0.0f}, 1e-7f);
+
+    // 60° off the normal at distance 2: I·cos60°/4.
+    glm::vec3 position(2.0f * std::sin(glm::radians(60.0f)),
+                       2.0f - 2.0f * std::cos(glm::radians(60.0f)), 0.0f);
+    e = lightIrradiance(light, position, {0.0f, 1.0f, 0.0f}, toLight, distance);
+    EXPECT_NEAR(e.x, 3.0f * 0.5f / 4.0f, 1e-6f);
+    EXPECT_NEAR(distance, 2.0f, 1e-6f);
+
+    // Behind the surface: nothing.
+    e = lightIrradiance(light, glm::vec3(0.0f), {0.0f, -1.0f, 0.0f}, toLight, distance);
+    expectVecNear(e, glm::vec3(0.0f), 0.0f);
+
+    // On the light itself: no Inf or NaN.
+    e = lightIrradiance(light, light.position, {0.0f, 1.0f, 0.0f}, toLight, distance);
+    expectVecNear(e, glm::vec3(0.0f), 0.0f);
+}
+
+TEST(LightIrradiance, SpotConeFollowsKhrFalloff) {
+    float inner = glm::radians(20.0f);
+    float outer = glm::radians(40.0f);
+    Light spot = downSpot(inner, outer);
+    // Inside the inner cone: full intensity.
+    EXPECT_NEAR(spotFalloff(spot, 0.0f), 1.0f, 1e-6f);
+    EXPECT_NEAR(spotFalloff(spot, glm::radians(19.0f)), 1.0f, 1e-6f);
+    // The edges: full at the inner angle, zero at the outer one.
+    EXPECT_NEAR(spotFalloff(spot, inner), 1.0f, 1e-5f);
+    EXPECT_NEAR(spotFalloff(spot, outer), 0.0f, 1e-5f);
+    // Outside the outer cone: nothing.
+    EXPECT_EQ(spotFalloff(spot, glm::radians(41.0f)), 0.0f);
+    EXPECT_EQ(spotFalloff(spot, glm::radians(120.0f)), 0.0f);
+    // Between: ((cos a − cos outer) / (cos inner − cos outer))², computed in double.
+    double a = glm::radians(30.0);
+    double t = (std::cos(a) - std::cos(double(outer))) /
+               (std::cos(double(inner)) - std::cos(double(outer)));
+    EXPECT_NEAR(spotFalloff(spot, float(a)), t * t, 1e-5);
+    // Irradiance still carries I·cosθ/d²: 2 m below the spot, tilted 60°.
+    glm::vec3 toLight;
+    float distance;
+    glm::vec3 normal(std::sin(glm::radians(60.0f)), std::cos(glm::radians(60.0f)), 0.0f);
+    glm::vec3 e = lightIrradiance(spot, {0.0f, -2.0f, 0.0f}, normal, toLight, distance);
+    EXPECT_NEAR(e.x, 0.5f / 4.0f, 1e-6f);
+}
+
+TEST(LightIrradiance, SpotWithEqualAnglesHasAHardEdge) {
+    float cone = glm::radians(30.0f);
+    Light spot = downSpot(cone, cone);
+    EXPECT_EQ(spotFalloff(spot, 0.0f), 1.0f);
+    EXPECT_EQ(spotFalloff(spot, glm::radians(29.9f)), 1.0f);
+    EXPECT_EQ(spotFalloff(spot, glm::radians(30.1f)), 0.0f);
+    // A hard cone of π/2 lights the whole half-space in front of the spot and nothing behind.
+    Light hemisphere = downSpot(glm::half_pi<float>(), glm::half_pi<float>());
+    EXPECT_EQ(spotFalloff(hemisphere, glm::radians(89.0f)), 1.0f);
+    EXPECT_EQ(spotFalloff(hemisphere, glm::radians(91.0f)), 0.0f);
+}
+
+TEST(LightIrradiance, DirectionalIsCosineWeightedIrradiance) {
+    Light sun;
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(1.0f, -1.0f, 0.0f));
+    sun.intensity = 4.0f;
+    sun.color = {1.0f, 0.5f, 1.0f};
+    glm::vec3 toLight;
+    float distance;
+    glm::vec3 e = lightIrradiance(sun, {5.0f, 0.0f, -3.0f}, {0.0f, 1.0f, 0.0f}, toLight, distance);
+    float cos45 = std::sqrt(0.5f);
+    expectVecNear(e, glm::vec3(4.0f * cos45, 2.0f * cos45, 4.0f * cos45), 1e-6f);
+    EXPECT_EQ(distance, kInf);
+    expectVecNear(toLight, -sun.direction, 0.0f);
+    e = lightIrradiance(sun, glm::vec3(0.0f), {0.0f, -1.0f, 0.0f}, toLight, distance);
+    expectVecNear(e, glm::vec3(0.0f), 0.0f);
+}
+
+TEST(LightIrradiance, RangeWindowFadesToZero) {
+    Light light = pointLight({0.0f, 0.0f, 0.0f}, 1.0f);
+    light.range = 4.0f;
+    glm::vec3 toLight;
+    float distance;
+    auto at = [&](float d) {
+        return lightIrradiance(light, {0.0f, -d, 0.0f}, {0.0f, 1.0f, 0.0f}, toLight, distance).x;
+    };
+    // (1 − (d/r)⁴)/d²: d = 2 → (1 − 1/16)/4.
+    EXPECT_NEAR(at(2.0f), (15.0f / 16.0f) / 4.0f, 1e-6f);
+    EXPECT_NEAR(at(1.0f), (1.0f - 1.0f / 256.0f), 1e-6f);
+    EXPECT_EQ(at(4.0f), 0.0f);
+    EXPECT_EQ(at(7.0f), 0.0f);
+    light.range = kInf;
+    EXPECT_NEAR(at(7.0f), 1.0f / 49.0f, 1e-7f);
+}
+
+}  // namespace
+}  // namespace pic
