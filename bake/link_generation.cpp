@@ -17,6 +17,8 @@ namespace pic {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
+/// Share of its bounding sphere a node without visible samples is assumed to show.
+constexpr float kUnsampledPrior = 0.25f;
 
 /// A visible surfel sample of a node: direction from the cache and its solid angle
 /// (already multiplied by the node's sampling weight).
@@ -102,7 +104,22 @@ public:
             if (scratch.estimates[open.top()].visible > 0.0f) closed.push_back(open.top());
             open.pop();
         }
-        chosen = std::move(closed);
+        // The cut was chosen by the estimates themselves, so it keeps the nodes whose estimates
+        // came out low (winner's curse): re-estimating the sampled nodes with fresh rays makes
+        // the final values unbiased. A node whose fresh samples all miss is not linked.
+        Rng fresh(mParams.seed ^ 0xA5A5A5A5A5A5A5A5ull, cacheIndex);
+        chosen.clear();
+        for (uint32_t e : closed) {
+            if (scratch.estimates[e].exact) {
+                chosen.push_back(e);
+                continue;
+            }
+            NodeEstimate again = estimate(scratch.estimates[e].node, cache, hemisphere, fresh,
+                                          scratch.samples, rays);
+            if (again.visible <= 0.0f) continue;
+            scratch.estimates.push_back(again);
+            chosen.push_back(static_cast<uint32_t>(scratch.estimates.size() - 1));
+        }
         // Links sorted by node index: neighbouring caches then read nodes in a similar order.
         std::sort(chosen.begin(), chosen.end(), [&](uint32_t a, uint32_t b) {
             return scratch.estimates[a].node < scratch.estimates[b].node;
@@ -163,7 +180,7 @@ private:
             float r2 = node.radius * node.radius;
             float bound = d2 <= r2 ? 4.0f * kPi
                                    : 2.0f * kPi * r2 / (d2 * (1.0f + std::sqrt(1.0f - r2 / d2)));
-            e.priority = bound / static_cast<float>(k + 1);
+            e.priority = bound * kUnsampledPrior;
         }
         return e;
     }

@@ -164,7 +164,11 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     std::error_code ec;
     std::filesystem::create_directories(params.outDir, ec);
     const std::string stem = std::filesystem::path(params.scenePath).stem().string();
-    const std::string base = (std::filesystem::path(params.outDir) / stem).string();
+    // Images are named after the JSON file when one is given, so runs with other settings
+    // into the same folder do not overwrite each other.
+    const std::string base = params.jsonPath.empty()
+                                 ? (std::filesystem::path(params.outDir) / stem).string()
+                                 : std::filesystem::path(params.jsonPath).replace_extension().string();
     const float exposureIndirect = exposureFor(*refIndirect), exposureFull = exposureFor(*refFull);
     for (const auto& [name, image] : std::vector<std::pair<std::string, const Image*>>{
              {"_ours_full.exr", &oursFull}, {"_ours_indirect.exr", &oursIndirect},
