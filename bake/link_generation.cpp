@@ -17,8 +17,6 @@ namespace pic {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-/// Share of its bounding sphere a node without visible samples is assumed to show.
-constexpr float kUnsampledPrior = 0.25f;
 
 /// A visible surfel sample of a node: direction from the cache and its solid angle
 /// (already multiplied by the node's sampling weight).
@@ -180,7 +178,7 @@ private:
             float r2 = node.radius * node.radius;
             float bound = d2 <= r2 ? 4.0f * kPi
                                    : 2.0f * kPi * r2 / (d2 * (1.0f + std::sqrt(1.0f - r2 / d2)));
-            e.priority = bound * kUnsampledPrior;
+            e.priority = bound / static_cast<float>(k + 1);
         }
         return e;
     }
