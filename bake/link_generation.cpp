@@ -47,8 +47,7 @@ class CacheLinker {
 public:
     CacheLinker(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                 const std::vector<Node>& nodes, const LinkParams& params)
-        : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params),
-          mEpsilon(rays.epsilon()) {}
+        : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params) {}
 
     /// Fills the nL links of cache `c` starting at `out`; returns rays cast.
     uint64_t link(uint32_t cacheIndex, const Cache& cache, Scratch& scratch,
@@ -57,11 +56,10 @@ public:
         scratch.samples.clear();
         chosen.clear();
         uint64_t rays = 0;
-        const bool hemisphere = cache.kind == gpu::kCacheKindLightmap;
         Rng rng(mParams.seed, cacheIndex);
 
         auto evaluate = [&](uint32_t node) {
-            NodeEstimate e = estimate(node, cache, hemisphere, rng, scratch.samples, rays);
+            NodeEstimate e = estimate(node, cache, rng, scratch.samples, rays);
             scratch.estimates.push_back(e);
             return static_cast<uint32_t>(scratch.estimates.size() - 1);
         };
@@ -112,7 +110,7 @@ public:
                 chosen.push_back(e);
                 continue;
             }
-            NodeEstimate again = estimate(scratch.estimates[e].node, cache, hemisphere, fresh,
+            NodeEstimate again = estimate(scratch.estimates[e].node, cache, fresh,
                                           scratch.samples, rays);
             if (again.visible <= 0.0f) continue;
             scratch.estimates.push_back(again);
@@ -132,7 +130,7 @@ public:
 private:
     /// Estimates a node's solid angle from up to K of its surfels (all of them when it has
     /// at most K), stratified over its contiguous surfel range, one occlusion ray each.
-    NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, bool hemisphere, Rng& rng,
+    NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, Rng& rng,
                           std::vector<VisibleSample>& samples, uint64_t& rays) const {
         const Node& node = mNodes[nodeIndex];
         NodeEstimate e;
@@ -146,21 +144,13 @@ private:
             uint32_t offset = e.exact ? j
                                       : std::min(node.surfelCount - 1,
                                                  static_cast<uint32_t>((j + rng.uniform()) * weight));
-            const Surfel& s = mSurfels[node.firstSurfel + offset];
-            glm::vec3 v = s.position - cache.position;
-            float d2 = glm::dot(v, v);
-            if (!(d2 > 0.0f)) continue;
-            float d = std::sqrt(d2);
-            glm::vec3 w = v / d;
-            float cosSender = -glm::dot(s.normal, w);
-            if (cosSender <= 0.0f) continue;  // the surfel faces away from the cache
-            if (hemisphere && glm::dot(cache.normal, w) <= 0.0f) continue;
-            float omega = weight * discSolidAngle(d, s.radius, cosSender);
+            const SurfelView view = viewSurfel(mRays, cache, mSurfels[node.firstSurfel + offset]);
+            if (view.solidAngle <= 0.0f) continue;  // faces away or lies behind the cache
+            const float omega = weight * view.solidAngle;
             e.unoccluded += omega;
-            // The ray stops just short of the surfel's own surface.
-            float tFar = d * (1.0f - 1e-4f) - 4.0f * mEpsilon;
             ++rays;
-            if (tFar > mEpsilon && mRays.occluded(cache.position, w, mEpsilon, tFar)) continue;
+            if (!view.visible) continue;
+            const glm::vec3 w = view.direction;
             e.visible += omega;
             e.directionSum += omega * w;
             samples.push_back({w, omega});
@@ -187,10 +177,28 @@ private:
     const std::vector<Surfel>& mSurfels;
     const std::vector<Node>& mNodes;
     const LinkParams& mParams;
-    float mEpsilon;
 };
 
 }  // namespace
+
+SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel) {
+    SurfelView view;
+    const glm::vec3 v = surfel.position - cache.position;
+    const float d2 = glm::dot(v, v);
+    if (!(d2 > 0.0f)) return view;
+    const float d = std::sqrt(d2);
+    const glm::vec3 w = v / d;
+    const float cosSender = -glm::dot(surfel.normal, w);
+    if (cosSender <= 0.0f) return view;
+    if (cache.kind == gpu::kCacheKindLightmap && glm::dot(cache.normal, w) <= 0.0f) return view;
+    view.direction = w;
+    view.solidAngle = discSolidAngle(d, surfel.radius, cosSender);
+    // The ray stops just short of the surfel's own surface.
+    const float epsilon = rays.epsilon();
+    const float tFar = d * (1.0f - 1e-4f) - 4.0f * epsilon;
+    view.visible = !(tFar > epsilon && rays.occluded(cache.position, w, epsilon, tFar));
+    return view;
+}
 
 float discSolidAngle(float distance, float radius, float cosTheta) {
     // On-axis disc: 2π(1 − d/√(d² + r²)), written as 2π r² / (√(d²+r²)(√(d²+r²) + d))

@@ -41,6 +41,16 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params);
 
+/// How a cache sees one surfel: the unit direction to it, its disc's solid angle (0 when it
+/// faces away from the cache or lies behind a light-map cache's surface) and whether an
+/// occlusion ray reaches it. The one test that link generation and its diagnostics share.
+struct SurfelView {
+    glm::vec3 direction{0.0f};
+    float solidAngle = 0.0f;  ///< sr, ignoring occlusion
+    bool visible = false;     ///< solidAngle > 0 and nothing blocks the segment
+};
+SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel);
+
 /// Solid angle (sr) of a disc of radius r seen from distance d at cosine cosTheta between
 /// its normal and the direction to the viewer: the on-axis disc formula scaled by cosTheta.
 float discSolidAngle(float distance, float radius, float cosTheta);

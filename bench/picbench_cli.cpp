@@ -5,6 +5,7 @@
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
 #include "bench/bake_benchmark.h"
+#include "bench/link_error_benchmark.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
@@ -48,6 +49,20 @@ int picbenchMain(int argc, char** argv) {
     accuracy->add_option("--ref-seed", accuracyParams.seed, "path tracer seed (default 1)");
     accuracyFlags.addTo(*accuracy);
 
+    CLI::App* links = app.add_subcommand(
+        "links", "decompose the linked caches' one-bounce error against path-traced radiance");
+    LinkErrorParams linkParams;
+    BakeOptionFlags linkFlags;
+    links->add_option("--scene", linkParams.scenePath, "scene file (.gltf or .glb)")->required();
+    links->add_option("--lights", linkParams.lightsPath, "light set JSON (default: the scene's lights)");
+    links->add_option("--caches", linkParams.caches, "caches to examine, spread over all (default 400)")
+        ->check(CLI::PositiveNumber);
+    links->add_option("--directions", linkParams.directions, "path-traced directions per cache (default 1024)")
+        ->check(CLI::PositiveNumber);
+    links->add_option("--json", linkParams.jsonPath, "write the ratios to this JSON file");
+    links->add_option("--ref-seed", linkParams.seed, "path tracer seed (default 1)");
+    linkFlags.addTo(*links);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -61,6 +76,10 @@ int picbenchMain(int argc, char** argv) {
     if (accuracy->parsed()) {
         accuracyParams.bake = accuracyFlags.toOptions();
         return runAccuracyBenchmark(accuracyParams);
+    }
+    if (links->parsed()) {
+        linkParams.bake = linkFlags.toOptions();
+        return runLinkErrorBenchmark(linkParams);
     }
     params.options = flags.toOptions();
     return runBakeBenchmark(params);

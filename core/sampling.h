@@ -1,7 +1,12 @@
 #pragma once
 /// Deterministic random and low-discrepancy numbers for the bake.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
+
+#include <glm/glm.hpp>
 
 namespace pic {
 
@@ -43,5 +48,14 @@ public:
 private:
     uint64_t mState;
 };
+
+/// Uniform direction on the unit sphere from two uniform numbers in [0, 1): z = 1 − 2u₁,
+/// azimuth 2πu₂ (Archimedes: equal z slices hold equal solid angle).
+inline glm::vec3 sampleUniformSphere(float u1, float u2) {
+    const float z = 1.0f - 2.0f * u1;
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = 2.0f * std::numbers::pi_v<float> * u2;
+    return glm::vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
 
 }  // namespace pic

@@ -1,0 +1,82 @@
+// `picbench links`: the one-bounce error decomposition of the linked caches.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class PicbenchLinks : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mDir = fs::temp_directory_path() /
+               ("picbench_links_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(mDir);
+    }
+    void TearDown() override { fs::remove_all(mDir); }
+
+    /// Runs picbench with `args`; returns its exit code, stderr in `err`.
+    int run(const std::string& args, std::string& err) {
+        const fs::path errPath = mDir / "stderr.txt";
+        const std::string command = std::string(PIC_PICBENCH) + " --quiet " + args + " >" +
+                                    (mDir / "stdout.txt").string() + " 2>" + errPath.string() +
+                                    " </dev/null";
+        const int status = std::system(command.c_str());
+        std::ifstream in(errPath);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        err = ss.str();
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+
+    fs::path mDir;
+};
+
+TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
+    // The four factors multiply to linked/traced by construction of their estimates; each is
+    // a ratio of two estimates of the same radiance, so on cornell every one of them is near 1
+    // (a wrong π, area or y00 in any of the five estimates would put one far off).
+    const fs::path json = mDir / "links.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --caches 40 "
+                  "--directions 256 --json " + json.string(), err), 0) << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    for (const char* kind : {"all", "grid", "lightmap"}) {
+        SCOPED_TRACE(kind);
+        const nlohmann::json& r = report.at(kind);
+        const double product = r.at("representation").get<double>() *
+                               r.at("cut_coverage").get<double>() *
+                               r.at("node_mean_radiance").get<double>() *
+                               r.at("visibility_estimate").get<double>();
+        EXPECT_NEAR(product, r.at("linked_over_traced").get<double>(), 1e-9);
+        for (const char* factor : {"linked_over_traced", "representation", "cut_coverage",
+                                   "node_mean_radiance", "visibility_estimate"}) {
+            const double value = r.at(factor).get<double>();
+            EXPECT_TRUE(std::isfinite(value)) << factor;
+            EXPECT_GT(value, 0.8) << factor;
+            EXPECT_LT(value, 1.25) << factor;
+        }
+    }
+    EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);
+}
+
+TEST_F(PicbenchLinks, MissingSceneIsBadInputNamingThePath) {
+    std::string err;
+    EXPECT_EQ(run("links --scene /nonexistent/scene.gltf", err), 2);
+    EXPECT_NE(err.find("/nonexistent/scene.gltf"), std::string::npos) << err;
+}
+
+}  // namespace
