@@ -82,13 +82,9 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     if (!scene) return failWith(scene.error());
     auto camera = params.camera.empty() ? sceneCamera(*scene, params.sceneCamera) : parseCamera(params.camera);
     if (!camera) return failWith(camera.error());
-    LightSet lights = defaultLightSet(*scene);
-    if (!params.lightsPath.empty()) {
-        auto read = readLightSet(params.lightsPath);
-        if (!read) return failWith(read.error());
-        lights = std::move(*read);
-    }
-    if (auto ok = checkLightSet(lights, *scene); !ok) return failWith(ok.error());
+    auto loaded = loadLightSet(params.lightsPath, *scene);
+    if (!loaded) return failWith(loaded.error());
+    const LightSet& lights = *loaded;
 
     Json seconds;
     auto start = Clock::now();

@@ -65,13 +65,9 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     };
     auto scene = loadScene(params.scenePath);
     if (!scene) return failWith(scene.error());
-    LightSet lights = defaultLightSet(*scene);
-    if (!params.lightsPath.empty()) {
-        auto read = readLightSet(params.lightsPath);
-        if (!read) return failWith(read.error());
-        lights = std::move(*read);
-    }
-    if (auto ok = checkLightSet(lights, *scene); !ok) return failWith(ok.error());
+    auto loaded = loadLightSet(params.lightsPath, *scene);
+    if (!loaded) return failWith(loaded.error());
+    const LightSet& lights = *loaded;
     BakeReport report;
     auto bake = runBake(*scene, params.bake, report);
     if (!bake) return failWith(bake.error());

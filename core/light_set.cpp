@@ -392,4 +392,12 @@ glm::vec3 lightIrradiance(const Light& light, const glm::vec3& position, const g
     return light.intensity * light.color * (cosTheta * attenuation);
 }
 
+Result<LightSet> loadLightSet(const std::string& path, const Scene& scene) {
+    if (path.empty()) return defaultLightSet(scene);
+    PIC_TRY_ASSIGN(LightSet lights, readLightSet(path));
+    if (auto checked = checkLightSet(lights, scene); !checked)
+        return std::unexpected(checked.error());
+    return lights;
+}
+
 }  // namespace pic

@@ -44,6 +44,10 @@ std::string toJson(const LightSet& lights);
 /// Checks a light set against a scene: every emissiveScale key names a material of the scene.
 Result<void> checkLightSet(const LightSet& lights, const Scene& scene);
 
+/// The scene's own lights when `path` is empty, else the light set read from `path` and
+/// checked against the scene (what every tool's `--lights FILE` means).
+Result<LightSet> loadLightSet(const std::string& path, const Scene& scene);
+
 /// Irradiance (W/m², RGB) that light `light` delivers at `position` on a surface with unit
 /// normal `normal`, ignoring occlusion: I·cosθ/d² for point and spot lights (with the
 /// KHR_lights_punctual spot falloff and range window), E·cosθ for directional lights.

@@ -68,15 +68,6 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& byt
     return {};
 }
 
-/// The scene's own lights, or the light set of `lightsPath` checked against the scene.
-Result<LightSet> loadLights(const std::string& lightsPath, const Scene& scene) {
-    if (lightsPath.empty()) return defaultLightSet(scene);
-    PIC_TRY_ASSIGN(LightSet lights, readLightSet(lightsPath));
-    if (auto checked = checkLightSet(lights, scene); !checked)
-        return std::unexpected(checked.error());
-    return lights;
-}
-
 /// The flags of `picref SCENE …`.
 struct RenderArgs {
     std::string scenePath;
@@ -125,7 +116,7 @@ int runRender(const RenderArgs& args) {
         if (!fromScene) return reportError(fromScene.error());
         camera = *fromScene;
     }
-    auto lights = loadLights(args.lightsPath, *scene);
+    auto lights = loadLightSet(args.lightsPath, *scene);
     if (!lights) return reportError(lights.error());
     auto rays = EmbreeScene::create(*scene);
     if (!rays) return reportError(rays.error());
@@ -201,7 +192,7 @@ int runProbes(const ProbeArgs& args) {
         return reportError(matches.error());
     auto bake = readBakeFile(args.bakePath);
     if (!bake) return reportError(bake.error());
-    auto lights = loadLights(args.lightsPath, *scene);
+    auto lights = loadLightSet(args.lightsPath, *scene);
     if (!lights) return reportError(lights.error());
     auto rays = EmbreeScene::create(*scene);
     if (!rays) return reportError(rays.error());

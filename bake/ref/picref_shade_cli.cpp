@@ -108,13 +108,9 @@ int runShade(const ShadeCommand& command) {
         camera = *fromScene;
     }
 
-    LightSet lights = defaultLightSet(*scene);
-    if (!command.lightsPath.empty()) {
-        auto read = readLightSet(command.lightsPath);
-        if (!read) return reportError(read.error());
-        if (auto ok = checkLightSet(*read, *scene); !ok) return reportError(ok.error());
-        lights = std::move(*read);
-    }
+    auto loaded = loadLightSet(command.lightsPath, *scene);
+    if (!loaded) return reportError(loaded.error());
+    const LightSet& lights = *loaded;
 
     auto rays = EmbreeScene::create(*scene);
     if (!rays) return reportError(rays.error());
