@@ -4,6 +4,7 @@
 
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
+#include "bench/runtime_benchmark.h"
 #include "bench/bake_benchmark.h"
 #include "bench/link_error_benchmark.h"
 #include "core/parallel.h"
@@ -63,6 +64,24 @@ int picbenchMain(int argc, char** argv) {
     links->add_option("--ref-seed", linkParams.seed, "path tracer seed (default 1)");
     linkFlags.addTo(*links);
 
+    CLI::App* runtime = app.add_subcommand(
+        "runtime", "GPU backend against the CPU twin: ms per pass and update, link bandwidth, memory");
+    RuntimeBenchmarkParams runtimeParams;
+    runtime->add_option("--scene", runtimeParams.scenePath, "scene file (.gltf or .glb)")->required();
+    runtime->add_option("--lights", runtimeParams.lightsPath, "light set JSON (default: the scene's lights)");
+    runtime->add_option("--settings", runtimeParams.settings, "paper 000 Table 2 settings (default: moderate high)")
+        ->check(CLI::IsMember({"moderate", "high"}));
+    runtime->add_option("--link-modes", runtimeParams.linkModes, "link forms (default: rtp sh)")
+        ->check(CLI::IsMember({"rtp", "sh"}));
+    runtime->add_option("--bounces", runtimeParams.bounces,
+                        "bounces per update, −1 = progressive (default: 1 -1)");
+    runtime->add_option("--repeat", runtimeParams.repeat, "timed updates per backend (default 5)")
+        ->check(CLI::Range(1, 1000));
+    runtime->add_option("--device", runtimeParams.device, "Vulkan device name substring");
+    runtime->add_option("--shadow-map-size", runtimeParams.shadowMapSize, "texels per shadow-map side (default 1024)")
+        ->check(CLI::Range(16u, 16384u));
+    runtime->add_option("--json", runtimeParams.jsonPath, "JSON file (default runtime_benchmark.json)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -77,6 +96,7 @@ int picbenchMain(int argc, char** argv) {
         accuracyParams.bake = accuracyFlags.toOptions();
         return runAccuracyBenchmark(accuracyParams);
     }
+    if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
     if (links->parsed()) {
         linkParams.bake = linkFlags.toOptions();
         return runLinkErrorBenchmark(linkParams);

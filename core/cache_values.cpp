@@ -9,64 +9,31 @@
 namespace pic {
 namespace {
 
-/// Up to 8 caches around a point with their interpolation weights.
-struct CacheStencil {
-    uint32_t cache[8];
-    float weight[8];
-    int count = 0;
+/// Collects a stencil's neighbours, then renormalises their weights.
+struct StencilBuilder {
+    CacheStencil stencil;
 
     /// Adds a neighbour; neighbours without a cache take no weight.
     void add(uint32_t cacheIndex, float w) {
         if (cacheIndex == kNoCache) return;
-        cache[count] = cacheIndex;
-        weight[count] = w;
-        ++count;
+        stencil.cache[stencil.count] = cacheIndex;
+        stencil.weight[stencil.count] = w;
+        ++stencil.count;
+    }
+
+    /// The weights are renormalised over the caches that exist; when all of those carry zero
+    /// weight (the point sits exactly on a missing vertex or texel, whose own weight is 1)
+    /// they are averaged equally instead, so that such a point still sees the radiance of its
+    /// neighbours rather than a black speck.
+    CacheStencil finish() const {
+        CacheStencil out = stencil;
+        float total = 0.0f;
+        for (int k = 0; k < out.count; ++k) total += out.weight[k];
+        for (int k = 0; k < out.count; ++k)
+            out.weight[k] = total > 0.0f ? out.weight[k] / total : 1.0f / float(out.count);
+        return out;
     }
 };
-
-/// Blends the stencil's caches into RGB SH. The weights are renormalised over the caches that
-/// exist; when all of those carry zero weight (the point sits exactly on a missing vertex or
-/// texel, whose own weight is 1) they are averaged equally instead, so that such a point still
-/// sees the radiance of its neighbours rather than a black speck.
-RadianceSh blend(const CacheValues& values, const CacheStencil& stencil) {
-    RadianceSh out;
-    out.bands = values.bandsY;
-    if (stencil.count == 0) return out;
-
-    float total = 0.0f;
-    for (int k = 0; k < stencil.count; ++k) total += stencil.weight[k];
-    float weights[8];
-    for (int k = 0; k < stencil.count; ++k)
-        weights[k] = total > 0.0f ? stencil.weight[k] / total : 1.0f / float(stencil.count);
-
-    // Interpolate in YCoCg first (the conversion is linear), then convert once per coefficient.
-    const size_t countY = shCount(int(values.bandsY));
-    const size_t countC = shCount(int(values.bandsC));
-    float y[shCount(kMaxShBands)] = {};
-    float co[shCount(kMaxShBands)] = {};
-    float cg[shCount(kMaxShBands)] = {};
-    for (int k = 0; k < stencil.count; ++k) {
-        const size_t cache = stencil.cache[k];
-        PIC_DCHECK(cache < values.cacheCount());
-        const float w = weights[k];
-        const float* srcY = values.y.data() + cache * countY;
-        for (size_t i = 0; i < countY; ++i) y[i] += w * srcY[i];
-        const float* srcCo = values.co.data() + cache * countC;
-        const float* srcCg = values.cg.data() + cache * countC;
-        for (size_t i = 0; i < countC; ++i) {
-            co[i] += w * srcCo[i];
-            cg[i] += w * srcCg[i];
-        }
-    }
-    // Chroma bands above lC stay zero: those coefficients are grey (R = G = B = Y).
-    for (size_t i = 0; i < countY; ++i) {
-        const glm::vec3 rgb = yCoCgToRgb(glm::vec3(y[i], co[i], cg[i]));
-        out.rgb[0][i] = rgb.r;
-        out.rgb[1][i] = rgb.g;
-        out.rgb[2][i] = rgb.b;
-    }
-    return out;
-}
 
 /// Lower vertex index and fraction along one grid axis of a (clamped) vertex coordinate.
 void gridAxis(float coordinate, uint32_t vertices, uint32_t& lower, float& fraction) {
@@ -95,10 +62,9 @@ CacheValues CacheValues::zeros(size_t caches, uint32_t bandsY, uint32_t bandsC) 
     return values;
 }
 
-RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
-                              const glm::vec3& position) {
+CacheStencil gridStencil(const BakeData& bake, const glm::vec3& position) {
     const GridLayout& grid = bake.grid;
-    CacheStencil stencil;
+    StencilBuilder stencil;
     if (grid.cellSize > 0.0f && !grid.cacheIndex.empty()) {
         const glm::vec3 p = (position - grid.origin) / grid.cellSize;
         uint32_t lower[3];
@@ -120,16 +86,21 @@ RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
             stencil.add(grid.cacheIndex[index], w);
         }
     }
-    return blend(values, stencil);
+    return stencil.finish();
 }
 
-RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values, uint32_t triangle,
-                                 float b1, float b2, const glm::vec3& position) {
+RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
+                              const glm::vec3& position) {
+    return blendCaches(values, gridStencil(bake, position));
+}
+
+CacheStencil surfaceStencil(const BakeData& bake, uint32_t triangle, float b1, float b2,
+                            const glm::vec3& position) {
     const LightmapLayout& map = bake.lightmap;
     const size_t first = size_t{triangle} * 3;
     if (first + 2 >= map.triangleUvs.size() || map.triangleUvs[first].x == kNotLightmapped ||
         map.width == 0 || map.height == 0)
-        return lookupGridRadiance(bake, values, position);
+        return gridStencil(bake, position);
 
     const glm::vec2 uv = (1.0f - b1 - b2) * map.triangleUvs[first] +
                          b1 * map.triangleUvs[first + 1] + b2 * map.triangleUvs[first + 2];
@@ -137,7 +108,7 @@ RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values
     const glm::vec2 p = uv * glm::vec2(float(map.width), float(map.height)) - 0.5f;
     const glm::vec2 base = glm::floor(p);
     const glm::vec2 f = p - base;
-    CacheStencil stencil;
+    StencilBuilder stencil;
     for (int dy = 0; dy < 2; ++dy) {
         for (int dx = 0; dx < 2; ++dx) {
             const float x = base.x + float(dx);
@@ -149,7 +120,44 @@ RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values
             stencil.add(map.cacheIndex[size_t(x) + size_t{map.width} * size_t(y)], w);
         }
     }
-    return blend(values, stencil);
+    return stencil.finish();
+}
+
+RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values, uint32_t triangle,
+                                 float b1, float b2, const glm::vec3& position) {
+    return blendCaches(values, surfaceStencil(bake, triangle, b1, b2, position));
+}
+
+RadianceSh blendCaches(const CacheValues& values, const CacheStencil& stencil) {
+    RadianceSh out;
+    out.bands = values.bandsY;
+    // Interpolate in YCoCg first (the conversion is linear), then convert once per coefficient.
+    const size_t countY = shCount(int(values.bandsY));
+    const size_t countC = shCount(int(values.bandsC));
+    float y[shCount(kMaxShBands)] = {};
+    float co[shCount(kMaxShBands)] = {};
+    float cg[shCount(kMaxShBands)] = {};
+    for (int k = 0; k < stencil.count; ++k) {
+        const size_t cache = stencil.cache[k];
+        PIC_DCHECK(cache < values.cacheCount());
+        const float w = stencil.weight[k];
+        const float* srcY = values.y.data() + cache * countY;
+        for (size_t i = 0; i < countY; ++i) y[i] += w * srcY[i];
+        const float* srcCo = values.co.data() + cache * countC;
+        const float* srcCg = values.cg.data() + cache * countC;
+        for (size_t i = 0; i < countC; ++i) {
+            co[i] += w * srcCo[i];
+            cg[i] += w * srcCg[i];
+        }
+    }
+    // Chroma bands above lC stay zero: those coefficients are grey (R = G = B = Y).
+    for (size_t i = 0; i < countY; ++i) {
+        const glm::vec3 rgb = yCoCgToRgb(glm::vec3(y[i], co[i], cg[i]));
+        out.rgb[0][i] = rgb.r;
+        out.rgb[1][i] = rgb.g;
+        out.rgb[2][i] = rgb.b;
+    }
+    return out;
 }
 
 glm::vec3 irradiance(const RadianceSh& radiance, const glm::vec3& normal) {

@@ -31,6 +31,25 @@ struct RadianceSh {
     float rgb[3][64] = {};  ///< per channel R, G, B: bands² coefficients
 };
 
+/// Up to 8 caches around a point with their final interpolation weights (they sum to 1 when
+/// count > 0). A stencil depends on the bake only, so a runtime that looks up the same points
+/// at every bounce computes it once (the GPU backend uploads one per surfel).
+struct CacheStencil {
+    uint32_t cache[8] = {};
+    float weight[8] = {};
+    int count = 0;
+};
+
+/// The stencil of lookupSurfaceRadiance (same arguments).
+CacheStencil surfaceStencil(const BakeData& bake, uint32_t triangle, float b1, float b2,
+                            const glm::vec3& position);
+
+/// The stencil of lookupGridRadiance.
+CacheStencil gridStencil(const BakeData& bake, const glm::vec3& position);
+
+/// Σ_k weight_k · values of cache_k, converted to RGB SH.
+RadianceSh blendCaches(const CacheValues& values, const CacheStencil& stencil);
+
 /// Interpolates the caches around a surface point the way every renderer of pic does:
 /// bilinearly from the 4 light-map texels around the triangle's light-map UV when the
 /// triangle is light-mapped (triangleUvs != kNotLightmapped), else trilinearly from the 8

@@ -87,6 +87,13 @@ const char* toString(ErrorCode code);
 #define PIC_DCHECK(cond) PIC_CHECK(cond)
 #endif
 
+/// Returns the error of a Result<void> (or any Result whose value is not needed).
+#define PIC_TRY(expr)                                                  \
+    do {                                                               \
+        auto picTryResult_ = (expr);                                   \
+        if (!picTryResult_) return std::unexpected(picTryResult_.error()); \
+    } while (false)
+
 /// Propagates the error of an expression returning Result<T>; yields the value otherwise.
 #define PIC_TRY_ASSIGN(lhs, expr)                                    \
     auto PIC_CONCAT_(picTry_, __LINE__) = (expr);                    \

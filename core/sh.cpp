@@ -194,6 +194,18 @@ void shEvaluate(int bands, const glm::vec3& direction, float* out) {
     }
 }
 
+ShRecurrence shRecurrence() {
+    ShRecurrence out{};
+    for (int m = 0; m < kMaxShBands; ++m) {
+        out.diagonal[m] = kLegendre.diagonal[m];
+        for (int l = 0; l < kMaxShBands; ++l) {
+            out.a[l][m] = kLegendre.a[l][m];
+            out.b[l][m] = kLegendre.b[l][m];
+        }
+    }
+    return out;
+}
+
 float clampedCosineZonal(int l) {
     PIC_DCHECK(l >= 0);
     return float(kPi * lobeFactor(l, 1.0));

@@ -40,6 +40,16 @@ constexpr int shIndex(int l, int m) {
 /// direction unit length. Polynomial recurrences in x, y, z only: no trig, no allocation.
 void shEvaluate(int bands, const glm::vec3& direction, float* out);
 
+/// The constants of shEvaluate's recurrence, for GPU shaders that evaluate the same basis:
+/// Q_m^m = diagonal[m], Q_l^m = a[l][m]·z·Q_{l−1}^m − b[l][m]·Q_{l−2}^m (l > m), with
+/// y_l^m = Q_l^m·Re((x + iy)^m) and y_l^−m = Q_l^m·Im((x + iy)^m).
+struct ShRecurrence {
+    float diagonal[kMaxShBands];
+    float a[kMaxShBands][kMaxShBands];
+    float b[kMaxShBands][kMaxShBands];
+};
+ShRecurrence shRecurrence();
+
 /// K_l of the clamped cosine max(0, d·ω): its projection is K_l y_l^m(d), so the irradiance
 /// of radiance L is E(n) = Σ K_l L_l^m y_l^m(n). K_0 = π, K_1 = 2π/3, K_2 = π/4, K_3 = 0,
 /// and zero for every odd l >= 3. l >= 0.

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "server/cpu/lightmap_copy.h"
 
 namespace pic {
 
@@ -27,6 +28,7 @@ struct UpdateStats {
     std::map<std::string, double> passMs;     ///< milliseconds per pass, summed over bounces
     double totalMs = 0.0;
     double surfelFlux = 0.0;                  ///< W, luminance of the last bounce's surfel flux
+    int shadowMapsRendered = 0;               ///< lights whose shadow maps were re-rendered (GPU)
 };
 
 /// A runtime backend over one bake of one scene.
@@ -35,8 +37,22 @@ public:
     virtual ~Runtime() = default;
     /// Relights the scene with `lights` and returns the caches' incident radiance.
     virtual Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats = nullptr) = 0;
+    /// The last update's caches as the grid and light-map textures renderers sample
+    /// (server/cpu/lightmap_copy.h layout): what the server encodes and streams.
+    virtual Result<const CacheTextures*> textures() = 0;
     /// Backend name for logs ("cpu", "gpu").
     virtual const char* name() const = 0;
 };
+
+/// What every backend relies on beyond the bake file's own validation: the bake belongs to
+/// this scene, its band counts and link counts agree, and the hierarchy is ordered so that a
+/// level-by-level pull reads only finished nodes. InvalidInput naming the mismatch.
+Result<void> checkRuntimeBake(const Scene& scene, const BakeData& bake);
+
+/// BounceParams in range (InvalidInput naming the field).
+Result<void> checkBounceParams(const BounceParams& params);
+
+/// A light set fits the scene (checkLightSet) and holds only finite, non-negative numbers.
+Result<void> checkRuntimeLights(const LightSet& lights, const Scene& scene);
 
 }  // namespace pic

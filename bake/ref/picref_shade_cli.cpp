@@ -19,6 +19,7 @@
 #include "core/progress.h"
 #include "server/cpu/cache_shading.h"
 #include "server/cpu/cpu_runtime.h"
+#include "server/gpu/gpu_runtime.h"
 
 namespace pic {
 namespace {
@@ -39,6 +40,8 @@ struct ShadeCommand {
     std::string scenePath;
     std::string bakePath;
     std::string backend = "cpu";
+    std::string device;              ///< --device: Vulkan device name substring (gpu backend)
+    uint32_t shadowMapSize = 1024;   ///< --shadow-map-size (gpu backend)
     std::string lightsPath;
     std::string cameraText;
     int sceneCameraIndex = -1;  ///< used when --camera is not given
@@ -54,9 +57,9 @@ struct ShadeCommand {
 
 /// Checks what can be checked without reading files, so that usage errors come first.
 Result<void> checkUsage(const ShadeCommand& command) {
-    if (command.backend == "gpu")
-        return fail(ErrorCode::Unsupported,
-                    "the GPU backend is not built yet (issue 4); use --backend cpu");
+    if (command.shadowMapSize < 16 || command.shadowMapSize > 16384)
+        return fail(ErrorCode::InvalidInput, "--shadow-map-size {} must be in [16, 16384]",
+                    command.shadowMapSize);
     if (command.bounces < -1)
         return fail(ErrorCode::InvalidInput, "--bounces {} must be ≥ 0 (or −1: until converged)",
                     command.bounces);
@@ -114,7 +117,19 @@ int runShade(const ShadeCommand& command) {
 
     auto rays = EmbreeScene::create(*scene);
     if (!rays) return reportError(rays.error());
-    auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{command.bounces});
+    Result<std::unique_ptr<Runtime>> runtime;
+    if (command.backend == "gpu") {
+        GpuRuntimeOptions options;
+        options.deviceName = command.device;
+        options.shadowMapSize = command.shadowMapSize;
+        auto gpu = GpuRuntime::create(*scene, **rays, *bake, BounceParams{command.bounces}, options);
+        if (!gpu) return reportError(gpu.error());
+        std::fprintf(stderr, "picref shade: GPU backend on \"%s\"\n",
+                     (*gpu)->context().deviceName().c_str());
+        runtime = std::unique_ptr<Runtime>(std::move(*gpu));
+    } else {
+        runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{command.bounces});
+    }
     if (!runtime) return reportError(runtime.error());
 
     UpdateStats stats;
@@ -160,6 +175,11 @@ int picrefShadeMain(int argc, char** argv) {
     app.add_option("--bake", command.bakePath, "bake file of this scene (.pic)")->required();
     app.add_option("--backend", command.backend, "runtime backend")
         ->check(CLI::IsMember({"cpu", "gpu"}));
+    app.add_option("--device", command.device,
+                   "gpu backend: Vulkan device whose name contains this (default: a discrete "
+                   "GPU, else integrated, else lavapipe)");
+    app.add_option("--shadow-map-size", command.shadowMapSize,
+                   "gpu backend: texels per side of each shadow-map layer (default 1024)");
     app.add_option("--lights", command.lightsPath, "light set JSON (default: the scene's lights)");
     auto* cameraOption = app.add_option("--camera", command.cameraText,
                                         "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");

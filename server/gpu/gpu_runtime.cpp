@@ -1,0 +1,311 @@
+#include "server/gpu/gpu_runtime.h"
+
+#include <chrono>
+
+#include "core/color.h"
+#include "core/sh.h"
+#include "server/passes/cache_lighting_pass.h"
+#include "server/passes/lightmap_copy_pass.h"
+#include "server/passes/pull_pass.h"
+#include "server/passes/shadow_map_pass.h"
+#include "server/passes/surfel_lighting_pass.h"
+#include "shaders/shared/sh_tables.h"
+
+namespace pic {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Timestamp pairs one submission may hold: shadow maps, surfel lighting, pull, cache
+/// lighting, light-map copy, with room to spare.
+constexpr uint32_t kTimedPasses = 16;
+
+gpu::ShTables makeShTables() {
+    const ShRecurrence recurrence = shRecurrence();
+    gpu::ShTables tables{};
+    // Element k of each array is component k % 4 of vec4 k / 4.
+    const auto at = [](glm::vec4* array, int k) -> float& { return array[k / 4][k % 4]; };
+    for (int l = 0; l < kMaxShBands; ++l) {
+        at(tables.diagonal, l) = recurrence.diagonal[l];
+        at(tables.clampedCosine, l) = clampedCosineZonal(l);
+        for (int m = 0; m < kMaxShBands; ++m) {
+            at(tables.a, l * kMaxShBands + m) = recurrence.a[l][m];
+            at(tables.b, l * kMaxShBands + m) = recurrence.b[l][m];
+        }
+    }
+    return tables;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GpuRuntime>> GpuRuntime::create(const Scene& scene, const EmbreeScene& rays,
+                                                       const BakeData& bake,
+                                                       const BounceParams& bounces,
+                                                       const GpuRuntimeOptions& options) {
+    PIC_TRY(checkRuntimeBake(scene, bake));
+    PIC_TRY(checkBounceParams(bounces));
+    std::unique_ptr<GpuRuntime> runtime(new GpuRuntime(scene, bake, bounces));
+    PIC_TRY(runtime->init(rays, options));
+    return runtime;
+}
+
+GpuRuntime::GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces)
+    : mScene(scene), mBake(bake), mBounces(bounces) {}
+
+GpuRuntime::~GpuRuntime() = default;
+
+Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& options) {
+    using namespace gpu;
+    PIC_TRY_ASSIGN(mContext, Context::create({options.deviceName, options.validation}));
+    Context& ctx = *mContext;
+    const size_t nC = mBake.caches.size();
+    const uint32_t countY = mBake.params.bandsY * mBake.params.bandsY;
+    const uint32_t countC = mBake.params.bandsC * mBake.params.bandsC;
+
+    PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), 0,
+                                               MemoryUse::Device, "node flux"));
+    PIC_TRY_ASSIGN(mCacheY, ctx.createBuffer(2 * nC * countY, 0, MemoryUse::Device, "caches Y"));
+    PIC_TRY_ASSIGN(mCacheCo, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Co"));
+    PIC_TRY_ASSIGN(mCacheCg, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Cg"));
+    const ShTables tables = makeShTables();
+    PIC_TRY_ASSIGN(mShTables, ctx.createBufferWith(&tables, sizeof(tables),
+                                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
+    PIC_TRY_ASSIGN(mTimer, ctx.createPassTimer(kTimedPasses));
+
+    PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(ctx, mScene, options.shadowMapSize));
+    PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon()));
+    PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
+    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake));
+    PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
+    PIC_TRY(bindShadowConsumers());
+    PIC_TRY(mPull->bind(mNodeFlux));
+    PIC_TRY(mCacheLighting->bind(mNodeFlux, mCacheY, mCacheCo, mCacheCg, mShTables));
+    PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
+
+    mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
+    mTextures = makeCacheTextures(mBake);
+    return {};
+}
+
+Result<void> GpuRuntime::bindShadowConsumers() {
+    return mSurfels->bind({mShadows.get(), &mNodeFlux, &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
+}
+
+Result<void> GpuRuntime::prepareLights(const LightSet& lights, UpdateStats& stats) {
+    PIC_TRY(checkRuntimeLights(lights, mScene));
+    bool reallocated = false;
+    PIC_TRY(mShadows->prepare(lights, reallocated));
+    // A new depth image invalidates the set that samples the old one.
+    if (reallocated) PIC_TRY(bindShadowConsumers());
+    PIC_TRY(mSurfels->setEmissiveScales(lights));
+    (void)stats;
+    return {};
+}
+
+Result<void> GpuRuntime::submitTimed(const std::function<void(VkCommandBuffer)>& record,
+                                     UpdateStats& stats) {
+    PIC_TRY(mContext->submit(record, &mTimer));
+    std::vector<std::pair<std::string, double>> ms;
+    PIC_TRY(mTimer.collect(ms));
+    for (const auto& [pass, t] : ms) stats.passMs[pass] += t;
+    return {};
+}
+
+Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateStats* statsOut) {
+    const Clock::time_point start = Clock::now();
+    UpdateStats local;
+    UpdateStats& stats = statsOut ? *statsOut : local;
+    stats = UpdateStats{};
+    PIC_TRY(prepareLights(lights, stats));
+    mTexturesCurrent = false;
+
+    const bool progressive = mBounces.bounces < 0;
+    const int passes = progressive ? mBounces.maxBounces : mBounces.bounces;
+    const uint32_t lightCount = uint32_t(lights.lights.size());
+    if (passes == 0) {
+        // No cache pass: the caches hold no light.
+        mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+        PIC_TRY(uploadCaches(mValues));
+        stats.totalMs = millisecondsSince(start);
+        return &mValues;
+    }
+
+    // Each submission ends with a bounce's caches and, when another bounce may follow, the
+    // surfel flux that bounce would pull; the host reads the flux sums to decide.
+    const auto cacheBounce = [&](VkCommandBuffer cmd, bool another, uint32_t sumSlot) {
+        mTimer.begin(cmd, "pull");
+        mPull->record(cmd);
+        mTimer.begin(cmd, "cache_lighting");
+        mCacheLighting->record(cmd);
+        if (another) {
+            // The caches are written before the surfels read them.
+            gpu::computeBarrier(cmd);
+            mTimer.begin(cmd, "surfel_lighting");
+            mSurfels->record(cmd, true, lightCount, sumSlot);
+        }
+        // Everything written before the next submission's first pass reads it.
+        gpu::computeBarrier(cmd);
+    };
+
+    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
+        mTimer.begin(cmd, "shadow_maps");
+        mShadows->record(cmd);
+        mTimer.begin(cmd, "surfel_lighting");
+        mSurfels->record(cmd, false, lightCount, 0);
+        // The leaves are written before the pull reads them.
+        gpu::computeBarrier(cmd);
+        cacheBounce(cmd, passes > 1, 1);
+    }, stats));
+    stats.shadowMapsRendered = int(mShadows->renderedLights());
+    PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
+    double total = luminance(glm::vec3(sum));
+    stats.bounces = 1;
+    stats.surfelFlux = total;
+
+    // sumSlot of the surfel flux the latest submission computed for the next bounce.
+    uint32_t slot = 1;
+    for (int bounce = 2; bounce <= passes; ++bounce) {
+        PIC_TRY_ASSIGN(sum, mSurfels->totalFlux(slot));
+        const double next = luminance(glm::vec3(sum));
+        // Progressive: a bounce that adds less than `convergence` of the flux is not worth
+        // its cache pass (`<=` also stops a scene without light at once).
+        if (progressive && next - total <= double(mBounces.convergence) * next) break;
+        total = next;
+        slot ^= 1u;
+        PIC_TRY(submitTimed([&](VkCommandBuffer cmd) { cacheBounce(cmd, bounce < passes, slot); },
+                            stats));
+        stats.bounces = bounce;
+        stats.surfelFlux = total;
+    }
+
+    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
+        mTimer.begin(cmd, "lightmap_copy");
+        mLightmapCopy->record(cmd);
+    }, stats));
+    PIC_TRY(downloadCaches(mValues));
+    stats.totalMs = millisecondsSince(start);
+    return &mValues;
+}
+
+Result<const CacheTextures*> GpuRuntime::textures() {
+    if (!mTexturesCurrent) {
+        PIC_TRY(mLightmapCopy->read(*mContext, mTextures));
+        mTexturesCurrent = true;
+    }
+    return &mTextures;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Single passes on given inputs
+
+Result<void> GpuRuntime::uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer) {
+    std::vector<glm::vec4> padded(flux.size());
+    for (size_t i = 0; i < flux.size(); ++i) padded[i] = glm::vec4(flux[i], 0.0f);
+    return mContext->upload(buffer, padded.data(), padded.size() * sizeof(glm::vec4));
+}
+
+Result<std::vector<glm::vec3>> GpuRuntime::downloadFlux(const gpu::Buffer& buffer, size_t count) {
+    std::vector<glm::vec4> padded(count);
+    PIC_TRY(mContext->download(buffer, padded.data(), count * sizeof(glm::vec4)));
+    std::vector<glm::vec3> flux(count);
+    for (size_t i = 0; i < count; ++i) flux[i] = glm::vec3(padded[i]);
+    return flux;
+}
+
+Result<void> GpuRuntime::uploadCaches(const CacheValues& values) {
+    PIC_CHECK(values.bandsY == mValues.bandsY && values.bandsC == mValues.bandsC &&
+              values.cacheCount() == mBake.caches.size());
+    const auto put = [&](const std::vector<float>& v, gpu::Buffer& buffer) -> Result<void> {
+        std::vector<uint16_t> halves(v.size());
+        for (size_t i = 0; i < v.size(); ++i) halves[i] = floatToHalf(v[i]);
+        if (halves.empty()) return {};
+        return mContext->upload(buffer, halves.data(), halves.size() * sizeof(uint16_t));
+    };
+    PIC_TRY(put(values.y, mCacheY));
+    PIC_TRY(put(values.co, mCacheCo));
+    return put(values.cg, mCacheCg);
+}
+
+Result<void> GpuRuntime::downloadCaches(CacheValues& values) {
+    const auto get = [&](const gpu::Buffer& buffer, std::vector<float>& v) -> Result<void> {
+        std::vector<uint16_t> halves(v.size());
+        if (!halves.empty())
+            PIC_TRY(mContext->download(buffer, halves.data(), halves.size() * sizeof(uint16_t)));
+        for (size_t i = 0; i < v.size(); ++i) v[i] = halfToFloat(halves[i]);
+        return {};
+    };
+    PIC_TRY(get(mCacheY, values.y));
+    PIC_TRY(get(mCacheCo, values.co));
+    return get(mCacheCg, values.cg);
+}
+
+Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, UpdateStats* statsOut) {
+    UpdateStats local;
+    UpdateStats& stats = statsOut ? *statsOut : local;
+    stats = UpdateStats{};
+    PIC_TRY(prepareLights(lights, stats));
+    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
+        mTimer.begin(cmd, "shadow_maps");
+        mShadows->record(cmd);
+        mTimer.begin(cmd, "surfel_lighting");
+        mSurfels->record(cmd, false, uint32_t(lights.lights.size()), 0);
+    }, stats));
+    stats.shadowMapsRendered = int(mShadows->renderedLights());
+    return downloadFlux(mSurfels->directFlux(), mBake.surfels.size());
+}
+
+Result<std::vector<glm::vec3>> GpuRuntime::runBounce(std::span<const glm::vec3> direct,
+                                                     const CacheValues& previous) {
+    PIC_CHECK_EQ(direct.size(), mBake.surfels.size());
+    PIC_TRY(uploadFlux(direct, const_cast<gpu::Buffer&>(mSurfels->directFlux())));
+    PIC_TRY(uploadCaches(previous));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mSurfels->record(cmd, true, 0, 0); }));
+    return downloadFlux(mNodeFlux, mBake.surfels.size());
+}
+
+Result<std::vector<glm::vec3>> GpuRuntime::runPull(std::span<const glm::vec3> leaves) {
+    PIC_CHECK_EQ(leaves.size(), mBake.surfels.size());
+    std::vector<glm::vec3> nodes(mBake.nodes.size(), glm::vec3(0.0f));
+    std::copy(leaves.begin(), leaves.end(), nodes.begin());
+    PIC_TRY(uploadFlux(nodes, mNodeFlux));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mPull->record(cmd); }));
+    return downloadFlux(mNodeFlux, mBake.nodes.size());
+}
+
+Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
+    PIC_CHECK_EQ(nodeFlux.size(), mBake.nodes.size());
+    PIC_TRY(uploadFlux(nodeFlux, mNodeFlux));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mCacheLighting->record(cmd); }));
+    CacheValues values = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+    PIC_TRY(downloadCaches(values));
+    return values;
+}
+
+Result<CacheTextures> GpuRuntime::runLightmapCopy(const CacheValues& values) {
+    PIC_TRY(uploadCaches(values));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
+    CacheTextures textures = makeCacheTextures(mBake);
+    PIC_TRY(mLightmapCopy->read(*mContext, textures));
+    mTexturesCurrent = false;
+    return textures;
+}
+
+std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
+    return {
+        {"links", mCacheLighting->bytes()},
+        {"surfels", mSurfels->bytes()},
+        {"node_children", mPull->bytes()},
+        {"node_flux", mNodeFlux.size()},
+        {"caches", mCacheY.size() + mCacheCo.size() + mCacheCg.size()},
+        {"textures", mLightmapCopy->bytes()},
+        {"shadow_maps", mShadows->bytes()},
+    };
+}
+
+uint64_t GpuRuntime::linkBytesPerBounce() const { return mCacheLighting->linkBytes(); }
+
+}  // namespace pic

@@ -1,0 +1,100 @@
+#pragma once
+/// The GPU backend of the runtime (paper 000 Figure 2 on Vulkan): shadow maps, surfel
+/// lighting, pull, cache lighting, light-map copy and progressive bounces, each pass in
+/// server/passes/ with its CPU twin in server/cpu/. Runs on any Vulkan 1.3 device; on a
+/// machine without a GPU that is Mesa's lavapipe.
+
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/embree_scene.h"
+#include "server/gpu/context.h"
+#include "server/runtime.h"
+
+namespace pic {
+
+/// How to run the GPU backend.
+struct GpuRuntimeOptions {
+    std::string deviceName;        ///< --device: substring of the Vulkan device name; empty = best
+    bool validation = false;       ///< Vulkan validation layer when installed (PIC_VK_VALIDATION overrides)
+    uint32_t shadowMapSize = 1024; ///< texels per side of each shadow-map layer
+};
+
+namespace gpu {
+class ShadowMapPass;
+class SurfelLightingPass;
+class PullPass;
+class CacheLightingPass;
+class LightmapCopyPass;
+}  // namespace gpu
+
+/// The GPU backend. Besides the Runtime API it runs single passes on given inputs, so that
+/// tests compare each pass with its CPU twin on identical data. Not thread-safe.
+class GpuRuntime final : public Runtime {
+public:
+    /// `scene`, `rays` (for its ray offset) and `bake` must outlive the runtime.
+    static Result<std::unique_ptr<GpuRuntime>> create(const Scene& scene, const EmbreeScene& rays,
+                                                      const BakeData& bake,
+                                                      const BounceParams& bounces,
+                                                      const GpuRuntimeOptions& options = {});
+    ~GpuRuntime() override;
+
+    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
+    Result<const CacheTextures*> textures() override;
+    const char* name() const override { return "gpu"; }
+
+    /// Shadow maps and the direct part of surfel lighting for `lights`: nS direct fluxes.
+    Result<std::vector<glm::vec3>> runDirect(const LightSet& lights, UpdateStats* stats = nullptr);
+    /// One bounce of surfel lighting from `direct` (nS) and the caches `previous`: the leaves.
+    Result<std::vector<glm::vec3>> runBounce(std::span<const glm::vec3> direct,
+                                             const CacheValues& previous);
+    /// Pull from the leaves `leaves` (nS): all 2nS − 1 node fluxes.
+    Result<std::vector<glm::vec3>> runPull(std::span<const glm::vec3> leaves);
+    /// Cache lighting from `nodeFlux` (2nS − 1 nodes).
+    Result<CacheValues> runCacheLighting(std::span<const glm::vec3> nodeFlux);
+    /// Light-map copy of `values` into the textures.
+    Result<CacheTextures> runLightmapCopy(const CacheValues& values);
+
+    /// Device memory per buffer group, bytes, for the benchmark (paper 000 Table 4).
+    std::vector<std::pair<std::string, uint64_t>> memory() const;
+    /// Link bytes cache lighting reads per bounce.
+    uint64_t linkBytesPerBounce() const;
+    const gpu::Context& context() const { return *mContext; }
+
+private:
+    GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces);
+    Result<void> init(const EmbreeScene& rays, const GpuRuntimeOptions& options);
+    Result<void> bindShadowConsumers();
+    Result<void> prepareLights(const LightSet& lights, UpdateStats& stats);
+    Result<void> submitTimed(const std::function<void(VkCommandBuffer)>& record, UpdateStats& stats);
+    Result<void> uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer);
+    Result<std::vector<glm::vec3>> downloadFlux(const gpu::Buffer& buffer, size_t count);
+    Result<void> uploadCaches(const CacheValues& values);
+    Result<void> downloadCaches(CacheValues& values);
+
+    const Scene& mScene;
+    const BakeData& mBake;
+    BounceParams mBounces;
+    std::unique_ptr<gpu::Context> mContext;
+    std::unique_ptr<gpu::ShadowMapPass> mShadows;
+    std::unique_ptr<gpu::SurfelLightingPass> mSurfels;
+    std::unique_ptr<gpu::PullPass> mPull;
+    std::unique_ptr<gpu::CacheLightingPass> mCacheLighting;
+    std::unique_ptr<gpu::LightmapCopyPass> mLightmapCopy;
+    gpu::PassTimer mTimer;
+    gpu::Buffer mNodeFlux;   ///< vec4 per node, W RGB
+    gpu::Buffer mCacheY;     ///< half, nC·lY²
+    gpu::Buffer mCacheCo;    ///< half, nC·lC²
+    gpu::Buffer mCacheCg;    ///< half, nC·lC²
+    gpu::Buffer mShTables;   ///< ShTables
+    CacheValues mValues;
+    CacheTextures mTextures;
+    bool mTexturesCurrent = false;
+};
+
+}  // namespace pic

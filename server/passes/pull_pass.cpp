@@ -1,0 +1,48 @@
+#include "server/passes/pull_pass.h"
+
+#include <array>
+
+#include <glm/glm.hpp>
+
+#include "shaders/shared/pull.h"
+#include "spirv/pull_comp.h"
+
+namespace pic::gpu {
+
+Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake) {
+    std::unique_ptr<PullPass> pass(new PullPass());
+    const size_t nS = bake.surfels.size();
+    pass->mSurfelCount = uint32_t(nS);
+    pass->mLevelOffsets = bake.levelOffsets;
+    KernelLayout layout;
+    layout.bindings.assign(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.pushBytes = sizeof(PullPush);
+    PIC_TRY_ASSIGN(pass->mKernel, Kernel::create(context, kSpirvPullComp, layout, "pull"));
+    // Only the children matter to the pull: 8 bytes per inner node instead of the 64-byte Node.
+    std::vector<glm::uvec2> children(bake.nodes.size() - nS);
+    for (size_t n = nS; n < bake.nodes.size(); ++n)
+        children[n - nS] = {bake.nodes[n].left, bake.nodes[n].right};
+    PIC_TRY_ASSIGN(pass->mChildren, context.createBufferWith(std::span<const glm::uvec2>(children),
+                                                             0, "node children"));
+    return pass;
+}
+
+Result<void> PullPass::bind(const Buffer& nodeFlux) {
+    const std::array<BindingResource, 2> resources = {BindingResource::storage(0, nodeFlux),
+                                                      BindingResource::storage(1, mChildren)};
+    PIC_TRY(mKernel.resetSets());
+    PIC_TRY_ASSIGN(mSet, mKernel.makeSet(resources));
+    return {};
+}
+
+void PullPass::record(VkCommandBuffer cmd) {
+    // Level k ≥ 1 is nodes [levelOffsets[k − 1], levelOffsets[k]).
+    for (size_t level = 1; level < mLevelOffsets.size(); ++level) {
+        const PullPush push{mLevelOffsets[level - 1], mLevelOffsets[level], mSurfelCount, 0};
+        mKernel.dispatch(cmd, mSet, &push, groupsFor(push.endNode - push.firstNode, kPullGroup));
+        // This level's sums are written before the next level reads them.
+        computeBarrier(cmd);
+    }
+}
+
+}  // namespace pic::gpu

@@ -1,0 +1,305 @@
+#include "server/passes/shadow_map_pass.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "spirv/shadow_map_vert.h"
+
+namespace pic::gpu {
+namespace {
+
+/// Layers of a light's shadow map.
+uint32_t layersOf(const Light& light) {
+    if (light.type == LightType::Point) return 6;
+    if (light.type == LightType::Spot && light.outerConeAngle > kMaxPerspectiveSpot) return 6;
+    return 1;
+}
+
+/// An up vector not parallel to `forward`.
+glm::vec3 upFor(const glm::vec3& forward) {
+    return std::abs(forward.y) > 0.9f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
+                                                             uint32_t size) {
+    if (size < 16 || size > 16384)
+        return fail(ErrorCode::InvalidInput, "shadow-map size must be in [16, 16384], got {}", size);
+    if (scene.triangles.empty() || scene.bounds.empty())
+        return fail(ErrorCode::InvalidInput, "scene {} has no triangles to cast shadows",
+                    scene.sourcePath);
+    std::unique_ptr<ShadowMapPass> pass(new ShadowMapPass(context));
+    pass->mSize = size;
+    pass->mBounds = scene.bounds;
+
+    // Positions only, packed: depth needs nothing else.
+    std::vector<float> positions;
+    positions.reserve(scene.vertices.size() * 3);
+    for (const Vertex& v : scene.vertices)
+        positions.insert(positions.end(), {v.position.x, v.position.y, v.position.z});
+    std::vector<uint32_t> indices;
+    indices.reserve(scene.triangles.size() * 3);
+    for (const Triangle& t : scene.triangles) indices.insert(indices.end(), {t.v[0], t.v[1], t.v[2]});
+    pass->mIndexCount = uint32_t(indices.size());
+    PIC_TRY_ASSIGN(pass->mVertices,
+                   context.createBufferWith(std::span<const float>(positions),
+                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "shadow vertices"));
+    PIC_TRY_ASSIGN(pass->mIndices,
+                   context.createBufferWith(std::span<const uint32_t>(indices),
+                                            VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "shadow indices"));
+    PIC_TRY_ASSIGN(pass->mLights, context.createBuffer(sizeof(GpuLight) * kMaxLights, 0,
+                                                       MemoryUse::Device, "lights"));
+    PIC_TRY_ASSIGN(pass->mMatrices, context.createBuffer(sizeof(glm::mat4) * 6 * kMaxLights, 0,
+                                                         MemoryUse::Device, "shadow matrices"));
+    // A one-layer placeholder keeps descriptor sets valid before the first light arrives.
+    PIC_TRY_ASSIGN(pass->mDepth, context.createDepthArray(size, 1));
+
+    // Depth-only pipeline: no fragment shader, both faces drawn (surfels sit on both sides of
+    // single-sided geometry), viewport and scissor set per layer.
+    VkDevice device = context.device();
+    const VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(ShadowMapPush)};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.pushConstantRangeCount = 1;
+    layoutInfo.pPushConstantRanges = &push;
+    PIC_VK_TRY(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pass->mPipelineLayout));
+
+    PIC_TRY_ASSIGN(VkShaderModule vertex, context.createShaderModule(kSpirvShadowMapVert, "shadow_map.vert"));
+    VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stage.stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stage.module = vertex;
+    stage.pName = "main";
+    const VkVertexInputBindingDescription binding{0, 3 * sizeof(float), VK_VERTEX_INPUT_RATE_VERTEX};
+    const VkVertexInputAttributeDescription attribute{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
+    VkPipelineVertexInputStateCreateInfo vertexInput{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vertexInput.vertexBindingDescriptionCount = 1;
+    vertexInput.pVertexBindingDescriptions = &binding;
+    vertexInput.vertexAttributeDescriptionCount = 1;
+    vertexInput.pVertexAttributeDescriptions = &attribute;
+    VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = VK_POLYGON_MODE_FILL;
+    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    raster.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    VkPipelineDepthStencilStateCreateInfo depthState{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    depthState.depthTestEnable = VK_TRUE;
+    depthState.depthWriteEnable = VK_TRUE;
+    depthState.depthCompareOp = VK_COMPARE_OP_LESS;
+    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    const VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = 2;
+    dynamic.pDynamicStates = dynamicStates;
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    rendering.depthAttachmentFormat = VK_FORMAT_D32_SFLOAT;
+    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    info.pNext = &rendering;
+    info.stageCount = 1;
+    info.pStages = &stage;
+    info.pVertexInputState = &vertexInput;
+    info.pInputAssemblyState = &assembly;
+    info.pViewportState = &viewport;
+    info.pRasterizationState = &raster;
+    info.pMultisampleState = &multisample;
+    info.pDepthStencilState = &depthState;
+    info.pColorBlendState = &blend;
+    info.pDynamicState = &dynamic;
+    info.layout = pass->mPipelineLayout;
+    const VkResult r = vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pass->mPipeline);
+    vkDestroyShaderModule(device, vertex, nullptr);
+    PIC_VK_TRY(r);
+    return pass;
+}
+
+ShadowMapPass::~ShadowMapPass() {
+    VkDevice device = mContext.device();
+    if (mPipeline) vkDestroyPipeline(device, mPipeline, nullptr);
+    if (mPipelineLayout) vkDestroyPipelineLayout(device, mPipelineLayout, nullptr);
+}
+
+VkDeviceSize ShadowMapPass::bytes() const {
+    return mVertices.size() + mIndices.size() + mLights.size() + mMatrices.size() + mDepth.bytes();
+}
+
+ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t firstLayer,
+                                                 std::vector<glm::mat4>& clipFromWorld) const {
+    LightSlot slot;
+    slot.id = light.id;
+    slot.position = light.position;
+    slot.direction = light.direction;
+    slot.outerConeAngle = light.outerConeAngle;
+    slot.type = light.type;
+    slot.layers = layersOf(light);
+
+    GpuLight& g = slot.gpu;
+    g.position = light.position;
+    g.type = light.type == LightType::Point ? kLightPoint
+             : light.type == LightType::Spot ? kLightSpot
+                                             : kLightDirectional;
+    g.direction = light.direction;
+    g.range = std::isfinite(light.range) ? light.range : 0.0f;
+    g.radiant = light.intensity * light.color;
+    g.cosOuter = std::cos(light.outerConeAngle);
+    g.cosInner = std::cos(light.innerConeAngle);
+    g.hardCone = light.innerConeAngle >= light.outerConeAngle ? 1u : 0u;
+    g.firstLayer = firstLayer;
+
+    const float diagonal = std::max(mBounds.diagonal(), 1e-3f);
+    if (light.type == LightType::Directional) {
+        // An orthographic box around the scene's bounding sphere, looking along the light.
+        const glm::vec3 centre = mBounds.center();
+        const float radius = 0.5f * diagonal * 1.01f;
+        const glm::vec3 eye = centre - light.direction * (radius * 1.01f);
+        const glm::mat4 view = glm::lookAtRH(eye, centre, upFor(light.direction));
+        g.shadowKind = kShadowOrthographic;
+        g.depthNear = 0.0f;
+        g.depthFar = 2.02f * radius * 1.01f;
+        g.texelSlope = 2.0f * radius / float(mSize);
+        clipFromWorld.push_back(glm::orthoRH_ZO(-radius, radius, -radius, radius, g.depthNear, g.depthFar) * view);
+        return slot;
+    }
+
+    // Perspective: near plane a thousandth of the scene, far plane past its farthest corner.
+    float farthest = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::vec3 c((corner & 1) ? mBounds.max.x : mBounds.min.x,
+                          (corner & 2) ? mBounds.max.y : mBounds.min.y,
+                          (corner & 4) ? mBounds.max.z : mBounds.min.z);
+        farthest = std::max(farthest, glm::length(c - light.position));
+    }
+    g.depthNear = 1e-3f * diagonal;
+    g.depthFar = std::max(farthest * 1.01f, 2.0f * g.depthNear);
+    if (slot.layers == 1) {
+        // A spot's cone plus a margin of one degree.
+        const float fov = 2.0f * light.outerConeAngle + 0.035f;
+        g.shadowKind = kShadowPerspective;
+        g.texelSlope = 2.0f * std::tan(0.5f * fov) / float(mSize);
+        const glm::mat4 view = glm::lookAtRH(light.position, light.position + light.direction,
+                                             upFor(light.direction));
+        clipFromWorld.push_back(glm::perspectiveRH_ZO(fov, 1.0f, g.depthNear, g.depthFar) * view);
+        return slot;
+    }
+    // Cube faces +x, −x, +y, −y, +z, −z: 90° frusta whose union is every direction; the
+    // surfel-lighting pass picks the face by the major axis of (p − light).
+    g.shadowKind = kShadowCube;
+    g.texelSlope = 2.0f / float(mSize);
+    const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, g.depthNear, g.depthFar);
+    for (const glm::vec3& axis : axes)
+        clipFromWorld.push_back(projection *
+                                glm::lookAtRH(light.position, light.position + axis, upFor(axis)));
+    return slot;
+}
+
+Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
+    reallocated = false;
+    std::vector<LightSlot> next;
+    std::vector<glm::mat4> matrices;
+    uint32_t layer = 0;
+    for (const Light& light : lights.lights) {
+        LightSlot slot = describe(light, layer, matrices);
+        layer += slot.layers;
+        next.push_back(std::move(slot));
+    }
+    // The image grows when the lights need more layers (every map is then re-rendered); it
+    // never shrinks, so that toggling a light does not reallocate.
+    if (layer > mDepth.layers()) {
+        PIC_TRY_ASSIGN(mDepth, mContext.createDepthArray(mSize, layer));
+        reallocated = true;
+    }
+    // A light keeps its maps when the same light sat on the same layers with the same
+    // geometry; colour, intensity, range and inner cone do not change its depth.
+    for (size_t i = 0; i < next.size(); ++i) {
+        LightSlot& slot = next[i];
+        slot.dirty = true;
+        if (reallocated || i >= mCurrent.size()) continue;
+        const LightSlot& old = mCurrent[i];
+        slot.dirty = !(old.id == slot.id && old.type == slot.type &&
+                       old.gpu.firstLayer == slot.gpu.firstLayer && old.layers == slot.layers &&
+                       old.position == slot.position && old.direction == slot.direction &&
+                       old.outerConeAngle == slot.outerConeAngle && !old.dirty);
+    }
+    mCurrent = std::move(next);
+    mClipFromWorld = std::move(matrices);
+
+    std::vector<GpuLight> records;
+    for (const LightSlot& slot : mCurrent) records.push_back(slot.gpu);
+    if (!records.empty()) {
+        PIC_TRY(mContext.upload(mLights, records.data(), records.size() * sizeof(GpuLight)));
+        PIC_TRY(mContext.upload(mMatrices, mClipFromWorld.data(),
+                                mClipFromWorld.size() * sizeof(glm::mat4)));
+    }
+    return {};
+}
+
+void ShadowMapPass::record(VkCommandBuffer cmd) {
+    mRenderedLights = 0;
+    const VkDeviceSize zero = 0;
+    for (LightSlot& slot : mCurrent) {
+        if (!slot.dirty) continue;
+        ++mRenderedLights;
+        for (uint32_t l = 0; l < slot.layers; ++l) {
+            const uint32_t layer = slot.gpu.firstLayer + l;
+            // Earlier compute reads of this layer finish before it is rendered over.
+            VkImageMemoryBarrier toDepth{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+            toDepth.srcAccessMask = VK_ACCESS_SHADER_READ_BIT;
+            toDepth.dstAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                                    VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+            toDepth.oldLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            toDepth.newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+            toDepth.srcQueueFamilyIndex = toDepth.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            toDepth.image = mDepth.image();
+            toDepth.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                 VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                     VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                                 0, 0, nullptr, 0, nullptr, 1, &toDepth);
+
+            VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+            depth.imageView = mDepth.layerView(layer);
+            depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+            depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+            depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+            depth.clearValue.depthStencil = {1.0f, 0};
+            VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+            rendering.renderArea = {{0, 0}, {mSize, mSize}};
+            rendering.layerCount = 1;
+            rendering.pDepthAttachment = &depth;
+            vkCmdBeginRendering(cmd, &rendering);
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipeline);
+            const VkViewport viewport{0.0f, 0.0f, float(mSize), float(mSize), 0.0f, 1.0f};
+            const VkRect2D scissor{{0, 0}, {mSize, mSize}};
+            vkCmdSetViewport(cmd, 0, 1, &viewport);
+            vkCmdSetScissor(cmd, 0, 1, &scissor);
+            const ShadowMapPush push{mClipFromWorld[layer]};
+            vkCmdPushConstants(cmd, mPipelineLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
+            const VkBuffer vertices = mVertices.handle();
+            vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &zero);
+            vkCmdBindIndexBuffer(cmd, mIndices.handle(), 0, VK_INDEX_TYPE_UINT32);
+            vkCmdDrawIndexed(cmd, mIndexCount, 1, 0, 0, 0);
+            vkCmdEndRendering(cmd);
+
+            // The depth writes finish before surfel lighting samples the layer.
+            VkImageMemoryBarrier toRead = toDepth;
+            toRead.srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+            toRead.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+            toRead.oldLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+            toRead.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1,
+                                 &toRead);
+        }
+        slot.dirty = false;
+    }
+}
+
+}  // namespace pic::gpu

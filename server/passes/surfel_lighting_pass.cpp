@@ -1,0 +1,136 @@
+#include "server/passes/surfel_lighting_pass.h"
+
+#include <array>
+
+#include "core/cache_values.h"
+#include "core/geometry.h"
+#include "core/parallel.h"
+#include "shaders/shared/surfel_lighting.h"
+#include "spirv/surfel_lighting_comp.h"
+
+namespace pic::gpu {
+namespace {
+
+constexpr uint32_t kBindingCount = 13;
+constexpr uint32_t kSamplerBinding = 4;
+constexpr uint32_t kShTablesBinding = 11;
+
+}  // namespace
+
+Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(Context& context,
+                                                                       const Scene& scene,
+                                                                       const BakeData& bake,
+                                                                       float epsilon) {
+    std::unique_ptr<SurfelLightingPass> pass(new SurfelLightingPass(context, scene));
+    pass->mSurfelCount = uint32_t(bake.surfels.size());
+    pass->mEpsilon = epsilon;
+
+    KernelLayout layout;
+    layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings[kSamplerBinding] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    layout.bindings[kShTablesBinding] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    layout.pushBytes = sizeof(SurfelLightingPush);
+    layout.specialization = {bake.params.bandsY, bake.params.bandsC};
+    PIC_TRY_ASSIGN(pass->mKernel,
+                   Kernel::create(context, kSpirvSurfelLightingComp, layout, "surfel_lighting"));
+
+    // The bounce reads the caches at fixed points: each surfel's stencil is computed once.
+    const size_t nS = bake.surfels.size();
+    std::vector<SurfelStencil> stencils(nS);
+    parallelFor(0, nS, [&](size_t i) {
+        const pic::Surfel& surfel = bake.surfels[i];
+        const Triangle& triangle = scene.triangles[surfel.triangle];
+        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
+                                        scene.vertices[triangle.v[1]].position,
+                                        scene.vertices[triangle.v[2]].position);
+        const CacheStencil s = surfaceStencil(bake, surfel.triangle, b.y, b.z, surfel.position);
+        SurfelStencil& out = stencils[i];
+        out = SurfelStencil{};
+        for (int k = 0; k < s.count; ++k) {
+            if (k < 4) {
+                out.cacheLow[k] = s.cache[k];
+                out.weightLow[k] = s.weight[k];
+            } else {
+                out.cacheHigh[k - 4] = s.cache[k];
+                out.weightHigh[k - 4] = s.weight[k];
+            }
+        }
+    }, 1024);
+
+    PIC_TRY_ASSIGN(pass->mSurfels, context.createBufferWith(bake.surfels.data(),
+                                                            nS * sizeof(pic::Surfel), 0, "surfels"));
+    PIC_TRY_ASSIGN(pass->mStencils,
+                   context.createBufferWith(std::span<const SurfelStencil>(stencils), 0,
+                                            "surfel stencils"));
+    PIC_TRY_ASSIGN(pass->mEmissiveScale,
+                   context.createBuffer(std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
+                                        0, MemoryUse::Device, "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFlux, context.createBuffer(nS * sizeof(glm::vec4), 0,
+                                                           MemoryUse::Device, "direct flux"));
+    PIC_TRY_ASSIGN(pass->mGroupFlux,
+                   context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
+                                        MemoryUse::Readback, "surfel flux sums"));
+    return pass;
+}
+
+Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
+    PIC_CHECK(r.shadows && r.nodeFlux && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    mShadowSize = r.shadows->size();
+    const std::array<BindingResource, kBindingCount> resources = {
+        BindingResource::storage(0, mSurfels),
+        BindingResource::storage(1, r.shadows->lightBuffer()),
+        BindingResource::storage(2, r.shadows->matrixBuffer()),
+        BindingResource::storage(3, mEmissiveScale),
+        BindingResource::image(4, r.shadows->depth().arrayView(), mContext.nearestSampler()),
+        BindingResource::storage(5, mDirectFlux),
+        BindingResource::storage(6, *r.nodeFlux),
+        BindingResource::storage(7, mStencils),
+        BindingResource::storage(8, *r.cacheY),
+        BindingResource::storage(9, *r.cacheCo),
+        BindingResource::storage(10, *r.cacheCg),
+        BindingResource::storage(11, *r.shTables),
+        BindingResource::storage(12, mGroupFlux),
+    };
+    PIC_TRY(mKernel.resetSets());
+    PIC_TRY_ASSIGN(mSet, mKernel.makeSet(resources));
+    return {};
+}
+
+Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
+    std::vector<float> scales(std::max<size_t>(mScene.materials.size(), 1), 1.0f);
+    for (size_t m = 0; m < mScene.materials.size(); ++m)
+        scales[m] = lights.emissiveScaleOf(mScene.materials[m].name);
+    return mContext.upload(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
+}
+
+void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
+                                uint32_t sumSlot) {
+    PIC_CHECK(sumSlot < 2);
+    PIC_CHECK(mSet != VK_NULL_HANDLE);
+    SurfelLightingPush push{};
+    push.surfelCount = mSurfelCount;
+    push.lightCount = lightCount;
+    push.mode = bounce ? kSurfelModeBounce : kSurfelModeDirect;
+    push.epsilon = mEpsilon;
+    push.shadowSize = mShadowSize;
+    push.sumSlot = sumSlot;
+    mKernel.dispatch(cmd, mSet, &push, groupsFor(mSurfelCount, kSurfelLightingGroup));
+}
+
+Result<glm::dvec3> SurfelLightingPass::totalFlux(uint32_t sumSlot) {
+    PIC_CHECK(sumSlot < 2);
+    const uint32_t groups = groupsFor(mSurfelCount, kSurfelLightingGroup);
+    std::vector<glm::vec4> sums(groups);
+    PIC_TRY(mContext.download(mGroupFlux, sums.data(), groups * sizeof(glm::vec4),
+                              sumSlot * groups * sizeof(glm::vec4)));
+    glm::dvec3 total(0.0);
+    for (const glm::vec4& s : sums) total += glm::dvec3(s);
+    return total;
+}
+
+VkDeviceSize SurfelLightingPass::bytes() const {
+    return mSurfels.size() + mStencils.size() + mEmissiveScale.size() + mDirectFlux.size() +
+           mGroupFlux.size();
+}
+
+}  // namespace pic::gpu

@@ -1,0 +1,66 @@
+#pragma once
+/// Surfel lighting on the GPU (paper 000 Figure 2 step 2): the direct flux of every surfel
+/// from the shadow-mapped lights and its emission, then, per further bounce, that plus the
+/// light the previous bounce's caches deliver to it. CPU twin: server/cpu/surfel_lighting.h.
+
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/bake_data.h"
+#include "core/light_set.h"
+#include "core/scene.h"
+#include "server/gpu/kernel.h"
+#include "server/passes/shadow_map_pass.h"
+
+namespace pic::gpu {
+
+/// The runtime's buffers this pass reads and writes.
+struct SurfelLightingResources {
+    const ShadowMapPass* shadows = nullptr;
+    const Buffer* nodeFlux = nullptr;    ///< vec4 per node; the pass writes the leaves
+    const Buffer* cacheY = nullptr;      ///< half, nC·lY²: the previous bounce
+    const Buffer* cacheCo = nullptr;     ///< half, nC·lC²
+    const Buffer* cacheCg = nullptr;     ///< half, nC·lC²
+    const Buffer* shTables = nullptr;    ///< ShTables
+};
+
+class SurfelLightingPass {
+public:
+    /// Uploads the surfels and their cache stencils (core/cache_values.h surfaceStencil at
+    /// each surfel's barycentrics: the same lookup as the CPU twin's bounce).
+    static Result<std::unique_ptr<SurfelLightingPass>> create(Context& context, const Scene& scene,
+                                                              const BakeData& bake, float epsilon);
+
+    /// (Re)binds the pass to the runtime's buffers and the shadow maps' current image.
+    Result<void> bind(const SurfelLightingResources& resources);
+    /// Writes the per-material emission scales of `lights`.
+    Result<void> setEmissiveScales(const LightSet& lights);
+    /// Records the direct part (directFlux and the leaves) or a bounce (the leaves); the
+    /// pass's flux sum goes to `sumSlot` (0 or 1).
+    void record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount, uint32_t sumSlot);
+    /// Σ of the leaves' flux of the last pass recorded with `sumSlot`, after it completed, in
+    /// double (W, RGB).
+    Result<glm::dvec3> totalFlux(uint32_t sumSlot);
+
+    const Buffer& directFlux() const { return mDirectFlux; }
+    VkDeviceSize bytes() const;
+
+private:
+    SurfelLightingPass(Context& context, const Scene& scene) : mContext(context), mScene(scene) {}
+    Context& mContext;
+    const Scene& mScene;
+    Kernel mKernel;
+    VkDescriptorSet mSet = VK_NULL_HANDLE;
+    uint32_t mSurfelCount = 0;
+    float mEpsilon = 0.0f;
+    uint32_t mShadowSize = 0;
+    Buffer mSurfels;
+    Buffer mEmissiveScale;
+    Buffer mStencils;
+    Buffer mDirectFlux;
+    Buffer mGroupFlux;
+};
+
+}  // namespace pic::gpu

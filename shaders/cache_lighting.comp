@@ -1,0 +1,88 @@
+#version 460
+// Cache lighting (paper 000 Figure 2 step 4, eq. 3): per cache, L = Σ over its nL links of
+// Φ_node·transport in YCoCg, Y with lY bands and Co, Cg with lC bands, stored as half floats.
+// CPU twin: server/cpu/cache_lighting.cpp.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+#extension GL_EXT_shader_16bit_storage : require
+#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+#include "shared/bake_layout.h"
+#include "shared/cache_lighting.h"
+#include "shared/sh_tables.h"
+
+layout(local_size_x = 64) in;
+layout(constant_id = 0) const uint kBandsY = 3u;
+layout(constant_id = 1) const uint kBandsC = 2u;
+layout(constant_id = 2) const uint kLinksPerCache = 128u;
+layout(constant_id = 3) const uint kLinkForm = 1u;
+const uint kCountY = kBandsY * kBandsY;
+const uint kCountC = kBandsC * kBandsC;
+
+layout(std430, binding = 0) readonly buffer NodeFlux { vec4 nodeFlux[]; };          // W, RGB
+layout(std430, binding = 1) readonly buffer RtpLinks { RtpLink rtpLinks[]; };       // chunk
+layout(std430, binding = 2) readonly buffer ShNodes { uint shNodes[]; };            // chunk
+layout(std430, binding = 3) readonly buffer ShCoefficients { float16_t shCoefficients[]; };
+layout(std430, binding = 4) writeonly buffer CacheY { float16_t cacheY[]; };
+layout(std430, binding = 5) writeonly buffer CacheCo { float16_t cacheCo[]; };
+layout(std430, binding = 6) writeonly buffer CacheCg { float16_t cacheCg[]; };
+layout(std140, binding = 7) uniform Sh { ShTables sh; };
+layout(push_constant) uniform Push { CacheLightingPush pc; };
+
+#include "lib/sh.glsl"
+
+float16_t toHalf(float value) {
+    return float16_t(clamp(value, -kHalfMax, kHalfMax));
+}
+
+void main() {
+    const uint local = gl_GlobalInvocationID.x;  // cache within the chunk
+    if (local >= pc.cacheCount) return;
+    float y[kCountY];
+    float co[kCountC];
+    float cg[kCountC];
+    [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = 0.0;
+    [[unroll]] for (uint i = 0u; i < kCountC; ++i) { co[i] = 0.0; cg[i] = 0.0; }
+
+    for (uint j = 0u; j < kLinksPerCache; ++j) {
+        const uint slot = local * kLinksPerCache + j;
+        if (kLinkForm == kLinkFormRtp) {
+            // §4.6: the node's cone projected at runtime, factor·K_l(α)·y_lm(direction).
+            const RtpLink link = rtpLinks[slot];
+            if (link.factor == 0.0) continue;  // padding
+            const vec3 flux = rgbToYCoCg(nodeFlux[link.node].xyz);
+            float cone[kBandsY];
+            coneZonal(link.oneMinusCosAlpha, cone);
+            float basis[64];
+            shEvaluate(decodeOctahedral(link.directionOct), basis);
+            [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
+                const float w = link.factor * cone[kShBandOf[i]] * basis[i];
+                y[i] += flux.x * w;
+                if (i < kCountC) {
+                    co[i] += flux.y * w;
+                    cg[i] += flux.z * w;
+                }
+            }
+        } else {
+            // SH-projected links: lY² half coefficients; chroma takes the first lC².
+            const uint node = shNodes[slot];
+            if (node == kNoNode) continue;
+            const vec3 flux = rgbToYCoCg(nodeFlux[node].xyz);
+            const uint first = slot * kCountY;
+            [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
+                const float k = float(shCoefficients[first + i]);
+                y[i] += flux.x * k;
+                if (i < kCountC) {
+                    co[i] += flux.y * k;
+                    cg[i] += flux.z * k;
+                }
+            }
+        }
+    }
+
+    const uint cache = pc.firstCache + local;
+    [[unroll]] for (uint i = 0u; i < kCountY; ++i) cacheY[cache * kCountY + i] = toHalf(y[i]);
+    [[unroll]] for (uint i = 0u; i < kCountC; ++i) {
+        cacheCo[cache * kCountC + i] = toHalf(co[i]);
+        cacheCg[cache * kCountC + i] = toHalf(cg[i]);
+    }
+}

@@ -1,0 +1,55 @@
+// Real SH of core/sh.h on the GPU. The includer declares the specialization constant
+// kBandsY, const uint kCountY = kBandsY·kBandsY, and a uniform block member `ShTables sh`.
+
+#define PIC_SH_TABLE(array, k) (array[(k) >> 2u][(k) & 3u])
+
+const float kPi = 3.14159265358979;
+
+#include "sh_basis.glsl"  // generated: shEvaluate
+
+/// K_l(α), l < kBandsY, of the indicator of a cone with u = 1 − cos α (core/sh.h
+/// coneZonalBands): K_0 = 2πu, K_l = 2π·(1 − x²)·P_l'(x)/(l(l + 1)) with x = cos α.
+void coneZonal(float oneMinusCosAlpha, out float k[kBandsY]) {
+    const float u = clamp(oneMinusCosAlpha, 0.0, 2.0);
+    const float x = 1.0 - u;
+    const float sinSquared = u * (2.0 - u);
+    float legendre = 1.0, legendrePrevious = 0.0;      // P_l, P_{l−1}
+    float derivative = 0.0, derivativePrevious = 0.0;  // P_l', P_{l−1}'
+    k[0] = 2.0 * kPi * u;
+    [[unroll]] for (uint l = 1u; l < kBandsY; ++l) {
+        const float lm = float(l - 1u);
+        const float nextLegendre = ((2.0 * lm + 1.0) * x * legendre - lm * legendrePrevious) / (lm + 1.0);
+        const float nextDerivative = derivativePrevious + (2.0 * lm + 1.0) * legendre;
+        legendrePrevious = legendre;
+        legendre = nextLegendre;
+        derivativePrevious = derivative;
+        derivative = nextDerivative;
+        k[l] = 2.0 * kPi * sinSquared * derivative / float(l * (l + 1u));
+    }
+}
+
+/// Paper 000 eq. 7 lifting steps (core/color.h rgbToYCoCg).
+vec3 rgbToYCoCg(vec3 rgb) {
+    const float co = 0.5 * (rgb.r - rgb.b);
+    const float t = rgb.b + co;
+    const float cg = 0.5 * (rgb.g - t);
+    return vec3(t + cg, co, cg);
+}
+
+/// core/color.h yCoCgToRgb.
+vec3 yCoCgToRgb(vec3 ycocg) {
+    const float t = ycocg.x - ycocg.z;
+    return vec3(t + ycocg.y, ycocg.x + ycocg.z, t - ycocg.y);
+}
+
+/// core/color.h decodeOctahedral: 2 × snorm16 → unit vector.
+vec3 decodeOctahedral(uint code) {
+    const float u = max(float(int(code << 16) >> 16) / 32767.0, -1.0);
+    const float v = max(float(int(code) >> 16) / 32767.0, -1.0);
+    vec3 dir = vec3(u, v, 1.0 - abs(u) - abs(v));
+    if (dir.z < 0.0) {
+        dir.x = (1.0 - abs(v)) * (u >= 0.0 ? 1.0 : -1.0);
+        dir.y = (1.0 - abs(u)) * (v >= 0.0 ? 1.0 : -1.0);
+    }
+    return normalize(dir);
+}

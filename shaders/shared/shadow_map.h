@@ -1,0 +1,44 @@
+#ifndef PIC_SHADERS_SHARED_SHADOW_MAP_H
+#define PIC_SHADERS_SHARED_SHADOW_MAP_H
+// Shadow maps (paper 000 Figure 2 step 1): the lights as the surfel-lighting pass reads them,
+// and the rasteriser's push constants. Every light owns consecutive layers of one depth
+// array: 6 cube faces (+x, −x, +y, −y, +z, −z) for point lights and wide spots, 1 layer for
+// narrow spots (perspective) and directional lights (orthographic over the scene).
+#include "glue.h"
+
+PIC_NAMESPACE_BEGIN
+
+PIC_CONST(uint, kLightPoint, 0u);
+PIC_CONST(uint, kLightSpot, 1u);
+PIC_CONST(uint, kLightDirectional, 2u);
+PIC_CONST(uint, kShadowCube, 0u);         // 6 perspective faces of 90°
+PIC_CONST(uint, kShadowPerspective, 1u);  // one perspective layer (spot)
+PIC_CONST(uint, kShadowOrthographic, 2u); // one orthographic layer (directional)
+
+struct GpuLight {
+    vec3 position;       // metres (point, spot)
+    uint type;           // kLightPoint, kLightSpot, kLightDirectional
+    vec3 direction;      // unit, the direction light travels (spot, directional)
+    float range;         // metres; 0 = no cut-off
+    vec3 radiant;        // intensity × colour: W/sr (point, spot) or W/m² (directional)
+    float cosOuter;      // spot: cos of the outer half-angle
+    float cosInner;      // spot: cos of the inner half-angle
+    uint shadowKind;     // kShadowCube, kShadowPerspective, kShadowOrthographic
+    uint firstLayer;     // its first layer in the depth array
+    float depthNear;     // metres: perspective near plane, or orthographic depth of z = 0
+    float depthFar;      // metres: perspective far plane, or orthographic depth of z = 1
+    float texelSlope;    // perspective: texel width per metre of depth; ortho: texel width (m)
+    uint hardCone;       // spot: 1 when inner ≥ outer (hard edge)
+    uint pad0;
+};
+PIC_STRUCT_CHECK(GpuLight, 80);
+
+// Push constants of the rasteriser: one layer's clip-from-world matrix.
+struct ShadowMapPush {
+    mat4 clipFromWorld;
+};
+PIC_STRUCT_CHECK(ShadowMapPush, 64);
+
+PIC_NAMESPACE_END
+
+#endif

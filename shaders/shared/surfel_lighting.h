@@ -1,0 +1,36 @@
+#ifndef PIC_SHADERS_SHARED_SURFEL_LIGHTING_H
+#define PIC_SHADERS_SHARED_SURFEL_LIGHTING_H
+// Surfel lighting (paper 000 Figure 2 step 2): push constants and the per-surfel cache
+// stencil of the bounce part (core/cache_values.h CacheStencil, computed once per bake).
+#include "glue.h"
+
+PIC_NAMESPACE_BEGIN
+
+PIC_CONST(uint, kSurfelLightingGroup, 64u);
+PIC_CONST(uint, kSurfelModeDirect, 0u);  // directFlux = lights + emission; leaves = directFlux
+PIC_CONST(uint, kSurfelModeBounce, 1u);  // leaves = directFlux + ρ·A·E(previous caches)
+
+// Up to 8 caches and weights; unused slots have weight 0 (and cache 0).
+struct SurfelStencil {
+    uvec4 cacheLow;   // caches 0–3
+    uvec4 cacheHigh;  // caches 4–7
+    vec4 weightLow;
+    vec4 weightHigh;
+};
+PIC_STRUCT_CHECK(SurfelStencil, 64);
+
+struct SurfelLightingPush {
+    uint surfelCount;  // nS
+    uint lightCount;
+    uint mode;         // kSurfelModeDirect or kSurfelModeBounce
+    float epsilon;     // metres: the CPU twin's ray offset along the normal
+    uint shadowSize;   // texels per side of a shadow-map layer
+    uint sumSlot;      // 0 or 1: which half of groupFlux takes this pass's workgroup sums
+    uint pad1;
+    uint pad2;
+};
+PIC_STRUCT_CHECK(SurfelLightingPush, 32);
+
+PIC_NAMESPACE_END
+
+#endif
