@@ -499,7 +499,8 @@ Result<DepthArray> Context::createDepthArray(uint32_t size, uint32_t layers) {
     info.arrayLayers = layers;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                 VK_IMAGE_USAGE_TRANSFER_DST_BIT;  // cleared once at creation
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     PIC_VK_TRY(vkCreateImage(mDevice, &info, nullptr, &depth.mImage));
     VkMemoryRequirements requirements;

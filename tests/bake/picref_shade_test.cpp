@@ -126,15 +126,38 @@ TEST(PicrefShade, RefusesABakeOfAnotherScene) {
     EXPECT_NE(run.stderrText.find("different scene"), std::string::npos) << run.stderrText;
 }
 
-TEST(PicrefShade, RefusesTheGpuBackendForNow) {
+TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
+    // ARCHITECTURE §5: `--backend gpu|cpu` selects the runtime; the images agree to 1 %.
+    const ShadeFixture& f = fixture();
+    ASSERT_TRUE(f.ok);
+    Image images[2];
+    const char* backends[2] = {"cpu", "gpu"};
+    for (int b = 0; b < 2; ++b) {
+        const std::string out = (f.dir / fmt::format("{}.exr", backends[b])).string();
+        const RunResult run = runShade(fmt::format(
+            "'{}' --bake '{}' --backend {} --scene-camera 0 --size 48x48 --component indirect "
+            "--out '{}'",
+            scenePath("cornell"), f.cornellBake, backends[b], out));
+        ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+        auto image = readImage(out);
+        ASSERT_TRUE(image.has_value()) << image.error().message;
+        images[b] = std::move(*image);
+    }
+    auto error = compareImages(images[1], images[0]);
+    ASSERT_TRUE(error.has_value()) << error.error().message;
+    EXPECT_LE(error->relativeRmse, 0.01);
+    EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
+}
+
+TEST(PicrefShade, UnknownGpuDeviceIsABadInput) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
     const RunResult run = runShade(
-        fmt::format("'{}' --bake '{}' --backend gpu --scene-camera 0 --size 8x8 --out '{}'",
+        fmt::format("'{}' --bake '{}' --backend gpu --device no-such-gpu --scene-camera 0 "
+                    "--size 8x8 --out '{}'",
                     scenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
     EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("GPU backend is not built yet"), std::string::npos)
-        << run.stderrText;
+    EXPECT_NE(run.stderrText.find("no-such-gpu"), std::string::npos) << run.stderrText;
 }
 
 TEST(PicrefShade, BadUsageExitsWithTwo) {

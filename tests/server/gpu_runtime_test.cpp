@@ -1,0 +1,365 @@
+// Every GPU pass on lavapipe (or whatever Vulkan device the machine has) against its CPU twin
+// on identical inputs, the whole GPU runtime against the CPU runtime, shadow maps rendered
+// only for lights that changed, and Vulkan failures returned as errors.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "bake/bake.h"
+#include "bake/embree_scene.h"
+#include "core/gltf_loader.h"
+#include "core/light_set.h"
+#include "server/cpu/cache_lighting.h"
+#include "server/cpu/cpu_runtime.h"
+#include "server/cpu/lightmap_copy.h"
+#include "server/cpu/pull.h"
+#include "server/cpu/surfel_lighting.h"
+#include "server/gpu/gpu_runtime.h"
+
+namespace pic {
+namespace {
+
+/// A test scene, its rays and a small bake per (scene, link form, lY, lC), shared.
+struct Baked {
+    Scene scene;
+    std::unique_ptr<EmbreeScene> rays;
+    BakeData bake;
+    bool ok = false;
+};
+
+const Baked& baked(const std::string& name, LinkMode mode, uint32_t bandsY = 3, uint32_t bandsC = 2) {
+    static std::map<std::tuple<std::string, LinkMode, uint32_t, uint32_t>, std::unique_ptr<Baked>> cache;
+    auto& slot = cache[{name, mode, bandsY, bandsC}];
+    if (slot) return *slot;
+    slot = std::make_unique<Baked>();
+    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf");
+    EXPECT_TRUE(scene) << name;
+    if (!scene) return *slot;
+    slot->scene = std::move(*scene);
+    auto rays = EmbreeScene::create(slot->scene);
+    EXPECT_TRUE(rays);
+    if (!rays) return *slot;
+    slot->rays = std::move(*rays);
+    BakeOptions options;
+    options.surfels = 4096;
+    options.links = 64;
+    options.linkMode = mode;
+    options.bandsY = bandsY;
+    options.bandsC = bandsC;
+    const float extent = slot->scene.bounds.diagonal();
+    options.gridCell = 0.12f * extent;
+    options.lightmapTexel = 0.06f * extent;
+    BakeReport report;
+    auto bake = runBake(slot->scene, options, report);
+    EXPECT_TRUE(bake) << name << ": " << (bake ? "" : bake.error().message);
+    if (!bake) return *slot;
+    slot->bake = std::move(*bake);
+    slot->ok = true;
+    return *slot;
+}
+
+/// The GPU runtime, or a skip when the machine has no Vulkan device at all (CI has lavapipe,
+/// so there these tests run).
+std::unique_ptr<GpuRuntime> gpuFor(const Baked& b, BounceParams bounces = {}) {
+    auto runtime = GpuRuntime::create(b.scene, *b.rays, b.bake, bounces);
+    if (!runtime) {
+        ADD_FAILURE() << runtime.error().message;
+        return nullptr;
+    }
+    return std::move(*runtime);
+}
+
+/// ‖a − b‖ / ‖b‖ over all coefficients of all channels.
+double relativeL2(const CacheValues& a, const CacheValues& b) {
+    double diff = 0.0, norm = 0.0;
+    const std::vector<float>* pa[3] = {&a.y, &a.co, &a.cg};
+    const std::vector<float>* pb[3] = {&b.y, &b.co, &b.cg};
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_EQ(pa[ch]->size(), pb[ch]->size());
+        for (size_t i = 0; i < pb[ch]->size(); ++i) {
+            const double d = double((*pa[ch])[i]) - double((*pb[ch])[i]);
+            diff += d * d;
+            norm += double((*pb[ch])[i]) * (*pb[ch])[i];
+        }
+    }
+    return norm > 0.0 ? std::sqrt(diff / norm) : std::sqrt(diff);
+}
+
+/// Node flux of the scene's lights: CPU direct surfel flux, pulled.
+std::vector<glm::vec3> cpuNodeFlux(const Baked& b, const LightSet& lights) {
+    std::vector<glm::vec3> nodes(b.bake.nodes.size());
+    directSurfelFlux(b.scene, *b.rays, b.bake, lights,
+                     std::span<glm::vec3>(nodes.data(), b.bake.surfels.size()));
+    pullFlux(b.bake, nodes);
+    return nodes;
+}
+
+/// Fraction of surfels whose GPU flux differs from the CPU's by more than 1 % of the larger
+/// (per channel, ignoring differences below 1e−6 of the brightest surfel).
+double fractionDiffering(const std::vector<glm::vec3>& gpu, const std::vector<glm::vec3>& cpu) {
+    float brightest = 0.0f;
+    for (const glm::vec3& f : cpu) brightest = std::max({brightest, f.r, f.g, f.b});
+    size_t differing = 0;
+    for (size_t i = 0; i < cpu.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            const float d = std::abs(gpu[i][c] - cpu[i][c]);
+            if (d > 0.01f * std::max(std::abs(cpu[i][c]), std::abs(gpu[i][c])) && d > 1e-6f * brightest) {
+                ++differing;
+                break;
+            }
+        }
+    }
+    return double(differing) / double(cpu.size());
+}
+
+TEST(GpuPull, NodeFluxIsExact) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 2.0f);
+    std::vector<glm::vec3> nodes(b.bake.nodes.size(), glm::vec3(0.0f));
+    for (size_t i = 0; i < b.bake.surfels.size(); ++i) nodes[i] = {u(rng), u(rng), u(rng)};
+    auto pulled = gpu->runPull(std::span<const glm::vec3>(nodes.data(), b.bake.surfels.size()));
+    ASSERT_TRUE(pulled) << pulled.error().message;
+    pullFlux(b.bake, nodes);
+    // Each inner node is one float addition of the same two children: bit-exact.
+    for (size_t n = 0; n < nodes.size(); ++n) ASSERT_EQ((*pulled)[n], nodes[n]) << "node " << n;
+}
+
+/// Cache lighting for a link form and band split.
+class GpuCacheLighting
+    : public testing::TestWithParam<std::tuple<LinkMode, uint32_t, uint32_t>> {};
+
+TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
+    const auto [mode, bandsY, bandsC] = GetParam();
+    const Baked& b = baked("cornell", mode, bandsY, bandsC);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    const std::vector<glm::vec3> nodes = cpuNodeFlux(b, defaultLightSet(b.scene));
+    CacheValues cpu;
+    lightCaches(b.bake, nodes, cpu);
+    auto values = gpu->runCacheLighting(nodes);
+    ASSERT_TRUE(values) << values.error().message;
+    ASSERT_EQ(values->bandsY, bandsY);
+    ASSERT_EQ(values->bandsC, bandsC);
+    EXPECT_LE(relativeL2(*values, cpu), 0.01);
+    EXPECT_GT(relativeL2(cpu, CacheValues::zeros(cpu.cacheCount(), bandsY, bandsC)), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    LinkFormsAndBands, GpuCacheLighting,
+    testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u), std::make_tuple(LinkMode::Rtp, 4u, 1u),
+                    std::make_tuple(LinkMode::Rtp, 2u, 2u), std::make_tuple(LinkMode::Sh, 3u, 2u),
+                    std::make_tuple(LinkMode::Sh, 4u, 2u), std::make_tuple(LinkMode::Sh, 1u, 1u)));
+
+/// Direct surfel flux for a scene and light set.
+void expectDirectMatches(const Baked& b, const LightSet& lights) {
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    std::vector<glm::vec3> cpu(b.bake.surfels.size());
+    directSurfelFlux(b.scene, *b.rays, b.bake, lights, cpu);
+    auto direct = gpu->runDirect(lights);
+    ASSERT_TRUE(direct) << direct.error().message;
+    // Shadow maps and exact rays disagree only where a shadow edge crosses a surfel.
+    EXPECT_LE(fractionDiffering(*direct, cpu), 0.01);
+    double gpuSum = 0.0, cpuSum = 0.0;
+    for (size_t i = 0; i < cpu.size(); ++i) {
+        gpuSum += (*direct)[i].g;
+        cpuSum += cpu[i].g;
+    }
+    EXPECT_GT(cpuSum, 0.0);
+    EXPECT_NEAR(gpuSum / cpuSum, 1.0, 0.01);
+}
+
+TEST(GpuSurfelLighting, DirectFluxOfPointLightMatchesRays) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    expectDirectMatches(b, defaultLightSet(b.scene));
+}
+
+TEST(GpuSurfelLighting, DirectFluxOfSpotMatchesRays) {
+    const Baked& b = baked("small_spot", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    expectDirectMatches(b, defaultLightSet(b.scene));
+}
+
+TEST(GpuSurfelLighting, DirectFluxOfEveryLightTypeMatchesRays) {
+    // Two floors, lit by a point light, a narrow spot (one perspective layer), a wide spot
+    // (cube) and a directional light (orthographic) at once.
+    const Baked& b = baked("two_floors", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    LightSet lights = defaultLightSet(b.scene);
+    const glm::vec3 c = b.scene.bounds.center();
+    Light narrow;
+    narrow.id = "narrow";
+    narrow.type = LightType::Spot;
+    narrow.position = c + glm::vec3(0.3f, 0.2f, 0.1f);
+    narrow.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.1f));
+    narrow.outerConeAngle = 0.5f;
+    narrow.innerConeAngle = 0.3f;
+    narrow.intensity = 3.0f;
+    Light wide = narrow;
+    wide.id = "wide";
+    wide.position = c + glm::vec3(-0.4f, -0.3f, -0.2f);
+    wide.outerConeAngle = 1.4f;
+    wide.innerConeAngle = 1.4f;
+    Light sun;
+    sun.id = "sun";
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+    sun.intensity = 2.0f;
+    lights.lights.insert(lights.lights.end(), {narrow, wide, sun});
+    expectDirectMatches(b, lights);
+}
+
+TEST(GpuSurfelLighting, BounceMatchesTheCpuTwin) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    const LightSet lights = defaultLightSet(b.scene);
+    const std::vector<glm::vec3> nodes = cpuNodeFlux(b, lights);
+    CacheValues caches;
+    lightCaches(b.bake, nodes, caches);
+    const std::vector<glm::vec3> direct(nodes.begin(), nodes.begin() + b.bake.surfels.size());
+    std::vector<glm::vec3> cpu(direct.size());
+    bounceSurfelFlux(b.scene, b.bake, direct, caches, cpu);
+    auto leaves = gpu->runBounce(direct, caches);
+    ASSERT_TRUE(leaves) << leaves.error().message;
+    // The GPU reads the caches as half floats: agreement to ~0.1 %, well inside 1 %.
+    EXPECT_LE(fractionDiffering(*leaves, cpu), 0.001);
+}
+
+TEST(GpuLightmapCopy, TexturesMatchTheCpuTwin) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    CacheValues caches;
+    lightCaches(b.bake, cpuNodeFlux(b, defaultLightSet(b.scene)), caches);
+    CacheTextures cpu = makeCacheTextures(b.bake);
+    copyCachesToTextures(b.bake, caches, cpu);
+    auto textures = gpu->runLightmapCopy(caches);
+    ASSERT_TRUE(textures) << textures.error().message;
+    for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_EQ(textures->grid[ch].size(), cpu.grid[ch].size());
+        ASSERT_EQ(textures->lightmap[ch].size(), cpu.lightmap[ch].size());
+        // Half floats: 11 significant bits.
+        for (size_t i = 0; i < cpu.grid[ch].size(); ++i)
+            ASSERT_NEAR(textures->grid[ch][i], cpu.grid[ch][i], 1e-3f * std::abs(cpu.grid[ch][i]) + 1e-7f);
+        for (size_t i = 0; i < cpu.lightmap[ch].size(); ++i)
+            ASSERT_NEAR(textures->lightmap[ch][i], cpu.lightmap[ch][i],
+                        1e-3f * std::abs(cpu.lightmap[ch][i]) + 1e-7f);
+    }
+    EXPECT_EQ(textures->gridCoverage, cpu.gridCoverage);
+    EXPECT_EQ(textures->lightmapCoverage, cpu.lightmapCoverage);
+}
+
+class GpuRuntimeForms : public testing::TestWithParam<LinkMode> {};
+
+TEST_P(GpuRuntimeForms, ProgressiveUpdateMatchesTheCpuRuntime) {
+    const Baked& b = baked("cornell", GetParam());
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    auto cpu = createCpuRuntime(b.scene, *b.rays, b.bake, BounceParams{});
+    ASSERT_TRUE(cpu);
+    const LightSet lights = defaultLightSet(b.scene);
+    UpdateStats gpuStats, cpuStats;
+    auto cpuValues = (*cpu)->setLights(lights, &cpuStats);
+    ASSERT_TRUE(cpuValues) << cpuValues.error().message;
+    auto gpuValues = gpu->setLights(lights, &gpuStats);
+    ASSERT_TRUE(gpuValues) << gpuValues.error().message;
+    EXPECT_EQ(gpuStats.bounces, cpuStats.bounces);
+    EXPECT_NEAR(gpuStats.surfelFlux / cpuStats.surfelFlux, 1.0, 0.01);
+    EXPECT_LE(relativeL2(**gpuValues, **cpuValues), 0.01);
+    for (float v : (*gpuValues)->y) ASSERT_TRUE(std::isfinite(v));
+    // The textures are the caches, copied.
+    auto textures = gpu->textures();
+    ASSERT_TRUE(textures) << textures.error().message;
+    auto cpuTextures = (*cpu)->textures();
+    ASSERT_TRUE(cpuTextures);
+    EXPECT_EQ((*textures)->grid[0].size(), (*cpuTextures)->grid[0].size());
+    EXPECT_EQ(gpu->context().validationMessages(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(LinkForms, GpuRuntimeForms, testing::Values(LinkMode::Rtp, LinkMode::Sh));
+
+TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b, BounceParams{1});
+    ASSERT_TRUE(gpu);
+    LightSet lights = defaultLightSet(b.scene);
+    ASSERT_FALSE(lights.lights.empty());
+    Light second = lights.lights[0];
+    second.id = "second";
+    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
+    lights.lights.push_back(second);
+    UpdateStats stats;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 2);
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 0);
+    // Colour and intensity do not change a depth map.
+    lights.lights[1].intensity *= 2.0f;
+    lights.lights[1].color = {1.0f, 0.5f, 0.25f};
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 0);
+    // Moving one light re-renders that light only.
+    lights.lights[1].position.x += 0.05f;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 1);
+}
+
+TEST(GpuContext, OutOfMemoryIsAnError) {
+    auto context = gpu::Context::create();
+    ASSERT_TRUE(context) << context.error().message;
+    auto buffer = (*context)->createBuffer(VkDeviceSize{1} << 44, 0, gpu::MemoryUse::Device, "huge test buffer");
+    ASSERT_FALSE(buffer);
+    EXPECT_NE(buffer.error().message.find("out of memory"), std::string::npos) << buffer.error().message;
+    // The context stays usable after the failure.
+    auto small = (*context)->createBuffer(1024, 0, gpu::MemoryUse::Device, "small test buffer");
+    EXPECT_TRUE(small) << (small ? "" : small.error().message);
+}
+
+TEST(GpuContext, DeviceLostIsReportedAsAnError) {
+    const Error e = gpu::vkError(VK_ERROR_DEVICE_LOST, "vkQueueSubmit", "file.cpp", 12);
+    EXPECT_EQ(e.code, ErrorCode::Internal);
+    EXPECT_NE(e.message.find("VK_ERROR_DEVICE_LOST"), std::string::npos);
+    EXPECT_NE(e.message.find("lost"), std::string::npos);
+    EXPECT_NE(e.message.find("file.cpp:12"), std::string::npos);
+}
+
+TEST(GpuContext, UnknownDeviceNameIsNotFound) {
+    auto context = gpu::Context::create({"no-such-device-name", false});
+    ASSERT_FALSE(context);
+    EXPECT_EQ(context.error().code, ErrorCode::NotFound);
+    EXPECT_NE(context.error().message.find("no-such-device-name"), std::string::npos);
+}
+
+TEST(GpuRuntime, RefusesInvalidLights) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    LightSet lights = defaultLightSet(b.scene);
+    ASSERT_FALSE(lights.lights.empty());
+    lights.lights[0].intensity = std::nanf("");
+    auto values = gpu->setLights(lights, nullptr);
+    ASSERT_FALSE(values);
+    EXPECT_EQ(values.error().code, ErrorCode::InvalidInput);
+}
+
+}  // namespace
+}  // namespace pic
