@@ -95,15 +95,13 @@ Result<void> GpuRuntime::bindShadowConsumers() {
     return mSurfels->bind({mShadows.get(), &mNodeFlux, &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
 }
 
-Result<void> GpuRuntime::prepareLights(const LightSet& lights, UpdateStats& stats) {
+Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
     PIC_TRY(checkRuntimeLights(lights, mScene));
     bool reallocated = false;
     PIC_TRY(mShadows->prepare(lights, reallocated));
     // A new depth image invalidates the set that samples the old one.
     if (reallocated) PIC_TRY(bindShadowConsumers());
-    PIC_TRY(mSurfels->setEmissiveScales(lights));
-    (void)stats;
-    return {};
+    return mSurfels->setEmissiveScales(lights);
 }
 
 Result<void> GpuRuntime::submitTimed(const std::function<void(VkCommandBuffer)>& record,
@@ -120,16 +118,17 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     UpdateStats local;
     UpdateStats& stats = statsOut ? *statsOut : local;
     stats = UpdateStats{};
-    PIC_TRY(prepareLights(lights, stats));
+    PIC_TRY(prepareLights(lights));
     mTexturesCurrent = false;
 
     const bool progressive = mBounces.bounces < 0;
     const int passes = progressive ? mBounces.maxBounces : mBounces.bounces;
     const uint32_t lightCount = uint32_t(lights.lights.size());
     if (passes == 0) {
-        // No cache pass: the caches hold no light.
+        // No cache pass: the caches, and so the textures, hold no light.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         PIC_TRY(uploadCaches(mValues));
+        PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
         stats.totalMs = millisecondsSince(start);
         return &mValues;
     }
@@ -247,7 +246,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, Upd
     UpdateStats local;
     UpdateStats& stats = statsOut ? *statsOut : local;
     stats = UpdateStats{};
-    PIC_TRY(prepareLights(lights, stats));
+    PIC_TRY(prepareLights(lights));
     PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
         mTimer.begin(cmd, "shadow_maps");
         mShadows->record(cmd);

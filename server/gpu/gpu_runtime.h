@@ -70,7 +70,7 @@ private:
     GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces);
     Result<void> init(const EmbreeScene& rays, const GpuRuntimeOptions& options);
     Result<void> bindShadowConsumers();
-    Result<void> prepareLights(const LightSet& lights, UpdateStats& stats);
+    Result<void> prepareLights(const LightSet& lights);
     Result<void> submitTimed(const std::function<void(VkCommandBuffer)>& record, UpdateStats& stats);
     Result<void> uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer);
     Result<std::vector<glm::vec3>> downloadFlux(const gpu::Buffer& buffer, size_t count);

@@ -322,6 +322,23 @@ TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
     EXPECT_EQ(stats.shadowMapsRendered, 1);
 }
 
+TEST(GpuRuntime, ZeroBouncesLeaveCachesAndTexturesDark) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto lit = gpuFor(b, BounceParams{1});
+    ASSERT_TRUE(lit);
+    ASSERT_TRUE(lit->setLights(defaultLightSet(b.scene), nullptr));
+    auto dark = gpuFor(b, BounceParams{0});
+    ASSERT_TRUE(dark);
+    auto values = dark->setLights(defaultLightSet(b.scene), nullptr);
+    ASSERT_TRUE(values) << values.error().message;
+    for (float v : (*values)->y) ASSERT_EQ(v, 0.0f);
+    auto textures = dark->textures();
+    ASSERT_TRUE(textures) << textures.error().message;
+    for (int ch = 0; ch < 3; ++ch)
+        for (float v : (*textures)->lightmap[ch]) ASSERT_EQ(v, 0.0f);
+}
+
 TEST(GpuContext, OutOfMemoryIsAnError) {
     auto context = gpu::Context::create();
     ASSERT_TRUE(context) << context.error().message;
