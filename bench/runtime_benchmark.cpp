@@ -79,6 +79,7 @@ struct BackendFigures {
     std::vector<double> cacheLightingWallMs;  ///< GPU: one cache-lighting pass, wall clock
     std::map<std::string, std::vector<double>> passMs;  ///< per update
     int bounces = 0;
+    uint64_t shadowTriangles = 0;  ///< GPU: triangles rasterised per update, after culling
 };
 
 Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step) {
@@ -90,6 +91,7 @@ Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int r
         figures.totalMs.push_back(stats.totalMs);
         for (const auto& [pass, ms] : stats.passMs) figures.passMs[pass].push_back(ms);
         figures.bounces = stats.bounces;
+        figures.shadowTriangles = stats.shadowTriangles;
     }
     return figures;
 }
@@ -119,6 +121,7 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     json["update_ms_median"] = median(f.totalMs);
     json["update_ms"] = f.totalMs;
     json["bounces"] = f.bounces;
+    json["shadow_triangles"] = f.shadowTriangles;
     json["pass_ms_median"] = nlohmann::ordered_json::object();
     for (const auto& [pass, ms] : f.passMs) json["pass_ms_median"][pass] = median(ms);
     return json;
@@ -153,8 +156,9 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
     json["triangles"] = scene->triangles.size();
     json["memcpy_bytes_per_second"] = bandwidth;
     json["runs"] = nlohmann::ordered_json::array();
-    std::printf("%-9s %-4s %-7s %6s %9s %9s %6s %9s %9s %9s %9s %8s\n", "setting", "link", "bounces",
-                "nC", "cpu ms", "gpu ms", "ratio", "shadow", "surfels", "pull", "caches*", "bw ratio");
+    std::printf("%-9s %-4s %-7s %6s %9s %9s %6s %9s %8s %9s %9s %9s %8s\n", "setting", "link",
+                "bounces", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris", "surfels", "pull",
+                "caches*", "bw ratio");
     for (const std::string& setting : params.settings) {
         for (const std::string& linkMode : params.linkModes) {
             BakeReport report;
@@ -198,10 +202,11 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                 const double cacheMs = median(*cacheWall);
                 const double linkBytes = double((*gpu)->linkBytesPerBounce());
                 const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
-                std::printf("%-9s %-4s %-7d %6zu %9.1f %9.1f %6.2f %9.1f %9.1f %9.1f %9.1f %8.2f\n",
+                std::printf("%-9s %-4s %-7d %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %9.1f %9.1f %9.1f %8.2f\n",
                             setting.c_str(), linkMode.c_str(), gpuFigures->bounces,
                             bake->caches.size(), cpuMs, gpuMs, gpuMs / cpuMs,
                             passMedian(*gpuFigures, "shadow_maps"),
+                            double(gpuFigures->shadowTriangles) * 1e-3,
                             passMedian(*gpuFigures, "surfel_lighting"),
                             passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
 

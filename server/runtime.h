@@ -29,6 +29,7 @@ struct UpdateStats {
     double totalMs = 0.0;
     double surfelFlux = 0.0;                  ///< W, luminance of the last bounce's surfel flux
     int shadowMapsRendered = 0;               ///< lights whose shadow maps were re-rendered (GPU)
+    uint64_t shadowTriangles = 0;             ///< triangles rasterised into them, after culling (GPU)
 };
 
 /// A runtime backend over one bake of one scene.

@@ -160,6 +160,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         cacheBounce(cmd, passes > 1, 1);
     }, stats));
     stats.shadowMapsRendered = int(mShadows->renderedLights());
+    stats.shadowTriangles = mShadows->drawnTriangles();
     PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
     double total = luminance(glm::vec3(sum));
     stats.bounces = 1;
@@ -254,6 +255,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, Upd
         mSurfels->record(cmd, false, uint32_t(lights.lights.size()), 0);
     }, stats));
     stats.shadowMapsRendered = int(mShadows->renderedLights());
+    stats.shadowTriangles = mShadows->drawnTriangles();
     return downloadFlux(mSurfels->directFlux(), mBake.surfels.size());
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -24,6 +26,81 @@ glm::vec3 upFor(const glm::vec3& forward) {
 
 }  // namespace
 
+std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
+                                                   std::vector<uint32_t>& order) {
+    std::vector<glm::vec3> centroids(scene.triangles.size());
+    for (size_t t = 0; t < scene.triangles.size(); ++t) {
+        const Triangle& tri = scene.triangles[t];
+        centroids[t] = (scene.vertices[tri.v[0]].position + scene.vertices[tri.v[1]].position +
+                        scene.vertices[tri.v[2]].position) / 3.0f;
+    }
+    order.resize(scene.triangles.size());
+    std::iota(order.begin(), order.end(), 0u);
+    const uint32_t leafSize = std::max(maxTriangles, 1u);
+
+    // Median splits along the longest axis of the centroids' bounds until a range fits in
+    // one cluster: compact boxes, which is what culling needs. Ranges are finished in index
+    // order, so the clusters come out sorted.
+    std::vector<TriangleCluster> clusters;
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t(order.size())}};
+    while (!stack.empty()) {
+        const auto [begin, end] = stack.back();
+        stack.pop_back();
+        if (end - begin <= leafSize) {
+            TriangleCluster cluster{begin, end - begin, {}};
+            for (uint32_t i = begin; i < end; ++i)
+                for (uint32_t v : scene.triangles[order[i]].v)
+                    cluster.bounds.extend(scene.vertices[v].position);
+            if (cluster.triangleCount > 0) clusters.push_back(cluster);
+            continue;
+        }
+        Aabb box;
+        for (uint32_t i = begin; i < end; ++i) box.extend(centroids[order[i]]);
+        const glm::vec3 extent = box.extent();
+        const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+        const uint32_t middle = begin + (end - begin) / 2;
+        std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end,
+                         [&](uint32_t a, uint32_t b) {
+                             return centroids[a][axis] < centroids[b][axis] ||
+                                    (centroids[a][axis] == centroids[b][axis] && a < b);
+                         });
+        stack.push_back({middle, end});  // popped second
+        stack.push_back({begin, middle});
+    }
+    return clusters;
+}
+
+std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
+                                                 const glm::mat4& clipFromWorld) {
+    // The clip volume's planes a·p ≥ 0 in world space (homogeneous p = (x, y, z, 1)), from
+    // the rows of the matrix: w ± x, w ± y, z (Vulkan's near plane) and w − z.
+    const glm::mat4 rows = glm::transpose(clipFromWorld);  // rows[i] = row i
+    const glm::vec4 planes[6] = {rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1],
+                                 rows[3] - rows[1], rows[2],           rows[3] - rows[2]};
+    std::vector<TriangleRange> ranges;
+    for (const TriangleCluster& cluster : clusters) {
+        if (cluster.bounds.empty()) continue;
+        bool outside = false;
+        for (const glm::vec4& plane : planes) {
+            // The box corner farthest along the plane's normal.
+            const glm::vec3 corner(plane.x >= 0.0f ? cluster.bounds.max.x : cluster.bounds.min.x,
+                                   plane.y >= 0.0f ? cluster.bounds.max.y : cluster.bounds.min.y,
+                                   plane.z >= 0.0f ? cluster.bounds.max.z : cluster.bounds.min.z);
+            if (glm::dot(glm::vec3(plane), corner) + plane.w < 0.0f) {
+                outside = true;
+                break;
+            }
+        }
+        if (outside) continue;
+        if (!ranges.empty() &&
+            ranges.back().firstTriangle + ranges.back().triangleCount == cluster.firstTriangle)
+            ranges.back().triangleCount += cluster.triangleCount;
+        else
+            ranges.push_back({cluster.firstTriangle, cluster.triangleCount});
+    }
+    return ranges;
+}
+
 Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
                                                              uint32_t size) {
     if (size < 16 || size > 16384)
@@ -35,15 +112,28 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     pass->mSize = size;
     pass->mBounds = scene.bounds;
 
-    // Positions only, packed: depth needs nothing else.
+    // Triangles in cluster order, so that each cluster is one run of the index buffer, and
+    // each cluster's vertices (positions only: depth needs nothing else) stored together, so
+    // that a draw of a few clusters spans a short vertex range (lavapipe shades the whole
+    // range an indexed draw spans).
+    std::vector<uint32_t> order;
+    pass->mClusters = buildTriangleClusters(scene, kShadowClusterTriangles, order);
     std::vector<float> positions;
-    positions.reserve(scene.vertices.size() * 3);
-    for (const Vertex& v : scene.vertices)
-        positions.insert(positions.end(), {v.position.x, v.position.y, v.position.z});
     std::vector<uint32_t> indices;
     indices.reserve(scene.triangles.size() * 3);
-    for (const Triangle& t : scene.triangles) indices.insert(indices.end(), {t.v[0], t.v[1], t.v[2]});
-    pass->mIndexCount = uint32_t(indices.size());
+    std::vector<uint32_t> local(scene.vertices.size(), UINT32_MAX);
+    for (const TriangleCluster& cluster : pass->mClusters) {
+        const uint32_t firstVertex = uint32_t(positions.size() / 3);
+        for (uint32_t i = cluster.firstTriangle; i < cluster.firstTriangle + cluster.triangleCount; ++i)
+            for (uint32_t v : scene.triangles[order[i]].v) {
+                if (local[v] == UINT32_MAX || local[v] < firstVertex) {
+                    local[v] = uint32_t(positions.size() / 3);
+                    const glm::vec3& p = scene.vertices[v].position;
+                    positions.insert(positions.end(), {p.x, p.y, p.z});
+                }
+                indices.push_back(local[v]);
+            }
+    }
     PIC_TRY_ASSIGN(pass->mVertices,
                    context.createBufferWith(std::span<const float>(positions),
                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "shadow vertices"));
@@ -243,6 +333,7 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
 
 void ShadowMapPass::record(VkCommandBuffer cmd) {
     mRenderedLights = 0;
+    mDrawnTriangles = 0;
     const VkDeviceSize zero = 0;
     for (LightSlot& slot : mCurrent) {
         if (!slot.dirty) continue;
@@ -285,7 +376,10 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
             const VkBuffer vertices = mVertices.handle();
             vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &zero);
             vkCmdBindIndexBuffer(cmd, mIndices.handle(), 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(cmd, mIndexCount, 1, 0, 0, 0);
+            for (const TriangleRange& range : visibleTriangleRanges(mClusters, mClipFromWorld[layer])) {
+                vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);
+                mDrawnTriangles += range.triangleCount;
+            }
             vkCmdEndRendering(cmd);
 
             // The depth writes finish before surfel lighting samples the layer.

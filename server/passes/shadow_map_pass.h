@@ -6,6 +6,7 @@
 /// did not change since the previous set keeps its layers: only changed lights re-render.
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,35 @@ namespace pic::gpu {
 /// Spots with a wider outer half-angle get a cube map (a single perspective layer would
 /// need a field of view near 180°). Radians.
 inline constexpr float kMaxPerspectiveSpot = 1.0472f;  // 60°
+
+/// Spatially close triangles, consecutive in the pass's index buffer: the unit of frustum
+/// culling, so that a cube face rasterises only the part of the scene it can see.
+struct TriangleCluster {
+    uint32_t firstTriangle = 0;
+    uint32_t triangleCount = 0;
+    Aabb bounds;
+};
+
+/// Triangles per cluster: small enough that a cube face skips most of a room, large enough
+/// that one layer needs few draws.
+inline constexpr uint32_t kShadowClusterTriangles = 512;
+
+/// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
+/// (median splits of their centroids); `order` receives the triangle indices in cluster order.
+std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
+                                                   std::vector<uint32_t>& order);
+
+/// A run of triangles to draw: [firstTriangle, firstTriangle + triangleCount).
+struct TriangleRange {
+    uint32_t firstTriangle = 0;
+    uint32_t triangleCount = 0;
+};
+
+/// The clusters whose bounds can intersect the clip volume of `clipFromWorld` (Vulkan's:
+/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w), adjacent ones merged into one range. Conservative: a cluster
+/// is dropped only when its box lies wholly outside one of the six planes.
+std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
+                                                 const glm::mat4& clipFromWorld);
 
 class ShadowMapPass {
 public:
@@ -40,6 +70,8 @@ public:
 
     /// Lights rendered by the last record().
     uint32_t renderedLights() const { return mRenderedLights; }
+    /// Triangles drawn by the last record(), over all layers (after frustum culling).
+    uint64_t drawnTriangles() const { return mDrawnTriangles; }
     uint32_t size() const { return mSize; }
     const DepthArray& depth() const { return mDepth; }
     const Buffer& lightBuffer() const { return mLights; }     ///< GpuLight[kMaxLights]
@@ -67,8 +99,8 @@ private:
 
     Context& mContext;
     uint32_t mSize = 0;
-    uint32_t mIndexCount = 0;
     Aabb mBounds;
+    std::vector<TriangleCluster> mClusters;
     Buffer mVertices;
     Buffer mIndices;
     Buffer mLights;
@@ -79,6 +111,7 @@ private:
     std::vector<LightSlot> mCurrent;
     std::vector<glm::mat4> mClipFromWorld;  ///< per layer
     uint32_t mRenderedLights = 0;
+    uint64_t mDrawnTriangles = 0;
 };
 
 }  // namespace pic::gpu
