@@ -80,7 +80,24 @@ int picbenchMain(int argc, char** argv) {
     runtime->add_option("--device", runtimeParams.device, "Vulkan device name substring");
     runtime->add_option("--shadow-map-size", runtimeParams.shadowMapSize, "texels per shadow-map side (default 1024)")
         ->check(CLI::Range(16u, 16384u));
+    runtime->add_option("--changes", runtimeParams.changes,
+                        "light changes: move-all, move-one, recolour (default: all three)")
+        ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));
     runtime->add_option("--json", runtimeParams.jsonPath, "JSON file (default runtime_benchmark.json)");
+
+    CLI::App* shadows = app.add_subcommand(
+        "shadows", "shadow-map size against time and direct-light error (GPU against the CPU twin's rays)");
+    ShadowBenchmarkParams shadowParams;
+    shadows->add_option("--scene", shadowParams.scenePath, "scene file (.gltf or .glb)")->required();
+    shadows->add_option("--lights", shadowParams.lightsPath, "light set JSON (default: the scene's lights)");
+    shadows->add_option("--setting", shadowParams.setting, "paper 000 Table 2 setting (default: moderate)")
+        ->check(CLI::IsMember({"moderate", "high"}));
+    shadows->add_option("--sizes", shadowParams.sizes, "texels per shadow-map side (default: 256 512 1024 2048)")
+        ->check(CLI::Range(16u, 16384u));
+    shadows->add_option("--repeat", shadowParams.repeat, "timed light changes per size (default 5)")
+        ->check(CLI::Range(1, 1000));
+    shadows->add_option("--device", shadowParams.device, "Vulkan device name substring");
+    shadows->add_option("--json", shadowParams.jsonPath, "JSON file (default shadow_benchmark.json)");
 
     try {
         app.parse(argc, argv);
@@ -97,6 +114,7 @@ int picbenchMain(int argc, char** argv) {
         return runAccuracyBenchmark(accuracyParams);
     }
     if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
+    if (shadows->parsed()) return runShadowBenchmark(shadowParams);
     if (links->parsed()) {
         linkParams.bake = linkFlags.toOptions();
         return runLinkErrorBenchmark(linkParams);

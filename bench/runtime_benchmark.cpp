@@ -6,6 +6,8 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -60,16 +62,27 @@ BakeOptions settingOptions(const std::string& setting, const std::string& linkMo
     return options;
 }
 
-/// The light set of update `k`: every light moves by a small step (point and spot lights
-/// along x, directional lights tilt), so each update re-renders its shadow maps.
-LightSet movedLights(const LightSet& base, int k, float step) {
+/// The light set of update `k` under a kind of change (see runtime_benchmark.h): lights move
+/// by a small step (point and spot lights along x, directional lights tilt) or change
+/// intensity by a few per cent.
+LightSet changedLights(const LightSet& base, int k, float step, const std::string& change) {
     LightSet lights = base;
-    for (Light& light : lights.lights) {
-        const float offset = step * float((k % 2) ? 1 : -1) * float(1 + k % 3);
-        if (light.type == LightType::Directional)
-            light.direction = glm::normalize(light.direction + glm::vec3(0.01f * offset / step, 0.0f, 0.0f));
+    const float sign = (k % 2) ? 1.0f : -1.0f;
+    const float offset = step * sign * float(1 + k % 3);
+    if (change == "recolour") {
+        for (Light& light : lights.lights) light.intensity *= 1.0f + 0.01f * sign * float(1 + k % 3);
+        return lights;
+    }
+    // move-one: the first point or spot light (what dragging a lamp does), else the first.
+    auto first = std::find_if(lights.lights.begin(), lights.lights.end(),
+                              [](const Light& l) { return l.type != LightType::Directional; });
+    if (first == lights.lights.end()) first = lights.lights.begin();
+    for (auto it = lights.lights.begin(); it != lights.lights.end(); ++it) {
+        if (change == "move-one" && it != first) continue;
+        if (it->type == LightType::Directional)
+            it->direction = glm::normalize(it->direction + glm::vec3(0.01f * offset / step, 0.0f, 0.0f));
         else
-            light.position.x += offset;
+            it->position.x += offset;
     }
     return lights;
 }
@@ -82,12 +95,13 @@ struct BackendFigures {
     uint64_t shadowTriangles = 0;  ///< GPU: triangles rasterised per update, after culling
 };
 
-Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step) {
+Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step,
+                                   const std::string& change) {
     BackendFigures figures;
     UpdateStats stats;
-    PIC_TRY(runtime.setLights(movedLights(base, 0, step), &stats));  // warm-up
+    PIC_TRY(runtime.setLights(changedLights(base, 0, step, change), &stats));  // warm-up
     for (int k = 1; k <= repeat; ++k) {
-        PIC_TRY(runtime.setLights(movedLights(base, k, step), &stats));
+        PIC_TRY(runtime.setLights(changedLights(base, k, step, change), &stats));
         figures.totalMs.push_back(stats.totalMs);
         for (const auto& [pass, ms] : stats.passMs) figures.passMs[pass].push_back(ms);
         figures.bounces = stats.bounces;
@@ -127,121 +141,216 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     return json;
 }
 
-}  // namespace
+/// What both benchmarks start from.
+struct Inputs {
+    Scene scene;
+    LightSet lights;
+    std::unique_ptr<EmbreeScene> rays;
+};
 
-int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
-    auto scene = loadScene(params.scenePath);
+/// Loads the scene, its light set and its rays; prints the error and returns nullopt.
+std::optional<Inputs> loadInputs(const std::string& scenePath, const std::string& lightsPath) {
+    auto scene = loadScene(scenePath);
     if (!scene) {
         std::fprintf(stderr, "picbench: error: %s\n", scene.error().message.c_str());
-        return exitCode(scene.error());
+        return std::nullopt;
     }
-    auto lights = loadLightSet(params.lightsPath, *scene);
+    auto lights = loadLightSet(lightsPath, *scene);
     if (!lights) {
         std::fprintf(stderr, "picbench: error: %s\n", lights.error().message.c_str());
-        return exitCode(lights.error());
+        return std::nullopt;
     }
     if (lights->lights.empty())
         std::fprintf(stderr, "picbench: warning: the light set has no punctual lights\n");
     auto rays = EmbreeScene::create(*scene);
     if (!rays) {
         std::fprintf(stderr, "picbench: error: %s\n", rays.error().message.c_str());
-        return exitCode(rays.error());
+        return std::nullopt;
     }
-    const float step = 1e-3f * scene->bounds.diagonal();
+    return Inputs{std::move(*scene), std::move(*lights), std::move(*rays)};
+}
+
+/// Prints `error` and returns its exit code.
+int report(const Error& error) {
+    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// Writes `json` to `path`; returns the exit code.
+int writeJson(const nlohmann::ordered_json& json, const std::string& path) {
+    std::ofstream out(path);
+    out << json.dump(2) << "\n";
+    if (!out) {
+        std::fprintf(stderr, "picbench: error: could not write %s\n", path.c_str());
+        return 1;
+    }
+    std::printf("written %s\n", path.c_str());
+    return 0;
+}
+
+}  // namespace
+
+int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
+    auto inputs = loadInputs(params.scenePath, params.lightsPath);
+    if (!inputs) return 2;
+    const Scene& scene = inputs->scene;
+    const float step = 1e-3f * scene.bounds.diagonal();
     const double bandwidth = memcpyBandwidth();
     std::printf("memcpy bandwidth: %.2f GB/s\n", bandwidth * 1e-9);
 
     nlohmann::ordered_json json;
     json["scene"] = params.scenePath;
-    json["triangles"] = scene->triangles.size();
+    json["triangles"] = scene.triangles.size();
     json["memcpy_bytes_per_second"] = bandwidth;
     json["runs"] = nlohmann::ordered_json::array();
-    std::printf("%-9s %-4s %-7s %6s %9s %9s %6s %9s %8s %9s %9s %9s %8s\n", "setting", "link",
-                "bounces", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris", "surfels", "pull",
-                "caches*", "bw ratio");
+    std::printf("%-9s %-4s %-7s %-8s %6s %9s %9s %6s %9s %8s %9s %9s %9s %8s\n", "setting", "link",
+                "bounces", "change", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris", "surfels",
+                "pull", "caches*", "bw ratio");
     for (const std::string& setting : params.settings) {
         for (const std::string& linkMode : params.linkModes) {
-            BakeReport report;
+            BakeReport bakeReport;
             std::fprintf(stderr, "picbench: baking %s %s …\n", setting.c_str(), linkMode.c_str());
-            auto bake = runBake(*scene, settingOptions(setting, linkMode), report);
-            if (!bake) {
-                std::fprintf(stderr, "picbench: error: %s\n", bake.error().message.c_str());
-                return exitCode(bake.error());
-            }
+            auto bake = runBake(scene, settingOptions(setting, linkMode), bakeReport);
+            if (!bake) return report(bake.error());
             for (int bounces : params.bounces) {
                 const BounceParams bounceParams{bounces};
-                auto cpu = createCpuRuntime(*scene, **rays, *bake, bounceParams);
+                auto cpu = createCpuRuntime(scene, *inputs->rays, *bake, bounceParams);
+                if (!cpu) return report(cpu.error());
                 GpuRuntimeOptions options;
                 options.deviceName = params.device;
                 options.shadowMapSize = params.shadowMapSize;
-                auto gpu = GpuRuntime::create(*scene, **rays, *bake, bounceParams, options);
-                if (!cpu || !gpu) {
-                    const Error& e = !cpu ? cpu.error() : gpu.error();
-                    std::fprintf(stderr, "picbench: error: %s\n", e.message.c_str());
-                    return exitCode(e);
-                }
-                auto cpuFigures = timeBackend(**cpu, *lights, params.repeat, step);
-                auto gpuFigures = timeBackend(**gpu, *lights, params.repeat, step);
-                if (!cpuFigures || !gpuFigures) {
-                    const Error& e = !cpuFigures ? cpuFigures.error() : gpuFigures.error();
-                    std::fprintf(stderr, "picbench: error: %s\n", e.message.c_str());
-                    return exitCode(e);
-                }
-                auto cacheWall = timeCacheLighting(**gpu, *scene, **rays, *bake, *lights, params.repeat);
-                if (!cacheWall) {
-                    std::fprintf(stderr, "picbench: error: %s\n", cacheWall.error().message.c_str());
-                    return exitCode(cacheWall.error());
-                }
-                const auto passMedian = [&](const BackendFigures& f, const char* pass) {
-                    auto it = f.passMs.find(pass);
-                    return it == f.passMs.end() ? 0.0 : median(it->second);
-                };
-                const double cpuMs = median(cpuFigures->totalMs), gpuMs = median(gpuFigures->totalMs);
-                // Link bytes per second of one GPU cache-lighting pass (wall clock): every link
-                // is read once per bounce.
+                auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
+                if (!gpu) return report(gpu.error());
+                // Link bytes per second of one GPU cache-lighting pass (wall clock): every
+                // link is read once per bounce.
+                auto cacheWall = timeCacheLighting(**gpu, scene, *inputs->rays, *bake, inputs->lights,
+                                                   params.repeat);
+                if (!cacheWall) return report(cacheWall.error());
                 const double cacheMs = median(*cacheWall);
                 const double linkBytes = double((*gpu)->linkBytesPerBounce());
                 const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
-                std::printf("%-9s %-4s %-7d %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %9.1f %9.1f %9.1f %8.2f\n",
-                            setting.c_str(), linkMode.c_str(), gpuFigures->bounces,
-                            bake->caches.size(), cpuMs, gpuMs, gpuMs / cpuMs,
-                            passMedian(*gpuFigures, "shadow_maps"),
-                            double(gpuFigures->shadowTriangles) * 1e-3,
-                            passMedian(*gpuFigures, "surfel_lighting"),
-                            passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
+                for (const std::string& change : params.changes) {
+                    auto cpuFigures = timeBackend(**cpu, inputs->lights, params.repeat, step, change);
+                    if (!cpuFigures) return report(cpuFigures.error());
+                    auto gpuFigures = timeBackend(**gpu, inputs->lights, params.repeat, step, change);
+                    if (!gpuFigures) return report(gpuFigures.error());
+                    const auto passMedian = [&](const BackendFigures& f, const char* pass) {
+                        auto it = f.passMs.find(pass);
+                        return it == f.passMs.end() ? 0.0 : median(it->second);
+                    };
+                    const double cpuMs = median(cpuFigures->totalMs), gpuMs = median(gpuFigures->totalMs);
+                    std::printf("%-9s %-4s %-7d %-8s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %9.1f %9.1f %9.1f %8.2f\n",
+                                setting.c_str(), linkMode.c_str(), gpuFigures->bounces, change.c_str(),
+                                bake->caches.size(), cpuMs, gpuMs, gpuMs / cpuMs,
+                                passMedian(*gpuFigures, "shadow_maps"),
+                                double(gpuFigures->shadowTriangles) * 1e-3,
+                                passMedian(*gpuFigures, "surfel_lighting"),
+                                passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
 
-                nlohmann::ordered_json run;
-                run["setting"] = setting;
-                run["link_mode"] = linkMode;
-                run["bounces_requested"] = bounces;
-                run["surfels"] = bake->surfels.size();
-                run["caches"] = bake->caches.size();
-                run["links_per_cache"] = bake->links.linksPerCache;
-                run["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
-                run["device"] = (*gpu)->context().deviceName();
-                run["cpu"] = figuresJson(*cpuFigures);
-                run["gpu"] = figuresJson(*gpuFigures);
-                run["gpu_over_cpu"] = gpuMs / cpuMs;
-                run["cache_lighting_wall_ms_median"] = cacheMs;
-                run["link_bytes_per_bounce"] = linkBytes;
-                run["cache_lighting_bytes_per_second"] = linkRate;
-                run["bandwidth_ratio"] = linkRate / bandwidth;
-                run["gpu_memory_bytes"] = nlohmann::ordered_json::object();
-                for (const auto& [buffer, bytes] : (*gpu)->memory()) run["gpu_memory_bytes"][buffer] = bytes;
-                json["runs"].push_back(run);
+                    nlohmann::ordered_json run;
+                    run["setting"] = setting;
+                    run["link_mode"] = linkMode;
+                    run["bounces_requested"] = bounces;
+                    run["change"] = change;
+                    run["surfels"] = bake->surfels.size();
+                    run["caches"] = bake->caches.size();
+                    run["links_per_cache"] = bake->links.linksPerCache;
+                    run["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
+                    run["device"] = (*gpu)->context().deviceName();
+                    run["shadow_map_size"] = params.shadowMapSize;
+                    run["cpu"] = figuresJson(*cpuFigures);
+                    run["gpu"] = figuresJson(*gpuFigures);
+                    run["gpu_over_cpu"] = gpuMs / cpuMs;
+                    run["cache_lighting_wall_ms_median"] = cacheMs;
+                    run["link_bytes_per_bounce"] = linkBytes;
+                    run["cache_lighting_bytes_per_second"] = linkRate;
+                    run["bandwidth_ratio"] = linkRate / bandwidth;
+                    run["gpu_memory_bytes"] = nlohmann::ordered_json::object();
+                    for (const auto& [buffer, bytes] : (*gpu)->memory()) run["gpu_memory_bytes"][buffer] = bytes;
+                    json["runs"].push_back(run);
+                }
             }
         }
     }
-    std::ofstream out(params.jsonPath);
-    out << json.dump(2) << "\n";
-    if (!out) {
-        std::fprintf(stderr, "picbench: error: could not write %s\n", params.jsonPath.c_str());
-        return 1;
-    }
     std::printf("ms: medians per update; shadow, surfels, pull from GPU timestamps; caches* is one\n"
                 "cache-lighting pass by wall clock (lavapipe's timestamps do not wait for it)\n");
-    std::printf("written %s\n", params.jsonPath.c_str());
-    return 0;
+    return writeJson(json, params.jsonPath);
+}
+
+int runShadowBenchmark(const ShadowBenchmarkParams& params) {
+    auto inputs = loadInputs(params.scenePath, params.lightsPath);
+    if (!inputs) return 2;
+    const Scene& scene = inputs->scene;
+    const float step = 1e-3f * scene.bounds.diagonal();
+    BakeReport bakeReport;
+    std::fprintf(stderr, "picbench: baking %s rtp …\n", params.setting.c_str());
+    auto bake = runBake(scene, settingOptions(params.setting, "rtp"), bakeReport);
+    if (!bake) return report(bake.error());
+    const size_t nS = bake->surfels.size();
+
+    nlohmann::ordered_json json;
+    json["scene"] = params.scenePath;
+    json["triangles"] = scene.triangles.size();
+    json["setting"] = params.setting;
+    json["surfels"] = nS;
+    json["sizes"] = nlohmann::ordered_json::array();
+    std::printf("%-6s %10s %10s %10s %12s %12s\n", "size", "gpu ms", "cpu ms", "gpu/cpu",
+                "rel L1", "surfels >1%");
+    for (uint32_t size : params.sizes) {
+        GpuRuntimeOptions options;
+        options.deviceName = params.device;
+        options.shadowMapSize = size;
+        auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options);
+        if (!gpu) return report(gpu.error());
+        std::vector<double> gpuMs, cpuMs;
+        double l1 = 0.0, norm = 0.0;
+        size_t differing = 0, compared = 0;
+        for (int k = 0; k <= params.repeat; ++k) {  // k = 0 warms up
+            // Every light moves, so every shadow map is rendered in each timed call.
+            const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
+            Clock::time_point start = Clock::now();
+            auto direct = (*gpu)->runDirect(lights);
+            if (!direct) return report(direct.error());
+            const double g = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+            std::vector<glm::vec3> rays(nS);
+            start = Clock::now();
+            directSurfelFlux(scene, *inputs->rays, *bake, lights, rays);
+            const double c = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+            if (k == 0) continue;
+            gpuMs.push_back(g);
+            cpuMs.push_back(c);
+            float brightest = 0.0f;
+            for (const glm::vec3& f : rays) brightest = std::max({brightest, f.r, f.g, f.b});
+            for (size_t i = 0; i < nS; ++i) {
+                bool differs = false;
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double d = std::abs(double((*direct)[i][ch]) - double(rays[i][ch]));
+                    l1 += d;
+                    norm += std::abs(double(rays[i][ch]));
+                    differs |= d > 0.01 * std::max(std::abs(rays[i][ch]), std::abs((*direct)[i][ch])) &&
+                               d > 1e-6 * brightest;
+                }
+                differing += differs;
+            }
+            compared += nS;
+        }
+        const double relL1 = norm > 0.0 ? l1 / norm : 0.0;
+        const double fraction = compared ? double(differing) / double(compared) : 0.0;
+        std::printf("%-6u %10.1f %10.1f %10.2f %11.2f%% %11.2f%%\n", size, median(gpuMs),
+                    median(cpuMs), median(gpuMs) / median(cpuMs), 100.0 * relL1, 100.0 * fraction);
+        nlohmann::ordered_json row;
+        row["size"] = size;
+        row["device"] = (*gpu)->context().deviceName();
+        row["gpu_direct_ms_median"] = median(gpuMs);
+        row["cpu_direct_ms_median"] = median(cpuMs);
+        row["gpu_direct_ms"] = gpuMs;
+        row["relative_l1"] = relL1;
+        row["fraction_surfels_differing"] = fraction;
+        json["sizes"].push_back(row);
+    }
+    std::printf("gpu: shadow maps of every light + direct surfel lighting (wall clock, read-back\n"
+                "included); cpu: the twin's rays; errors: GPU direct surfel flux against the rays\n");
+    return writeJson(json, params.jsonPath);
 }
 
 }  // namespace pic

@@ -1,11 +1,18 @@
 #pragma once
 /// `picbench runtime`: the runtime passes on the GPU backend against the CPU twin in the same
 /// run, at paper 000 Table 2's settings (moderate: nS 32k, nL 128, l 3; high: nS 128k,
-/// nL 254, l 4) with RTP and SH links. Per setting and link form: a light change that moves
-/// one light (its shadow map re-renders) is applied `repeat` times to each backend after a
-/// warm-up; the medians of the update time and of every pass (GPU timestamps), the
-/// cache-lighting link bandwidth against this machine's memcpy bandwidth, the GPU/CPU time
-/// ratio and the runtime memory per buffer. Prints a table and writes JSON. Never asserts.
+/// nL 254, l 4) with RTP and SH links. Per setting, link form and kind of light change
+/// (`move-all`: every light moves, so every shadow map re-renders; `move-one`: the first
+/// point or spot light moves; `recolour`: intensities change, no shadow map re-renders) the
+/// change is applied `repeat` times to each backend after a warm-up; the medians of the
+/// update time and of every pass (GPU timestamps), the cache-lighting link bandwidth
+/// against this machine's memcpy bandwidth, the GPU/CPU time ratio and the runtime memory
+/// per buffer. Prints a table and writes JSON. Never asserts.
+///
+/// `picbench shadows`: the shadow-map size's trade-off. Per size, the wall-clock ms of the
+/// GPU's direct light (every light's shadow maps + surfel lighting) against the CPU twin's
+/// rays, and how far the GPU's direct surfel flux is from the rays' (relative L1, and the
+/// fraction of surfels differing by more than 1 %).
 
 #include <string>
 #include <vector>
@@ -18,6 +25,7 @@ struct RuntimeBenchmarkParams {
     std::vector<std::string> settings{"moderate", "high"};
     std::vector<std::string> linkModes{"rtp", "sh"};
     std::vector<int> bounces{1, -1};               ///< per update; −1 = progressive
+    std::vector<std::string> changes{"move-all", "move-one", "recolour"};
     int repeat = 5;
     std::string device;                            ///< Vulkan device name substring
     uint32_t shadowMapSize = 1024;
@@ -26,5 +34,18 @@ struct RuntimeBenchmarkParams {
 
 /// Runs the benchmark; returns the process exit code.
 int runRuntimeBenchmark(const RuntimeBenchmarkParams& params);
+
+struct ShadowBenchmarkParams {
+    std::string scenePath;
+    std::string lightsPath;                        ///< empty: the scene's lights
+    std::string setting = "moderate";
+    std::vector<uint32_t> sizes{256, 512, 1024, 2048};
+    int repeat = 5;
+    std::string device;
+    std::string jsonPath = "shadow_benchmark.json";
+};
+
+/// Runs the shadow-map size sweep; returns the process exit code.
+int runShadowBenchmark(const ShadowBenchmarkParams& params);
 
 }  // namespace pic

@@ -1,0 +1,97 @@
+// `picbench runtime` and `picbench shadows` on cornell: they run, and what they report holds
+// together (kinds of light change, triangles drawn, shadow-map error falling with size).
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class PicbenchRuntime : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mDir = fs::temp_directory_path() /
+               ("picbench_runtime_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(mDir);
+    }
+    void TearDown() override { fs::remove_all(mDir); }
+
+    /// Runs picbench with `args`, returns its exit code with stderr in `err`.
+    int run(const std::string& args, std::string& err) {
+        const fs::path errPath = mDir / "stderr.txt";
+        const std::string command = std::string(PIC_PICBENCH) + " --quiet " + args + " >" +
+                                    (mDir / "stdout.txt").string() + " 2>" + errPath.string() +
+                                    " </dev/null";
+        const int status = std::system(command.c_str());
+        std::ifstream in(errPath);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        err = ss.str();
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+
+    fs::path mDir;
+};
+
+TEST_F(PicbenchRuntime, ReportsEveryKindOfLightChange) {
+    const fs::path json = mDir / "runtime.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("runtime --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf "
+                  "--settings moderate --link-modes rtp --bounces 1 --repeat 1 --shadow-map-size 256 "
+                  "--json " + json.string(), err), 0) << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    ASSERT_EQ(report.at("runs").size(), 3u);
+    for (const nlohmann::json& run : report.at("runs")) {
+        const std::string change = run.at("change");
+        SCOPED_TRACE(change);
+        EXPECT_GT(run.at("cpu").at("update_ms_median").get<double>(), 0.0);
+        EXPECT_GT(run.at("gpu").at("update_ms_median").get<double>(), 0.0);
+        EXPECT_EQ(run.at("shadow_map_size").get<int>(), 256);
+        // Cornell's one point light: a cube, every triangle in some face, none drawn when only
+        // the intensity changes.
+        const uint64_t drawn = run.at("gpu").at("shadow_triangles").get<uint64_t>();
+        if (change == "recolour")
+            EXPECT_EQ(drawn, 0u);
+        else
+            EXPECT_GE(drawn, report.at("triangles").get<uint64_t>());
+        EXPECT_GT(run.at("bandwidth_ratio").get<double>(), 0.0);
+    }
+}
+
+TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {
+    const fs::path json = mDir / "shadows.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("shadows --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf "
+                  "--sizes 64 512 --repeat 1 --json " + json.string(), err), 0) << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    const nlohmann::json& sizes = report.at("sizes");
+    ASSERT_EQ(sizes.size(), 2u);
+    for (const nlohmann::json& row : sizes) {
+        EXPECT_GE(row.at("relative_l1").get<double>(), 0.0);
+        EXPECT_LE(row.at("fraction_surfels_differing").get<double>(), 1.0);
+        EXPECT_GT(row.at("gpu_direct_ms_median").get<double>(), 0.0);
+    }
+    // Eight times the resolution: the edges of cornell's box shadow get sharper.
+    EXPECT_LT(sizes[1].at("relative_l1").get<double>(), sizes[0].at("relative_l1").get<double>());
+}
+
+TEST_F(PicbenchRuntime, RefusesAnUnknownChange) {
+    std::string err;
+    EXPECT_EQ(run(std::string("runtime --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --changes teleport", err), 2);
+    EXPECT_NE(err.find("teleport"), std::string::npos) << err;
+}
+
+}  // namespace
