@@ -1,0 +1,78 @@
+#pragma once
+/// The frame codec: one version's cache textures, as half floats, compressed for the stream
+/// (paper 001's YCoCg split is already in the textures: Y with lY² layers, Co and Cg with
+/// lC²). Lossless: decoding reproduces the encoder's half-float input bit for bit.
+///
+/// Each of the six planes (grid and light map × Y, Co, Cg; server/cpu/lightmap_copy.h
+/// layout) is coded on its own:
+///   1. each half's bit pattern h becomes its rank o(h) in float order (negative values
+///      reversed), so that nearby values have nearby ranks across zero;
+///   2. key planes take the difference from the previous value in the plane (neighbouring
+///      texels are alike), delta planes the difference from the same value in the base
+///      version (a light change moves most values a little); differences wrap mod 2¹⁶;
+///   3. differences are zigzagged (small negatives become small positives) and split into
+///      a plane of low bytes followed by a plane of high bytes, mostly zero;
+///   4. zstd.
+/// A delta frame applies only to the exact base version it was made from; a receiver that
+/// holds another version needs a key frame.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace pic {
+
+/// The planes of a frame, in wire order.
+enum class FrameTexture : uint8_t { GridY, GridCo, GridCg, LightmapY, LightmapCo, LightmapCg };
+inline constexpr int kFrameTextures = 6;
+
+/// "grid_y", "lightmap_cg", … for logs and messages.
+const char* frameTextureName(int texture);
+
+/// Every plane of one version as half-float bit patterns: what the encoder takes and the
+/// decoder reproduces.
+struct HalfFrame {
+    std::array<std::vector<uint16_t>, kFrameTextures> planes;
+
+    bool operator==(const HalfFrame&) const = default;
+};
+
+enum class PlaneEncoding : uint8_t {
+    Key = 1,    ///< the plane alone
+    Delta = 2,  ///< the difference from the base version's plane
+};
+
+struct EncodedPlane {
+    PlaneEncoding encoding = PlaneEncoding::Key;
+    uint32_t values = 0;        ///< halves in the decoded plane
+    std::vector<uint8_t> bytes; ///< one zstd frame of 2·values bytes
+};
+
+struct EncodedFrame {
+    std::array<EncodedPlane, kFrameTextures> planes;
+
+    /// Compressed bytes over all planes.
+    size_t bytes() const;
+    /// Whether every plane is a key plane (decodable without a base).
+    bool key() const;
+};
+
+/// zstd level of the stream: fast enough to encode a frame in a few milliseconds.
+inline constexpr int kDefaultZstdLevel = 3;
+
+/// Encodes `frame` as a key frame (`base` null) or as the difference from `base`, whose
+/// planes must have the same sizes (InvalidInput naming the plane otherwise).
+Result<EncodedFrame> encodeFrame(const HalfFrame& frame, const HalfFrame* base,
+                                 int zstdLevel = kDefaultZstdLevel);
+
+/// Decodes `encoded` into `frame`, whose planes already have their sizes (from the scene's
+/// layout): a key plane replaces its plane, a delta plane applies to it, which must hold the
+/// base version. Corrupt input, a size that does not match or a zstd failure gives Corrupt
+/// naming the plane, and leaves `frame` unchanged.
+Result<void> decodeFrame(const EncodedFrame& encoded, HalfFrame& frame);
+
+}  // namespace pic
