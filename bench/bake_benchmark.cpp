@@ -13,18 +13,9 @@
 #include "core/bake_file.h"
 #include "core/gltf_loader.h"
 #include "core/parallel.h"
+#include "bench/bench_common.h"
 
 namespace pic {
-
-namespace {
-
-double median(std::vector<double> values) {
-    std::sort(values.begin(), values.end());
-    size_t n = values.size();
-    return n == 0 ? 0.0 : n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-}  // namespace
 
 int runBakeBenchmark(const BakeBenchmarkParams& params) {
     using Clock = std::chrono::steady_clock;

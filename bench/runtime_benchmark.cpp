@@ -6,15 +6,10 @@
 #include <cstring>
 #include <fstream>
 #include <map>
-#include <memory>
-#include <optional>
 
 #include <nlohmann/json.hpp>
 
-#include "bake/bake.h"
-#include "bake/embree_scene.h"
-#include "core/gltf_loader.h"
-#include "core/light_set.h"
+#include "bench/bench_common.h"
 #include "server/cpu/cpu_runtime.h"
 #include "server/cpu/pull.h"
 #include "server/cpu/surfel_lighting.h"
@@ -24,13 +19,6 @@ namespace pic {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double median(std::vector<double> values) {
-    if (values.empty()) return 0.0;
-    std::sort(values.begin(), values.end());
-    const size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 /// This machine's memcpy bandwidth in bytes/s (median of 7 copies of 256 MiB, after a
 /// warm-up copy that also faults the pages in): the floor a pass that reads every link once
@@ -48,43 +36,6 @@ double memcpyBandwidth() {
         src[i] = dst[bytes - 1 - i];  // keep the copies observable
     }
     return median(rates);
-}
-
-/// Paper 000 Table 2's two settings as bake options.
-BakeOptions settingOptions(const std::string& setting, const std::string& linkMode) {
-    BakeOptions options;
-    const bool high = setting == "high";
-    options.surfels = high ? 131072u : 32768u;
-    options.links = high ? 254u : 128u;
-    options.bandsY = high ? 4u : 3u;
-    options.bandsC = 2u;
-    options.linkMode = linkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
-    return options;
-}
-
-/// The light set of update `k` under a kind of change (see runtime_benchmark.h): lights move
-/// by a small step (point and spot lights along x, directional lights tilt) or change
-/// intensity by a few per cent.
-LightSet changedLights(const LightSet& base, int k, float step, const std::string& change) {
-    LightSet lights = base;
-    const float sign = (k % 2) ? 1.0f : -1.0f;
-    const float offset = step * sign * float(1 + k % 3);
-    if (change == "recolour") {
-        for (Light& light : lights.lights) light.intensity *= 1.0f + 0.01f * sign * float(1 + k % 3);
-        return lights;
-    }
-    // move-one: the first point or spot light (what dragging a lamp does), else the first.
-    auto first = std::find_if(lights.lights.begin(), lights.lights.end(),
-                              [](const Light& l) { return l.type != LightType::Directional; });
-    if (first == lights.lights.end()) first = lights.lights.begin();
-    for (auto it = lights.lights.begin(); it != lights.lights.end(); ++it) {
-        if (change == "move-one" && it != first) continue;
-        if (it->type == LightType::Directional)
-            it->direction = glm::normalize(it->direction + glm::vec3(0.01f * offset / step, 0.0f, 0.0f));
-        else
-            it->position.x += offset;
-    }
-    return lights;
 }
 
 struct BackendFigures {
@@ -141,57 +92,10 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     return json;
 }
 
-/// What both benchmarks start from.
-struct Inputs {
-    Scene scene;
-    LightSet lights;
-    std::unique_ptr<EmbreeScene> rays;
-};
-
-/// Loads the scene, its light set and its rays; prints the error and returns nullopt.
-std::optional<Inputs> loadInputs(const std::string& scenePath, const std::string& lightsPath) {
-    auto scene = loadScene(scenePath);
-    if (!scene) {
-        std::fprintf(stderr, "picbench: error: %s\n", scene.error().message.c_str());
-        return std::nullopt;
-    }
-    auto lights = loadLightSet(lightsPath, *scene);
-    if (!lights) {
-        std::fprintf(stderr, "picbench: error: %s\n", lights.error().message.c_str());
-        return std::nullopt;
-    }
-    if (lights->lights.empty())
-        std::fprintf(stderr, "picbench: warning: the light set has no punctual lights\n");
-    auto rays = EmbreeScene::create(*scene);
-    if (!rays) {
-        std::fprintf(stderr, "picbench: error: %s\n", rays.error().message.c_str());
-        return std::nullopt;
-    }
-    return Inputs{std::move(*scene), std::move(*lights), std::move(*rays)};
-}
-
-/// Prints `error` and returns its exit code.
-int report(const Error& error) {
-    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
-
-/// Writes `json` to `path`; returns the exit code.
-int writeJson(const nlohmann::ordered_json& json, const std::string& path) {
-    std::ofstream out(path);
-    out << json.dump(2) << "\n";
-    if (!out) {
-        std::fprintf(stderr, "picbench: error: could not write %s\n", path.c_str());
-        return 1;
-    }
-    std::printf("written %s\n", path.c_str());
-    return 0;
-}
-
 }  // namespace
 
 int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
-    auto inputs = loadInputs(params.scenePath, params.lightsPath);
+    auto inputs = loadBenchInputs(params.scenePath, params.lightsPath);
     if (!inputs) return 2;
     const Scene& scene = inputs->scene;
     const float step = 1e-3f * scene.bounds.diagonal();
@@ -211,29 +115,29 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
             BakeReport bakeReport;
             std::fprintf(stderr, "picbench: baking %s %s …\n", setting.c_str(), linkMode.c_str());
             auto bake = runBake(scene, settingOptions(setting, linkMode), bakeReport);
-            if (!bake) return report(bake.error());
+            if (!bake) return reportError(bake.error());
             for (int bounces : params.bounces) {
                 const BounceParams bounceParams{bounces};
                 auto cpu = createCpuRuntime(scene, *inputs->rays, *bake, bounceParams);
-                if (!cpu) return report(cpu.error());
+                if (!cpu) return reportError(cpu.error());
                 GpuRuntimeOptions options;
                 options.deviceName = params.device;
                 options.shadowMapSize = params.shadowMapSize;
                 auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
-                if (!gpu) return report(gpu.error());
+                if (!gpu) return reportError(gpu.error());
                 // Link bytes per second of one GPU cache-lighting pass (wall clock): every
                 // link is read once per bounce.
                 auto cacheWall = timeCacheLighting(**gpu, scene, *inputs->rays, *bake, inputs->lights,
                                                    params.repeat);
-                if (!cacheWall) return report(cacheWall.error());
+                if (!cacheWall) return reportError(cacheWall.error());
                 const double cacheMs = median(*cacheWall);
                 const double linkBytes = double((*gpu)->linkBytesPerBounce());
                 const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
                 for (const std::string& change : params.changes) {
                     auto cpuFigures = timeBackend(**cpu, inputs->lights, params.repeat, step, change);
-                    if (!cpuFigures) return report(cpuFigures.error());
+                    if (!cpuFigures) return reportError(cpuFigures.error());
                     auto gpuFigures = timeBackend(**gpu, inputs->lights, params.repeat, step, change);
-                    if (!gpuFigures) return report(gpuFigures.error());
+                    if (!gpuFigures) return reportError(gpuFigures.error());
                     const auto passMedian = [&](const BackendFigures& f, const char* pass) {
                         auto it = f.passMs.find(pass);
                         return it == f.passMs.end() ? 0.0 : median(it->second);
@@ -278,14 +182,14 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
 }
 
 int runShadowBenchmark(const ShadowBenchmarkParams& params) {
-    auto inputs = loadInputs(params.scenePath, params.lightsPath);
+    auto inputs = loadBenchInputs(params.scenePath, params.lightsPath);
     if (!inputs) return 2;
     const Scene& scene = inputs->scene;
     const float step = 1e-3f * scene.bounds.diagonal();
     BakeReport bakeReport;
     std::fprintf(stderr, "picbench: baking %s rtp …\n", params.setting.c_str());
     auto bake = runBake(scene, settingOptions(params.setting, "rtp"), bakeReport);
-    if (!bake) return report(bake.error());
+    if (!bake) return reportError(bake.error());
     const size_t nS = bake->surfels.size();
 
     nlohmann::ordered_json json;
@@ -301,7 +205,7 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
         options.deviceName = params.device;
         options.shadowMapSize = size;
         auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options);
-        if (!gpu) return report(gpu.error());
+        if (!gpu) return reportError(gpu.error());
         std::vector<double> gpuMs, cpuMs;
         double l1 = 0.0, norm = 0.0;
         size_t differing = 0, compared = 0;
@@ -310,7 +214,7 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
             const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
             Clock::time_point start = Clock::now();
             auto direct = (*gpu)->runDirect(lights);
-            if (!direct) return report(direct.error());
+            if (!direct) return reportError(direct.error());
             const double g = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
             std::vector<glm::vec3> rays(nS);
             start = Clock::now();

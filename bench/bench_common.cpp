@@ -1,0 +1,88 @@
+#include "bench/bench_common.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include "core/gltf_loader.h"
+
+namespace pic {
+
+double median(std::vector<double> values) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+BakeOptions settingOptions(const std::string& setting, const std::string& linkMode) {
+    BakeOptions options;
+    const bool high = setting == "high";
+    options.surfels = high ? 131072u : 32768u;
+    options.links = high ? 254u : 128u;
+    options.bandsY = high ? 4u : 3u;
+    options.bandsC = 2u;
+    options.linkMode = linkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
+    return options;
+}
+
+LightSet changedLights(const LightSet& base, int k, float step, const std::string& change) {
+    LightSet lights = base;
+    const float sign = (k % 2) ? 1.0f : -1.0f;
+    const float offset = step * sign * float(1 + k % 3);
+    if (change == "recolour") {
+        for (Light& light : lights.lights) light.intensity *= 1.0f + 0.01f * sign * float(1 + k % 3);
+        return lights;
+    }
+    // move-one: the first point or spot light (what dragging a lamp does), else the first.
+    auto first = std::find_if(lights.lights.begin(), lights.lights.end(),
+                              [](const Light& l) { return l.type != LightType::Directional; });
+    if (first == lights.lights.end()) first = lights.lights.begin();
+    for (auto it = lights.lights.begin(); it != lights.lights.end(); ++it) {
+        if (change == "move-one" && it != first) continue;
+        if (it->type == LightType::Directional)
+            it->direction = glm::normalize(it->direction + glm::vec3(0.01f * offset / step, 0.0f, 0.0f));
+        else
+            it->position.x += offset;
+    }
+    return lights;
+}
+
+std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath) {
+    auto scene = loadScene(scenePath);
+    if (!scene) {
+        std::fprintf(stderr, "picbench: error: %s\n", scene.error().message.c_str());
+        return std::nullopt;
+    }
+    auto lights = loadLightSet(lightsPath, *scene);
+    if (!lights) {
+        std::fprintf(stderr, "picbench: error: %s\n", lights.error().message.c_str());
+        return std::nullopt;
+    }
+    if (lights->lights.empty())
+        std::fprintf(stderr, "picbench: warning: the light set has no punctual lights\n");
+    auto rays = EmbreeScene::create(*scene);
+    if (!rays) {
+        std::fprintf(stderr, "picbench: error: %s\n", rays.error().message.c_str());
+        return std::nullopt;
+    }
+    return BenchInputs{std::move(*scene), std::move(*lights), std::move(*rays)};
+}
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+int writeJson(const nlohmann::ordered_json& json, const std::string& path) {
+    std::ofstream out(path);
+    out << json.dump(2) << "\n";
+    if (!out) {
+        std::fprintf(stderr, "picbench: error: could not write %s\n", path.c_str());
+        return 1;
+    }
+    std::printf("written %s\n", path.c_str());
+    return 0;
+}
+
+}  // namespace pic

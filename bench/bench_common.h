@@ -1,0 +1,50 @@
+#pragma once
+/// What the picbench benchmarks share: medians, paper 000 Table 2's settings, the light
+/// changes they time, loading a scene with its lights and rays, and their JSON output.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "bake/embree_scene.h"
+#include "core/error.h"
+#include "core/light_set.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// Median of `values` (0 when empty).
+double median(std::vector<double> values);
+
+/// Paper 000 Table 2's settings as bake options: "moderate" (nS 32k, nL 128, lY 3) or
+/// "high" (nS 128k, nL 254, lY 4), lC 2, with "rtp" or "sh" links.
+BakeOptions settingOptions(const std::string& setting, const std::string& linkMode);
+
+/// The light set of update `k` under a kind of change: "move-all" (every light moves by a
+/// small step: point and spot lights along x, directional lights tilt), "move-one" (the
+/// first point or spot light moves, else the first light) or "recolour" (intensities
+/// change by a few per cent). `step` is in metres.
+LightSet changedLights(const LightSet& base, int k, float step, const std::string& change);
+
+/// A scene with its light set and rays.
+struct BenchInputs {
+    Scene scene;
+    LightSet lights;
+    std::unique_ptr<EmbreeScene> rays;
+};
+
+/// Loads the scene, its light set (`lightsPath` empty: the scene's own) and its rays;
+/// prints the error and returns nullopt on failure.
+std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath);
+
+/// Prints `error` on stderr and returns its exit code.
+int reportError(const Error& error);
+
+/// Writes `json` to `path` and says so; returns the exit code.
+int writeJson(const nlohmann::ordered_json& json, const std::string& path);
+
+}  // namespace pic
