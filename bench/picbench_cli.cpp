@@ -4,6 +4,7 @@
 
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
+#include "bench/codec_benchmark.h"
 #include "bench/runtime_benchmark.h"
 #include "bench/bake_benchmark.h"
 #include "bench/link_error_benchmark.h"
@@ -99,6 +100,24 @@ int picbenchMain(int argc, char** argv) {
     shadows->add_option("--device", shadowParams.device, "Vulkan device name substring");
     shadows->add_option("--json", shadowParams.jsonPath, "JSON file (default shadow_benchmark.json)");
 
+    CLI::App* codec = app.add_subcommand(
+        "codec", "stream frame sizes (key and delta, bits per SH coefficient) and codec ms under light changes");
+    CodecBenchmarkParams codecParams;
+    codec->add_option("--scene", codecParams.scenePath, "scene file (.gltf or .glb)")->required();
+    codec->add_option("--lights", codecParams.lightsPath, "light set JSON (default: the scene's lights)");
+    codec->add_option("--setting", codecParams.setting, "paper 000 Table 2 setting (default: moderate)")
+        ->check(CLI::IsMember({"moderate", "high"}));
+    codec->add_option("--link-mode", codecParams.linkMode, "link form (default: rtp)")
+        ->check(CLI::IsMember({"rtp", "sh"}));
+    codec->add_option("--backend", codecParams.backend, "runtime backend (default: cpu)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    codec->add_option("--change", codecParams.change, "light change per update: move-one, move-all, recolour (default: move-one)")
+        ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));
+    codec->add_option("--updates", codecParams.updates, "light changes after the first frame (default 10)")
+        ->check(CLI::Range(1, 100000));
+    codec->add_option("--zstd-level", codecParams.zstdLevel, "zstd level (default 3)")->check(CLI::Range(1, 19));
+    codec->add_option("--json", codecParams.jsonPath, "JSON file (default codec_benchmark.json)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -115,6 +134,7 @@ int picbenchMain(int argc, char** argv) {
     }
     if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
     if (shadows->parsed()) return runShadowBenchmark(shadowParams);
+    if (codec->parsed()) return runCodecBenchmark(codecParams);
     if (links->parsed()) {
         linkParams.bake = linkFlags.toOptions();
         return runLinkErrorBenchmark(linkParams);

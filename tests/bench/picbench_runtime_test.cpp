@@ -88,6 +88,23 @@ TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {
     EXPECT_LT(sizes[1].at("relative_l1").get<double>(), sizes[0].at("relative_l1").get<double>());
 }
 
+TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {
+    // picbench codec exits 1 if a decoded frame differs from the encoder's input.
+    const fs::path json = mDir / "codec.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("codec --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --updates 3 "
+                  "--json " + json.string(), err), 0) << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    const double key = report.at("key_bits_per_value_median").get<double>();
+    const double delta = report.at("delta_bits_per_value_median").get<double>();
+    EXPECT_GT(key, 0.0);
+    EXPECT_LT(key, 16.0);  // below raw halves
+    EXPECT_GT(delta, 0.0);
+    EXPECT_LT(delta, key);
+    EXPECT_EQ(report.at("frames").size(), 4u);
+}
+
 TEST_F(PicbenchRuntime, RefusesAnUnknownChange) {
     std::string err;
     EXPECT_EQ(run(std::string("runtime --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --changes teleport", err), 2);

@@ -1,0 +1,28 @@
+#pragma once
+/// `picbench codec`: what the stream costs per frame. Bakes the scene at a paper 000 Table 2
+/// setting, runs `updates` light changes on one runtime backend, turns each update's cache
+/// textures into the stream's half planes and encodes them as a key frame and as a delta
+/// from the previous update. Prints per-frame bytes as bits per SH coefficient (over the
+/// texture values the frame carries, and over the unique caches' coefficients), encode and
+/// decode ms, and checks that decoding gives back the encoder's input exactly (exit 1 if
+/// not). Writes JSON.
+
+#include <string>
+
+namespace pic {
+
+struct CodecBenchmarkParams {
+    std::string scenePath;
+    std::string lightsPath;            ///< empty: the scene's lights
+    std::string setting = "moderate";
+    std::string linkMode = "rtp";
+    std::string backend = "cpu";       ///< "cpu" or "gpu": the textures are the same to 1 %
+    std::string change = "move-one";   ///< bench_common.h changedLights
+    int updates = 10;
+    int zstdLevel = 3;
+    std::string jsonPath = "codec_benchmark.json";
+};
+
+int runCodecBenchmark(const CodecBenchmarkParams& params);
+
+}  // namespace pic
