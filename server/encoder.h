@@ -12,8 +12,8 @@ namespace pic {
 /// no infinity reaches a client. The GPU writes halves already, so this loses nothing there.
 HalfFrame halfFrameOf(const CacheTextures& textures);
 
-/// SH coefficients a frame carries per texel: lY² + 2·lC² over grid vertices and light-map
-/// texels, i.e. the values of all six planes.
+/// Values over all six planes: lY² + 2·lC² SH coefficients per grid vertex and light-map
+/// texel.
 size_t frameValues(const HalfFrame& frame);
 
 }  // namespace pic
