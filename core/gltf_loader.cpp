@@ -1,11 +1,13 @@
 #include "core/gltf_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <new>
 #include <set>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -1004,6 +1007,74 @@ Result<Scene> loadSceneUnguarded(const std::string& path, const LoadOptions& opt
 }
 
 }  // namespace
+
+namespace {
+
+/// The JSON text of a .gltf file or of a .glb file's first chunk.
+Result<std::string> gltfJsonText(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return fail(ErrorCode::NotFound, "cannot open scene file '{}'", path);
+    std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    if (file.bad()) return fail(ErrorCode::Io, "could not read scene file '{}'", path);
+    if (bytes.size() < kGlbMagic.size() ||
+        !std::equal(kGlbMagic.begin(), kGlbMagic.end(), bytes.begin()))
+        return bytes;
+    // GLB: 12-byte header, then chunk 0 = u32 length, u32 type "JSON", the JSON text.
+    constexpr size_t kChunkData = 20;
+    uint32_t length = 0;
+    uint32_t type = 0;
+    if (bytes.size() >= kChunkData) {
+        std::memcpy(&length, bytes.data() + 12, 4);
+        std::memcpy(&type, bytes.data() + 16, 4);
+    }
+    constexpr uint32_t kJsonChunk = 0x4E4F534Au;
+    if (bytes.size() < kChunkData || type != kJsonChunk || length > bytes.size() - kChunkData)
+        return fail(ErrorCode::Corrupt, "'{}' is not a valid GLB file (no JSON chunk)", path);
+    return bytes.substr(kChunkData, length);
+}
+
+std::string percentDecoded(const std::string& uri) {
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit((unsigned char)uri[i + 1]) &&
+            std::isxdigit((unsigned char)uri[i + 2])) {
+            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+Result<std::vector<std::string>> sceneFiles(const std::string& path) {
+    PIC_TRY_ASSIGN(std::string text, gltfJsonText(path));
+    nlohmann::json root = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (!root.is_object())
+        return fail(ErrorCode::Corrupt, "'{}' is not glTF: its JSON does not parse to an object",
+                    path);
+    std::vector<std::string> files{fs::path(path).filename().string()};
+    for (const char* list : {"buffers", "images"}) {
+        auto entries = root.find(list);
+        if (entries == root.end() || !entries->is_array()) continue;
+        for (const auto& entry : *entries) {
+            if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
+            std::string uri = entry["uri"].get<std::string>();
+            if (uri.starts_with("data:")) continue;
+            std::string file = percentDecoded(uri);
+            fs::path relative(file);
+            bool escapes = relative.is_absolute() || file.find("://") != std::string::npos;
+            for (const auto& part : relative) escapes = escapes || part == "..";
+            if (escapes)
+                return fail(ErrorCode::InvalidInput,
+                            "'{}': {} URI \"{}\" leaves the scene's folder", path, list, uri);
+            if (std::find(files.begin(), files.end(), file) == files.end()) files.push_back(file);
+        }
+    }
+    return files;
+}
 
 Result<Scene> loadScene(const std::string& path, const LoadOptions& options) {
     // Allocation failures and container limits surface as exceptions (in tinygltf, its JSON

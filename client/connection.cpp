@@ -1,0 +1,306 @@
+#include "client/connection.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "core/color.h"
+#include "core/gltf_loader.h"
+#include "proto/wire.h"
+
+namespace pic {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A deadline for unary calls: a server that hangs must not hang the client.
+void setDeadline(grpc::ClientContext& context) {
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+}
+
+/// An asset name from the server as a path inside `folder`, or InvalidInput when it would
+/// leave it (a server must not make a client write anywhere else).
+Result<fs::path> assetPath(const fs::path& folder, const std::string& name) {
+    fs::path relative(name);
+    bool escapes = name.empty() || relative.is_absolute();
+    for (const auto& part : relative) escapes = escapes || part == ".." || part == ".";
+    if (escapes)
+        return fail(ErrorCode::Corrupt, "the server sent an asset named \"{}\", outside its folder",
+                    name);
+    return folder / relative;
+}
+
+Result<void> writeFile(const fs::path& path, const std::string& bytes) {
+    std::error_code ec;
+    fs::create_directories(path.parent_path(), ec);
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    out.close();
+    if (!out) return fail(ErrorCode::Io, "cannot write {}", path.string());
+    return {};
+}
+
+}  // namespace
+
+FrameStream::FrameStream(v1::Pic::Stub& stub, const v1::SubscribeRequest& request) {
+    mReader = stub.Subscribe(&mContext, request);
+}
+
+FrameStream::~FrameStream() {
+    if (!mFinished) {
+        mContext.TryCancel();
+        v1::Frame drained;
+        while (mReader->Read(&drained)) {
+        }
+        mReader->Finish();
+    }
+}
+
+bool FrameStream::next(v1::Frame& frame) {
+    if (mFinished) return false;
+    if (mReader->Read(&frame)) return true;
+    mStatus = mReader->Finish();
+    mFinished = true;
+    return false;
+}
+
+void FrameStream::cancel() {
+    mContext.TryCancel();
+}
+
+grpc::Status FrameStream::status() {
+    return mStatus;
+}
+
+Result<std::unique_ptr<PicConnection>> PicConnection::connect(const std::string& address,
+                                                              std::chrono::milliseconds timeout) {
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(-1);
+    auto connection = std::unique_ptr<PicConnection>(new PicConnection());
+    connection->mAddress = address;
+    connection->mChannel =
+        grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments);
+    if (!connection->mChannel->WaitForConnected(std::chrono::system_clock::now() + timeout))
+        return fail(ErrorCode::Io, "cannot reach a picserver at {} (waited {} ms)", address,
+                    timeout.count());
+    connection->mStub = v1::Pic::NewStub(connection->mChannel);
+    return connection;
+}
+
+Result<v1::ListBakesResponse> PicConnection::listBakes() {
+    grpc::ClientContext context;
+    setDeadline(context);
+    v1::ListBakesResponse response;
+    grpc::Status status = mStub->ListBakes(&context, v1::ListBakesRequest(), &response);
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "ListBakes"));
+    return response;
+}
+
+Result<v1::CreateSessionResponse> PicConnection::createSession(const std::string& bakeId) {
+    grpc::ClientContext context;
+    setDeadline(context);
+    v1::CreateSessionRequest request;
+    request.set_bake_id(bakeId);
+    v1::CreateSessionResponse response;
+    grpc::Status status = mStub->CreateSession(&context, request, &response);
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "CreateSession"));
+    return response;
+}
+
+Result<v1::JoinSessionResponse> PicConnection::joinSession(const std::string& session,
+                                                           const std::string& token) {
+    grpc::ClientContext context;
+    setDeadline(context);
+    v1::JoinSessionRequest request;
+    request.set_session(session);
+    request.set_token(token);
+    v1::JoinSessionResponse response;
+    grpc::Status status = mStub->JoinSession(&context, request, &response);
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "JoinSession"));
+    return response;
+}
+
+Result<uint64_t> PicConnection::setLights(const std::string& session, const std::string& token,
+                                          const LightSet& lights) {
+    grpc::ClientContext context;
+    setDeadline(context);
+    v1::SetLightsRequest request;
+    request.set_session(session);
+    request.set_token(token);
+    *request.mutable_lights() = wire::toProto(lights);
+    v1::SetLightsResponse response;
+    grpc::Status status = mStub->SetLights(&context, request, &response);
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "SetLights"));
+    return response.version();
+}
+
+Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
+                                              const std::string& cacheDir) {
+    grpc::ClientContext context;
+    v1::GetSceneRequest request;
+    request.set_bake_id(bakeId);
+    auto reader = mStub->GetScene(&context, request);
+    v1::SceneChunk chunk;
+    if (!reader->Read(&chunk) || !chunk.has_header()) {
+        grpc::Status status = reader->Finish();
+        if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetScene"));
+        return fail(ErrorCode::Corrupt, "GetScene: the stream did not start with a header");
+    }
+    ClientScene client;
+    client.header = chunk.header();
+    const v1::SceneHeader& header = client.header;
+
+    // Into a fresh folder first, renamed into place when complete: a crash or a second client
+    // never leaves a half-written scene where the next run would load it.
+    const fs::path root = fs::path(cacheDir);
+    const fs::path folder = root / header.bake_id();
+    const fs::path staging = root / fmt::format("{}.tmp-{}", header.bake_id(), getpid());
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    fs::create_directories(staging, ec);
+    if (ec) return fail(ErrorCode::Io, "cannot create {}: {}", staging.string(), ec.message());
+
+    std::map<std::string, std::string> layout;
+    std::string pending;  // bytes received and not yet assigned to an asset
+    int asset = 0;
+    const auto flush = [&]() -> Result<void> {
+        while (asset < header.assets_size() && pending.size() >= header.assets(asset).size()) {
+            const v1::AssetInfo& info = header.assets(asset);
+            std::string bytes = pending.substr(0, info.size());
+            pending.erase(0, info.size());
+            if (info.name().starts_with("scene/")) {
+                PIC_TRY_ASSIGN(fs::path path, assetPath(staging, info.name().substr(6)));
+                PIC_TRY(writeFile(path, bytes));
+            } else {
+                layout[info.name()] = std::move(bytes);
+            }
+            ++asset;
+        }
+        return {};
+    };
+    uint64_t received = 0;
+    while (reader->Read(&chunk)) {
+        if (!chunk.has_data()) return fail(ErrorCode::Corrupt, "GetScene: a second header");
+        received += chunk.data().size();
+        if (received > header.total_bytes())
+            return fail(ErrorCode::Corrupt, "GetScene: more bytes than the header's {}",
+                        header.total_bytes());
+        pending += chunk.data();
+        PIC_TRY(flush());
+    }
+    grpc::Status status = reader->Finish();
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetScene"));
+    PIC_TRY(flush());
+    if (received != header.total_bytes() || asset != header.assets_size())
+        return fail(ErrorCode::Corrupt, "GetScene: received {} of {} bytes", received,
+                    header.total_bytes());
+
+    fs::remove_all(folder, ec);
+    fs::rename(staging, folder, ec);
+    if (ec)
+        return fail(ErrorCode::Io, "cannot move {} to {}: {}", staging.string(), folder.string(),
+                    ec.message());
+    client.folder = folder.string();
+
+    if (!header.scene_file().starts_with("scene/"))
+        return fail(ErrorCode::Corrupt, "GetScene: scene file \"{}\" is not a scene asset",
+                    header.scene_file());
+    PIC_TRY_ASSIGN(fs::path scenePath, assetPath(folder, header.scene_file().substr(6)));
+    PIC_TRY_ASSIGN(client.scene, loadScene(scenePath.string()));
+    if (client.scene.hash != header.scene_hash())
+        return fail(ErrorCode::Corrupt,
+                    "the downloaded scene has hash {:016x}, the server's bake is of {:016x}",
+                    client.scene.hash, header.scene_hash());
+
+    const std::string& uvs = layout["layout/triangle_uvs"];
+    if (uvs.size() != client.scene.triangles.size() * 3 * sizeof(glm::vec2))
+        return fail(ErrorCode::Corrupt, "layout/triangle_uvs holds {} bytes for {} triangles",
+                    uvs.size(), client.scene.triangles.size());
+    client.triangleUvs.resize(client.scene.triangles.size() * 3);
+    if (!uvs.empty()) std::memcpy(client.triangleUvs.data(), uvs.data(), uvs.size());
+    const std::string& grid = layout["layout/grid_coverage"];
+    const std::string& lightmap = layout["layout/lightmap_coverage"];
+    const uint64_t vertices =
+        uint64_t(header.grid().dims_x()) * header.grid().dims_y() * header.grid().dims_z();
+    const uint64_t texels = uint64_t(header.lightmap_width()) * header.lightmap_height();
+    if (grid.size() != vertices || lightmap.size() != texels)
+        return fail(ErrorCode::Corrupt,
+                    "coverage of {} grid vertices and {} texels for a layout of {} and {}",
+                    grid.size(), lightmap.size(), vertices, texels);
+    client.gridCoverage.assign(grid.begin(), grid.end());
+    client.lightmapCoverage.assign(lightmap.begin(), lightmap.end());
+    return client;
+}
+
+std::unique_ptr<FrameStream> PicConnection::subscribe(const std::string& session,
+                                                      const std::string& token) {
+    v1::SubscribeRequest request;
+    request.set_session(session);
+    request.set_token(token);
+    return std::make_unique<FrameStream>(*mStub, request);
+}
+
+Result<void> FrameDecoder::apply(v1::Frame& frame) {
+    if (frame.base_version() != 0 && frame.base_version() != mVersion)
+        return fail(ErrorCode::Corrupt,
+                    "frame of version {} is a delta against version {}, but version {} is held",
+                    frame.version(), frame.base_version(), mVersion);
+    PIC_TRY_ASSIGN(EncodedFrame encoded, wire::planesFromProto(frame));
+    if (encoded.key()) {
+        // A key frame sets the sizes; decode into a copy so a corrupt one changes nothing.
+        HalfFrame decoded;
+        for (int t = 0; t < kFrameTextures; ++t)
+            decoded.planes[size_t(t)].resize(encoded.planes[size_t(t)].values);
+        PIC_TRY(decodeFrame(encoded, decoded));
+        mFrame = std::move(decoded);
+    } else {
+        PIC_TRY(decodeFrame(encoded, mFrame));
+    }
+    mVersion = frame.version();
+    return {};
+}
+
+Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame) {
+    const v1::SceneHeader& header = scene.header;
+    CacheTextures textures;
+    textures.bandsY = header.bands_y();
+    textures.bandsC = header.bands_c();
+    textures.gridDims = glm::uvec3(header.grid().dims_x(), header.grid().dims_y(),
+                                   header.grid().dims_z());
+    textures.lightmapWidth = header.lightmap_width();
+    textures.lightmapHeight = header.lightmap_height();
+    const size_t vertices = scene.gridCoverage.size();
+    const size_t texels = scene.lightmapCoverage.size();
+    for (int ch = 0; ch < 3; ++ch) {
+        const std::vector<uint16_t>& grid = frame.planes[size_t(ch)];
+        const std::vector<uint16_t>& lightmap = frame.planes[size_t(3 + ch)];
+        const size_t layers = textures.layers(ch);
+        if (grid.size() != layers * vertices || lightmap.size() != layers * texels)
+            return fail(ErrorCode::InvalidInput,
+                        "frame planes {} and {} hold {} and {} values; the layout needs {} × {} "
+                        "and {} × {}",
+                        frameTextureName(ch), frameTextureName(3 + ch), grid.size(),
+                        lightmap.size(), layers, vertices, layers, texels);
+        textures.grid[size_t(ch)].resize(grid.size());
+        for (size_t i = 0; i < grid.size(); ++i) textures.grid[size_t(ch)][i] = halfToFloat(grid[i]);
+        textures.lightmap[size_t(ch)].resize(lightmap.size());
+        for (size_t i = 0; i < lightmap.size(); ++i)
+            textures.lightmap[size_t(ch)][i] = halfToFloat(lightmap[i]);
+    }
+    textures.gridCoverage.assign(scene.gridCoverage.begin(), scene.gridCoverage.end());
+    textures.lightmapCoverage.assign(scene.lightmapCoverage.begin(), scene.lightmapCoverage.end());
+    return textures;
+}
+
+std::string defaultCacheDir() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+        return (fs::path(xdg) / "pic").string();
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return (fs::path(home) / ".cache" / "pic").string();
+    return "/tmp/pic-cache";
+}
+
+}  // namespace pic

@@ -1,0 +1,110 @@
+#pragma once
+/// The thin client's side of the wire (proto/pic.proto): a connection to a picserver, the
+/// scene download, the frame stream and the decoder that turns frames back into the cache
+/// textures the server computed.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+
+#include "core/error.h"
+#include "core/frame_codec.h"
+#include "core/light_set.h"
+#include "core/scene.h"
+#include "proto/pic.grpc.pb.h"
+#include "server/cpu/lightmap_copy.h"
+
+namespace pic {
+
+/// A bake's scene as a thin client holds it: the scene loaded from the downloaded files and
+/// what it needs to place and sample the cache textures.
+struct ClientScene {
+    v1::SceneHeader header;
+    std::string folder;                     ///< where the assets were written
+    Scene scene;
+    std::vector<glm::vec2> triangleUvs;     ///< 3 light-map UVs per triangle (kNotLightmapped: grid)
+    std::vector<uint8_t> gridCoverage;      ///< 1 per grid vertex that holds a cache
+    std::vector<uint8_t> lightmapCoverage;  ///< 1 per light-map texel that holds a cache
+};
+
+/// One Subscribe call: frames as they arrive, until the stream ends or is cancelled.
+class FrameStream {
+public:
+    FrameStream(v1::Pic::Stub& stub, const v1::SubscribeRequest& request);
+    ~FrameStream();
+
+    /// Blocks for the next frame into `frame`; false when the stream has ended (status() says
+    /// why).
+    bool next(v1::Frame& frame);
+    /// Ends the stream from any thread; next() then returns false.
+    void cancel();
+    /// The stream's final status, once next() returned false.
+    grpc::Status status();
+
+private:
+    grpc::ClientContext mContext;
+    std::unique_ptr<grpc::ClientReader<v1::Frame>> mReader;
+    bool mFinished = false;
+    grpc::Status mStatus;
+};
+
+/// A channel to one picserver and its calls, each returning the server's refusal as an Error
+/// that names the call and the status (INVALID_ARGUMENT → InvalidInput, ...).
+class PicConnection {
+public:
+    /// Connects to `address` ("HOST:PORT"), waiting up to `timeout` for the server; Io when it
+    /// cannot be reached.
+    static Result<std::unique_ptr<PicConnection>> connect(
+        const std::string& address, std::chrono::milliseconds timeout = std::chrono::seconds(10));
+
+    const std::string& address() const { return mAddress; }
+    v1::Pic::Stub& stub() { return *mStub; }
+
+    Result<v1::ListBakesResponse> listBakes();
+    Result<v1::CreateSessionResponse> createSession(const std::string& bakeId = "");
+    Result<v1::JoinSessionResponse> joinSession(const std::string& session, const std::string& token);
+    /// Pushes a light set; the version it will produce.
+    Result<uint64_t> setLights(const std::string& session, const std::string& token,
+                               const LightSet& lights);
+    /// Downloads the assets of bake `bakeId` (empty: the server's first) into a fresh folder
+    /// under `cacheDir` (replacing an older copy atomically) and loads them; Corrupt when the
+    /// loaded scene's hash is not the one the server announced.
+    Result<ClientScene> fetchScene(const std::string& bakeId, const std::string& cacheDir);
+    /// Starts a Subscribe stream.
+    std::unique_ptr<FrameStream> subscribe(const std::string& session, const std::string& token);
+
+private:
+    std::string mAddress;
+    std::shared_ptr<grpc::Channel> mChannel;
+    std::unique_ptr<v1::Pic::Stub> mStub;
+};
+
+/// Turns a session's frames back into the textures, exactly: key frames replace the held
+/// version, delta frames apply to the version they were made from.
+class FrameDecoder {
+public:
+    /// Decodes `frame` (its bytes are moved out). Corrupt when it is a delta against a version
+    /// other than the one held, or does not decode; the held version is then unchanged.
+    Result<void> apply(v1::Frame& frame);
+    /// The version held, 0 before the first key frame.
+    uint64_t version() const { return mVersion; }
+    const HalfFrame& frame() const { return mFrame; }
+
+private:
+    HalfFrame mFrame;
+    uint64_t mVersion = 0;
+};
+
+/// The textures of `frame` for `scene`: halves widened to floats, coverage from the layout.
+/// InvalidInput when the frame's planes do not match the scene's layout and band counts.
+Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);
+
+/// The default folder for downloaded scenes: $XDG_CACHE_HOME/pic, else ~/.cache/pic, else
+/// /tmp/pic-cache.
+std::string defaultCacheDir();
+
+}  // namespace pic

@@ -1,0 +1,37 @@
+#pragma once
+/// Conversions between the wire messages of proto/pic.proto and pic's own types, shared by
+/// the server and the client so that both sides read the wire the same way.
+
+#include <string>
+
+#include <grpcpp/support/status.h>
+
+#include "core/error.h"
+#include "core/frame_codec.h"
+#include "core/light_set.h"
+#include "proto/pic.pb.h"
+
+namespace pic::wire {
+
+/// A light set as the wire carries it: only the fields each light type uses, no range for
+/// "no cut-off".
+v1::LightSet toProto(const LightSet& lights);
+
+/// Reads and validates a wire light set under the rules of parseLightSet (core/light_set.h),
+/// naming the offending field ("lights[2].intensity") and value: InvalidInput.
+Result<LightSet> fromProto(const v1::LightSet& lights);
+
+/// The six planes of an encoded frame into `frame` (other fields untouched).
+void toProto(const EncodedFrame& encoded, v1::Frame& frame);
+
+/// The planes of a wire frame: Corrupt when there are not six, in texture order, with known
+/// encodings. The bytes are moved out of `frame`.
+Result<EncodedFrame> planesFromProto(v1::Frame& frame);
+
+/// The gRPC status for an Error: InvalidInput → INVALID_ARGUMENT, NotFound → NOT_FOUND, ...
+grpc::Status toStatus(const Error& error);
+
+/// The Error for a failed call: the status code's name and its message, prefixed by `call`.
+Error fromStatus(const grpc::Status& status, const std::string& call);
+
+}  // namespace pic::wire

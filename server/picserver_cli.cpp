@@ -1,0 +1,155 @@
+#include "server/picserver_cli.h"
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <future>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <pthread.h>
+
+#include <CLI/CLI.hpp>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "server/service.h"
+
+namespace pic {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picserver: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// The update's line on stdout: version, ms per pass, encode ms, bytes, subscribers.
+void logUpdate(const UpdateLog& log) {
+    const Update& update = *log.update;
+    std::string passes;
+    for (const auto& [pass, ms] : update.stats.passMs) passes += fmt::format(" {}_ms={:.1f}", pass, ms);
+    size_t bytes = 0;
+    for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
+    std::string base = update.baseVersion == 0 ? std::string("key")
+                                               : fmt::format("delta:{}", update.baseVersion);
+    std::printf("update session=%s version=%llu bounces=%d%s update_ms=%.1f encode_ms=%.1f "
+                "bytes=%zu frame=%s subscribers=%zu\n",
+                log.session.c_str(), (unsigned long long)update.version, update.stats.bounces,
+                passes.c_str(), update.broadcast->update_ms(), update.encodeMs, bytes,
+                base.c_str(), log.subscribers);
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+int picserverMain(int argc, char** argv) {
+    CLI::App app{"picserver: relights baked scenes on light changes and streams the caches to "
+                 "the clients of each session over gRPC"};
+    app.name("picserver");
+    std::vector<std::string> bakePaths;
+    std::vector<std::string> scenePaths;
+    std::string listen = "127.0.0.1:50051";
+    ServeOptions serve;
+    ServerOptions options;
+    int threads = 0;
+    bool quiet = false;
+    app.add_option("--bake", bakePaths, "bake file (.pic); repeat with --scene for several bakes")
+        ->required();
+    app.add_option("--scene", scenePaths, "the scene each --bake was made from, in order")
+        ->required();
+    app.add_option("--listen", listen, "HOST:PORT to serve on; port 0 picks a free one");
+    app.add_option("--backend", serve.backend, "runtime backend (cpu: the CPU twin)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    app.add_option("--device", serve.device,
+                   "gpu backend: Vulkan device whose name contains this (default: a discrete "
+                   "GPU, else integrated, else lavapipe)");
+    app.add_option("--shadow-map-size", serve.shadowMapSize,
+                   "gpu backend: texels per side of each shadow-map layer")
+        ->check(CLI::Range(16u, 8192u));
+    app.add_option("--bounces", serve.bounces.bounces,
+                   "cache passes per update: 0 = direct light only, B = up to B reflections "
+                   "(default: until a bounce adds < 0.5 % of the flux, at most 8)")
+        ->check(CLI::Range(-1, 64));
+    app.add_option("--keyframe-interval", options.session.keyframeInterval,
+                   "every N-th version is streamed as a key frame, the others as deltas")
+        ->check(CLI::Range(1u, 100000u));
+    app.add_option("--zstd-level", options.session.zstdLevel, "zstd level of the frames")
+        ->check(CLI::Range(1, 19));
+    app.add_option("--max-sessions", options.maxSessions, "sessions the server holds at most")
+        ->check(CLI::Range(size_t(1), size_t(100000)));
+    app.add_option("--threads", threads, "worker threads of the CPU passes (0 = all cores)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--quiet", quiet, "no progress bars");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+    if (bakePaths.size() != scenePaths.size()) {
+        std::fprintf(stderr, "picserver: error: %zu --bake but %zu --scene; give one scene per bake\n",
+                     bakePaths.size(), scenePaths.size());
+        return 2;
+    }
+    // SIGINT and SIGTERM go to one thread, never to whichever thread gRPC, TBB or Vulkan runs:
+    // before the server is up they end the process at once, after it they shut it down.
+    sigset_t stopSignals;
+    sigemptyset(&stopSignals);
+    sigaddset(&stopSignals, SIGINT);
+    sigaddset(&stopSignals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+    std::atomic<bool> serving{false};
+    std::promise<int> stopped;
+    std::thread signalThread([&] {
+        int signal = 0;
+        sigwait(&stopSignals, &signal);
+        if (!serving) {
+            std::fprintf(stderr, "picserver: interrupted while loading\n");
+            std::_Exit(130);
+        }
+        stopped.set_value(signal);
+    });
+    signalThread.detach();
+
+    setWorkerCount(threads);
+    Progress::setEnabled(!quiet);
+
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    for (size_t i = 0; i < bakePaths.size(); ++i) {
+        const auto start = Clock::now();
+        auto bake = ServedBake::load(bakePaths[i], scenePaths[i], serve);
+        if (!bake) return reportError(bake.error());
+        const v1::BakeSummary& summary = (*bake)->summary();
+        std::fprintf(stderr,
+                     "picserver: bake %s: %s, %u triangles, %u surfels, %u caches × %u %s links, "
+                     "%s backend%s%s, loaded in %.1f s\n",
+                     summary.bake_id().c_str(), summary.scene_name().c_str(), summary.triangles(),
+                     summary.surfels(), summary.caches(), summary.links_per_cache(),
+                     summary.link_mode().c_str(), serve.backend.c_str(),
+                     (*bake)->device().empty() ? "" : " on ", (*bake)->device().c_str(),
+                     std::chrono::duration<double>(Clock::now() - start).count());
+        bakes.push_back(std::move(*bake));
+    }
+
+    options.session.log = logUpdate;
+    auto server = PicServer::start(std::move(bakes), listen, std::move(options));
+    if (!server) return reportError(server.error());
+    std::printf("listening on %s\n", (*server)->address().c_str());
+    std::fflush(stdout);
+
+    serving = true;
+    const int signal = stopped.get_future().get();
+    std::fprintf(stderr, "picserver: %s, shutting down\n", signal == SIGINT ? "SIGINT" : "SIGTERM");
+    (*server)->shutdown();
+    return 0;
+}
+
+}  // namespace pic

@@ -1,0 +1,72 @@
+#pragma once
+/// A bake as the server serves it (ARCHITECTURE §1): the scene, the bake data, the one
+/// runtime that relights it for every session on it, and the assets thin clients download.
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "bake/embree_scene.h"
+#include "core/bake_data.h"
+#include "core/error.h"
+#include "core/frame_codec.h"
+#include "core/scene.h"
+#include "proto/pic.pb.h"
+#include "server/runtime.h"
+
+namespace pic {
+
+/// How the server relights its bakes.
+struct ServeOptions {
+    std::string backend = "gpu";    ///< "gpu" or "cpu" (the CPU twin)
+    std::string device;             ///< gpu: substring of the Vulkan device name; empty = best
+    uint32_t shadowMapSize = 1024;  ///< gpu: texels per side of each shadow-map layer
+    BounceParams bounces;           ///< progressive by default, as everywhere
+};
+
+/// Bytes of one SceneChunk data message.
+inline constexpr size_t kSceneChunkBytes = 1u << 20;
+
+class ServedBake {
+public:
+    /// Loads the scene and its bake (refusing a bake of another scene), builds the runtime and
+    /// the client assets. Errors name the file and the problem.
+    static Result<std::unique_ptr<ServedBake>> load(const std::string& bakePath,
+                                                    const std::string& scenePath,
+                                                    const ServeOptions& options);
+
+    /// 16 hex digits: a hash of the bake file's bytes.
+    const std::string& id() const { return mId; }
+    const Scene& scene() const { return mScene; }
+    const BakeData& bake() const { return mBake; }
+    /// The summary ListBakes returns.
+    const v1::BakeSummary& summary() const { return mSummary; }
+    /// The header GetScene sends first; the assets' bytes follow in its order.
+    const v1::SceneHeader& header() const { return mHeader; }
+    const std::vector<std::string>& assetBytes() const { return mAssetBytes; }
+    /// The Vulkan device of the GPU backend, empty for the CPU twin.
+    const std::string& device() const { return mDevice; }
+
+    /// Relights the scene with `lights` and copies the resulting textures as half floats, one
+    /// session at a time (the runtime keeps per-light state such as shadow maps).
+    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame);
+
+private:
+    ServedBake() = default;
+    Result<void> buildAssets(const std::string& scenePath);
+
+    std::string mId;
+    Scene mScene;
+    BakeData mBake;
+    std::unique_ptr<EmbreeScene> mRays;
+    std::unique_ptr<Runtime> mRuntime;
+    std::mutex mRuntimeMutex;
+    std::string mDevice;
+    v1::BakeSummary mSummary;
+    v1::SceneHeader mHeader;
+    std::vector<std::string> mAssetBytes;
+};
+
+}  // namespace pic

@@ -1,0 +1,370 @@
+#include "server/service.h"
+
+#include <atomic>
+#include <chrono>
+#include <random>
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include "proto/pic.grpc.pb.h"
+#include "proto/wire.h"
+
+namespace pic {
+
+struct PicServer::State {
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    ServerOptions options;
+    mutable std::mutex mutex;
+    std::map<std::string, std::shared_ptr<Session>> sessions;
+    std::atomic<bool> stopping{false};
+    std::mt19937_64 random{std::random_device{}()};
+
+    /// The bake `id` names, or the first one when `id` is empty.
+    ServedBake* findBake(const std::string& id) const {
+        if (id.empty()) return bakes.front().get();
+        for (const auto& bake : bakes)
+            if (bake->id() == id) return bake.get();
+        return nullptr;
+    }
+
+    std::shared_ptr<Session> findSession(const std::string& id) const {
+        std::lock_guard lock(mutex);
+        auto it = sessions.find(id);
+        return it == sessions.end() ? nullptr : it->second;
+    }
+
+    /// `bits` random bits as hex (under `mutex`).
+    std::string randomHex(int words) {
+        std::string hex;
+        for (int i = 0; i < words; ++i) hex += fmt::format("{:016x}", random());
+        return hex;
+    }
+};
+
+namespace {
+
+/// Compares tokens in time independent of where they differ.
+bool sameToken(const std::string& a, const std::string& b) {
+    if (a.size() != b.size()) return false;
+    unsigned char diff = 0;
+    for (size_t i = 0; i < a.size(); ++i) diff |= (unsigned char)(a[i] ^ b[i]);
+    return diff == 0;
+}
+
+/// The session `id` and the role `token` grants in it, or the status to fail with.
+struct Access {
+    std::shared_ptr<Session> session;
+    v1::Role role = v1::ROLE_UNSPECIFIED;
+    grpc::Status status;
+};
+
+Access authorise(const PicServer::State& state, const std::string& id, const std::string& token) {
+    Access access;
+    if (state.stopping) {
+        access.status = grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+        return access;
+    }
+    access.session = state.findSession(id);
+    if (!access.session) {
+        access.status = grpc::Status(grpc::StatusCode::NOT_FOUND,
+                                     fmt::format("no session \"{}\"", id));
+        return access;
+    }
+    if (sameToken(token, access.session->editorToken()))
+        access.role = v1::EDITOR;
+    else if (sameToken(token, access.session->viewerToken()))
+        access.role = v1::VIEWER;
+    else
+        access.status = grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                                     fmt::format("the token is not one of session \"{}\"", id));
+    return access;
+}
+
+/// GetScene: the header, then the assets' bytes in chunks, one write at a time.
+class SceneWriter final : public grpc::ServerWriteReactor<v1::SceneChunk> {
+public:
+    explicit SceneWriter(const ServedBake& bake) : mBake(bake) {
+        *mChunk.mutable_header() = bake.header();
+        StartWrite(&mChunk);
+    }
+
+    void OnWriteDone(bool ok) override {
+        if (!ok) return Finish(grpc::Status(grpc::StatusCode::CANCELLED, "write failed"));
+        const auto& assets = mBake.assetBytes();
+        std::string data;
+        while (data.size() < kSceneChunkBytes && mAsset < assets.size()) {
+            const std::string& bytes = assets[mAsset];
+            const size_t n = std::min(kSceneChunkBytes - data.size(), bytes.size() - mOffset);
+            data.append(bytes, mOffset, n);
+            mOffset += n;
+            if (mOffset == bytes.size()) {
+                ++mAsset;
+                mOffset = 0;
+            }
+        }
+        if (data.empty()) return Finish(grpc::Status::OK);
+        mChunk.set_data(std::move(data));
+        StartWrite(&mChunk);
+    }
+
+    void OnDone() override { delete this; }
+
+private:
+    const ServedBake& mBake;
+    v1::SceneChunk mChunk;
+    size_t mAsset = 0;
+    size_t mOffset = 0;
+};
+
+/// Subscribe: takes the newest update from its latest-wins slot whenever no write is in
+/// flight, so a slow client skips versions and holds at most one frame in the server.
+class FrameWriter final : public grpc::ServerWriteReactor<v1::Frame> {
+public:
+    explicit FrameWriter(std::shared_ptr<Session> session) : mSession(std::move(session)) {
+        // The slot may wake after this reactor is gone (a publish that copied the slot list
+        // before unsubscribe); the link tells it so.
+        mLink = std::make_shared<Link>();
+        mLink->writer = this;
+        mSlot = mSession->subscribe([link = mLink] {
+            std::lock_guard lock(link->mutex);
+            if (link->writer) link->writer->pump();
+        });
+    }
+
+    void OnWriteDone(bool ok) override {
+        {
+            std::lock_guard lock(mLink->mutex);
+            mInFlight.reset();
+            mWriting = false;
+            if (!ok || mCancelled) {
+                finishOnce(grpc::Status(grpc::StatusCode::CANCELLED, "the stream ended"));
+                return;
+            }
+            pump();
+        }
+    }
+
+    void OnCancel() override {
+        std::lock_guard lock(mLink->mutex);
+        mCancelled = true;
+        if (!mWriting) finishOnce(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled"));
+    }
+
+    void OnDone() override {
+        {
+            std::lock_guard lock(mLink->mutex);
+            mLink->writer = nullptr;
+        }
+        mSession->unsubscribe(mSlot.get());
+        delete this;
+    }
+
+private:
+    struct Link {
+        std::mutex mutex;
+        FrameWriter* writer = nullptr;
+    };
+
+    /// Starts the next write if none is in flight (under the link's lock). gRPC never runs
+    /// OnWriteDone inline from StartWrite, so holding the lock here cannot deadlock.
+    void pump() {
+        if (mWriting || mCancelled || mFinished) return;
+        std::shared_ptr<const Update> update = mSlot->take();
+        if (!update) return;
+        std::shared_ptr<const v1::Frame> frame = update->frameFor(mHeld);
+        if (!frame) {
+            finishOnce(grpc::Status(grpc::StatusCode::INTERNAL,
+                                    fmt::format("no frame for version {}", update->version)));
+            return;
+        }
+        mHeld = update->version;
+        mInFlight = std::move(frame);
+        mWriting = true;
+        StartWrite(mInFlight.get());
+    }
+
+    void finishOnce(grpc::Status status) {
+        if (mFinished) return;
+        mFinished = true;
+        Finish(std::move(status));
+    }
+
+    std::shared_ptr<Session> mSession;
+    std::shared_ptr<Link> mLink;
+    std::shared_ptr<SubscriberSlot> mSlot;
+    std::shared_ptr<const v1::Frame> mInFlight;  ///< alive until its write is done
+    uint64_t mHeld = 0;                          ///< version the client holds
+    bool mWriting = false;
+    bool mCancelled = false;
+    bool mFinished = false;
+};
+
+class Service final : public v1::Pic::CallbackService {
+public:
+    explicit Service(std::shared_ptr<PicServer::State> state) : mState(std::move(state)) {}
+
+    grpc::ServerUnaryReactor* ListBakes(grpc::CallbackServerContext* context,
+                                        const v1::ListBakesRequest*,
+                                        v1::ListBakesResponse* response) override {
+        for (const auto& bake : mState->bakes) *response->add_bakes() = bake->summary();
+        response->set_backend(mState->bakes.front()->device().empty() ? "cpu" : "gpu");
+        response->set_device(mState->bakes.front()->device());
+        return finish(context, grpc::Status::OK);
+    }
+
+    grpc::ServerWriteReactor<v1::SceneChunk>* GetScene(grpc::CallbackServerContext*,
+                                                       const v1::GetSceneRequest* request) override {
+        const ServedBake* bake = mState->findBake(request->bake_id());
+        if (!bake)
+            return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::SceneChunk>>(
+                grpc::Status(grpc::StatusCode::NOT_FOUND,
+                             fmt::format("no bake \"{}\"", request->bake_id())));
+        return new SceneWriter(*bake);
+    }
+
+    grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* context,
+                                            const v1::CreateSessionRequest* request,
+                                            v1::CreateSessionResponse* response) override {
+        if (mState->stopping)
+            return finish(context, grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                                "the server is shutting down"));
+        ServedBake* bake = mState->findBake(request->bake_id());
+        if (!bake)
+            return finish(context, grpc::Status(grpc::StatusCode::NOT_FOUND,
+                                                fmt::format("no bake \"{}\"", request->bake_id())));
+        std::shared_ptr<Session> session;
+        {
+            std::lock_guard lock(mState->mutex);
+            if (mState->sessions.size() >= mState->options.maxSessions)
+                return finish(context,
+                              grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                           fmt::format("the server holds its maximum of {} sessions",
+                                                       mState->options.maxSessions)));
+            std::string id = mState->randomHex(1);
+            while (mState->sessions.contains(id)) id = mState->randomHex(1);
+            session = std::make_shared<Session>(id, mState->randomHex(2), mState->randomHex(2),
+                                                *bake, mState->options.session);
+            mState->sessions[id] = session;
+        }
+        response->set_session(session->id());
+        response->set_editor_token(session->editorToken());
+        response->set_viewer_token(session->viewerToken());
+        response->set_bake_id(bake->id());
+        response->set_version(session->latestVersion());
+        return finish(context, grpc::Status::OK);
+    }
+
+    grpc::ServerUnaryReactor* JoinSession(grpc::CallbackServerContext* context,
+                                          const v1::JoinSessionRequest* request,
+                                          v1::JoinSessionResponse* response) override {
+        Access access = authorise(*mState, request->session(), request->token());
+        if (!access.status.ok()) return finish(context, access.status);
+        response->set_role(access.role);
+        response->set_bake_id(access.session->bake().id());
+        response->set_version(access.session->latestVersion());
+        *response->mutable_lights() = wire::toProto(access.session->latestLights());
+        return finish(context, grpc::Status::OK);
+    }
+
+    grpc::ServerUnaryReactor* SetLights(grpc::CallbackServerContext* context,
+                                        const v1::SetLightsRequest* request,
+                                        v1::SetLightsResponse* response) override {
+        Access access = authorise(*mState, request->session(), request->token());
+        if (!access.status.ok()) return finish(context, access.status);
+        if (access.role != v1::EDITOR)
+            return finish(context, grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
+                                                "only an editor token may set lights"));
+        auto lights = wire::fromProto(request->lights());
+        if (!lights) return finish(context, wire::toStatus(lights.error()));
+        auto version = access.session->setLights(std::move(*lights));
+        if (!version) return finish(context, wire::toStatus(version.error()));
+        response->set_version(*version);
+        return finish(context, grpc::Status::OK);
+    }
+
+    grpc::ServerWriteReactor<v1::Frame>* Subscribe(grpc::CallbackServerContext*,
+                                                   const v1::SubscribeRequest* request) override {
+        Access access = authorise(*mState, request->session(), request->token());
+        if (!access.status.ok())
+            return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::Frame>>(
+                access.status);
+        return new FrameWriter(std::move(access.session));
+    }
+
+private:
+    static grpc::ServerUnaryReactor* finish(grpc::CallbackServerContext* context,
+                                            grpc::Status status) {
+        grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+        reactor->Finish(std::move(status));
+        return reactor;
+    }
+
+    std::shared_ptr<PicServer::State> mState;
+};
+
+}  // namespace
+
+Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<ServedBake>> bakes,
+                                                    const std::string& listen,
+                                                    ServerOptions options) {
+    if (bakes.empty()) return fail(ErrorCode::InvalidInput, "the server needs at least one bake");
+    const size_t colon = listen.rfind(':');
+    if (colon == std::string::npos || colon == 0 || colon + 1 == listen.size())
+        return fail(ErrorCode::InvalidInput, "--listen must be HOST:PORT, got \"{}\"", listen);
+
+    std::unique_ptr<PicServer> server(new PicServer());
+    server->mState = std::make_shared<State>();
+    server->mState->bakes = std::move(bakes);
+    server->mState->options = std::move(options);
+    server->mService = std::make_unique<Service>(server->mState);
+
+    grpc::EnableDefaultHealthCheckService(true);
+    grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+    grpc::ServerBuilder builder;
+    int port = 0;
+    builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
+    builder.RegisterService(server->mService.get());
+    // Scene assets go in 1 MiB chunks, but key frames of large bakes can be bigger.
+    builder.SetMaxSendMessageSize(-1);
+    server->mServer = builder.BuildAndStart();
+    if (!server->mServer || port == 0)
+        return fail(ErrorCode::InvalidInput, "cannot listen on \"{}\" (address in use or invalid)",
+                    listen);
+    server->mAddress = fmt::format("{}:{}", listen.substr(0, colon), port);
+    if (auto* health = server->mServer->GetHealthCheckService())
+        health->SetServingStatus(true);
+    return server;
+}
+
+PicServer::~PicServer() {
+    shutdown();
+}
+
+void PicServer::wait() {
+    if (mServer) mServer->Wait();
+}
+
+void PicServer::shutdown() {
+    std::lock_guard lock(mShutdownMutex);
+    if (mShutDown || !mServer) return;
+    mShutDown = true;
+    mState->stopping = true;
+    if (auto* health = mServer->GetHealthCheckService()) health->SetServingStatus(false);
+    // Streams never end on their own: cancel them after a short grace period.
+    mServer->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(200));
+    mServer->Wait();
+    std::map<std::string, std::shared_ptr<Session>> sessions;
+    {
+        std::lock_guard stateLock(mState->mutex);
+        sessions.swap(mState->sessions);
+    }
+    sessions.clear();  // joins each session's worker
+}
+
+std::shared_ptr<Session> PicServer::session(const std::string& id) const {
+    return mState->findSession(id);
+}
+
+}  // namespace pic

@@ -1,0 +1,211 @@
+#include "server/session.h"
+
+#include <cstdio>
+
+#include "proto/wire.h"
+#include "server/served_bake.h"
+
+namespace pic {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+std::shared_ptr<const v1::Frame> Update::frameFor(uint64_t held) const {
+    if (baseVersion == 0 || held == baseVersion) return broadcast;
+    std::call_once(mKeyOnce, [this] {
+        const auto start = Clock::now();
+        auto encoded = encodeFrame(*frame, nullptr, zstdLevel);
+        if (!encoded) {
+            std::fprintf(stderr, "picserver: key frame of version %llu failed: %s\n",
+                         (unsigned long long)version, encoded.error().message.c_str());
+            return;
+        }
+        auto key = std::make_shared<v1::Frame>(*broadcast);
+        key->set_base_version(0);
+        wire::toProto(*encoded, *key);
+        key->set_encode_ms(millisecondsSince(start));
+        mKey = std::move(key);
+        mKeyEncoded = true;
+    });
+    return mKey;
+}
+
+void SubscriberSlot::put(std::shared_ptr<const Update> update) {
+    {
+        std::lock_guard lock(mMutex);
+        if (mPending) ++mSkipped;
+        mPending = std::move(update);
+    }
+    if (mWake) mWake();
+}
+
+std::shared_ptr<const Update> SubscriberSlot::take() {
+    std::lock_guard lock(mMutex);
+    return std::exchange(mPending, nullptr);
+}
+
+uint64_t SubscriberSlot::skipped() const {
+    std::lock_guard lock(mMutex);
+    return mSkipped;
+}
+
+Session::Session(std::string id, std::string editorToken, std::string viewerToken,
+                 ServedBake& bake, SessionOptions options)
+    : mId(std::move(id)),
+      mEditorToken(std::move(editorToken)),
+      mViewerToken(std::move(viewerToken)),
+      mBake(bake),
+      mOptions(std::move(options)) {
+    mLatestLights = defaultLightSet(bake.scene());
+    mPending = Pending{mNextVersion++, mLatestLights, std::chrono::system_clock::now()};
+    mWorker = std::thread([this] { run(); });
+}
+
+Session::~Session() {
+    {
+        std::lock_guard lock(mMutex);
+        mStopping = true;
+    }
+    mChanged.notify_all();
+    mWorker.join();
+}
+
+Result<uint64_t> Session::setLights(LightSet lights) {
+    PIC_TRY(checkRuntimeLights(lights, mBake.scene()));
+    uint64_t version = 0;
+    {
+        std::lock_guard lock(mMutex);
+        version = mNextVersion++;
+        mLatestLights = lights;
+        // Coalescing: a set still waiting is replaced, and its version is never produced.
+        mPending = Pending{version, std::move(lights), std::chrono::system_clock::now()};
+    }
+    mChanged.notify_all();
+    return version;
+}
+
+uint64_t Session::latestVersion() const {
+    std::lock_guard lock(mMutex);
+    return mNextVersion - 1;
+}
+
+LightSet Session::latestLights() const {
+    std::lock_guard lock(mMutex);
+    return mLatestLights;
+}
+
+std::shared_ptr<const Update> Session::latestUpdate() const {
+    std::lock_guard lock(mMutex);
+    return mLatest;
+}
+
+std::shared_ptr<SubscriberSlot> Session::subscribe(std::function<void()> wake) {
+    auto slot = std::make_shared<SubscriberSlot>(std::move(wake));
+    // Under the publish lock, so that no newer update reaches the slot before this one.
+    std::lock_guard publishing(mPublishMutex);
+    std::shared_ptr<const Update> latest;
+    {
+        std::lock_guard lock(mMutex);
+        mSlots.push_back(slot);
+        latest = mLatest;
+    }
+    if (latest) slot->put(std::move(latest));
+    return slot;
+}
+
+void Session::unsubscribe(const SubscriberSlot* slot) {
+    std::lock_guard lock(mMutex);
+    std::erase_if(mSlots, [slot](const auto& held) { return held.get() == slot; });
+}
+
+size_t Session::subscribers() const {
+    std::lock_guard lock(mMutex);
+    return mSlots.size();
+}
+
+bool Session::waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mMutex);
+    return mChanged.wait_for(lock, timeout,
+                             [&] { return mLatest && mLatest->version >= version; });
+}
+
+void Session::publish(std::shared_ptr<const Update> update) {
+    std::lock_guard publishing(mPublishMutex);
+    std::vector<std::shared_ptr<SubscriberSlot>> slots;
+    {
+        std::lock_guard lock(mMutex);
+        mLatest = update;
+        slots = mSlots;
+    }
+    mChanged.notify_all();
+    for (const auto& slot : slots) slot->put(update);
+    if (mOptions.log) mOptions.log(UpdateLog{mId, update.get(), slots.size()});
+}
+
+void Session::run() {
+    std::shared_ptr<const HalfFrame> previous;
+    uint64_t previousVersion = 0;
+    uint32_t deltasSinceKey = 0;
+    for (;;) {
+        Pending job;
+        {
+            std::unique_lock lock(mMutex);
+            mChanged.wait(lock, [&] { return mStopping || mPending; });
+            if (mStopping) return;
+            job = std::move(*mPending);
+            mPending.reset();
+        }
+
+        auto update = std::make_shared<Update>();
+        update->version = job.version;
+        update->zstdLevel = mOptions.zstdLevel;
+        auto frame = std::make_shared<HalfFrame>();
+        const auto start = Clock::now();
+        if (auto relit = mBake.relight(job.lights, update->stats, *frame); !relit) {
+            std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
+                         (unsigned long long)job.version, relit.error().message.c_str());
+            continue;
+        }
+        const double updateMs = millisecondsSince(start);
+
+        const bool key = !previous || deltasSinceKey + 1 >= mOptions.keyframeInterval;
+        const auto encodeStart = Clock::now();
+        auto encoded = encodeFrame(*frame, key ? nullptr : previous.get(), mOptions.zstdLevel);
+        if (!encoded) {
+            std::fprintf(stderr, "picserver: session %s: encoding version %llu failed: %s\n",
+                         mId.c_str(), (unsigned long long)job.version,
+                         encoded.error().message.c_str());
+            continue;
+        }
+        auto wireFrame = std::make_shared<v1::Frame>();
+        wireFrame->set_version(update->version);
+        wireFrame->set_bake_id(mBake.id());
+        wireFrame->set_base_version(key ? 0 : previousVersion);
+        wire::toProto(*encoded, *wireFrame);
+        update->encodeMs = millisecondsSince(encodeStart);
+        wireFrame->set_bounces(uint32_t(update->stats.bounces));
+        for (const auto& [pass, ms] : update->stats.passMs) (*wireFrame->mutable_pass_ms())[pass] = ms;
+        wireFrame->set_update_ms(updateMs);
+        wireFrame->set_encode_ms(update->encodeMs);
+        wireFrame->set_lights_set_unix_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                              job.accepted.time_since_epoch())
+                                              .count());
+
+        update->baseVersion = wireFrame->base_version();
+        update->frame = frame;
+        update->broadcast = std::move(wireFrame);
+        previous = std::move(frame);
+        previousVersion = update->version;
+        deltasSinceKey = key ? 0 : deltasSinceKey + 1;
+        publish(std::move(update));
+    }
+}
+
+}  // namespace pic

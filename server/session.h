@@ -1,0 +1,154 @@
+#pragma once
+/// A design-review session (ARCHITECTURE §1): one light set at a time on one bake, versions
+/// computed once and encoded once, handed to every subscriber through a latest-wins slot.
+///
+/// Versions. Every accepted light set gets the next version number. One worker per session
+/// relights: while an update computes, newer sets replace the pending one (coalescing), so
+/// only the newest pending version is computed and the ones it replaced are never produced.
+///
+/// Frames. Each computed version is encoded once as the frame every subscriber holding the
+/// previous version receives: a delta against it, or a key frame every keyframeInterval
+/// versions. A subscriber that holds any other version (it joined late or skipped versions)
+/// gets the version's key frame instead, encoded at most once per version on first demand.
+/// So compute and encode cost per update do not grow with the number of subscribers.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/error.h"
+#include "core/frame_codec.h"
+#include "core/light_set.h"
+#include "proto/pic.pb.h"
+#include "server/runtime.h"
+
+namespace pic {
+
+class ServedBake;
+
+/// One computed version: its textures as halves and its frames on the wire.
+class Update {
+public:
+    uint64_t version = 0;
+    uint64_t baseVersion = 0;               ///< what `broadcast` applies to; 0 when it is a key frame
+    std::shared_ptr<const HalfFrame> frame; ///< the textures, kept while anyone may need a key frame
+    std::shared_ptr<const v1::Frame> broadcast;
+    UpdateStats stats;
+    double encodeMs = 0.0;
+    int zstdLevel = kDefaultZstdLevel;     ///< for the key frame encoded on demand
+
+    /// The frame for a subscriber that holds version `held` (0: none): `broadcast` when it
+    /// applies to `held`, else this version's key frame.
+    std::shared_ptr<const v1::Frame> frameFor(uint64_t held) const;
+    /// Whether a key frame besides `broadcast` was encoded for this version.
+    bool keyEncoded() const { return mKeyEncoded.load(); }
+
+private:
+    mutable std::atomic<bool> mKeyEncoded{false};
+    mutable std::once_flag mKeyOnce;
+    mutable std::shared_ptr<const v1::Frame> mKey;
+};
+
+/// A subscriber's mailbox: only the newest update not yet taken (latest wins), so a slow
+/// subscriber costs one update of memory and never holds the others up.
+class SubscriberSlot {
+public:
+    /// `wake` runs (outside the slot's lock) whenever an update is put.
+    explicit SubscriberSlot(std::function<void()> wake) : mWake(std::move(wake)) {}
+
+    void put(std::shared_ptr<const Update> update);
+    /// The pending update, or null.
+    std::shared_ptr<const Update> take();
+    /// Updates replaced before they were taken.
+    uint64_t skipped() const;
+
+private:
+    std::function<void()> mWake;
+    mutable std::mutex mMutex;
+    std::shared_ptr<const Update> mPending;
+    uint64_t mSkipped = 0;
+};
+
+/// One update's line for the log: version, ms per pass, encode ms, bytes, subscribers.
+struct UpdateLog {
+    std::string session;
+    const Update* update = nullptr;
+    size_t subscribers = 0;
+};
+
+struct SessionOptions {
+    uint32_t keyframeInterval = 32;   ///< every N-th version is broadcast as a key frame
+    int zstdLevel = kDefaultZstdLevel;
+    std::function<void(const UpdateLog&)> log;  ///< called once per computed update
+};
+
+class Session {
+public:
+    /// Starts the session's worker and queues version 1: the scene's own lights.
+    Session(std::string id, std::string editorToken, std::string viewerToken, ServedBake& bake,
+            SessionOptions options);
+    /// Stops the worker (an update in progress finishes first).
+    ~Session();
+    Session(const Session&) = delete;
+    Session& operator=(const Session&) = delete;
+
+    const std::string& id() const { return mId; }
+    const std::string& editorToken() const { return mEditorToken; }
+    const std::string& viewerToken() const { return mViewerToken; }
+    ServedBake& bake() const { return mBake; }
+
+    /// Queues a light set, checked against the scene (InvalidInput naming the problem), and
+    /// returns the version it will produce.
+    Result<uint64_t> setLights(LightSet lights);
+    /// The newest accepted version and light set.
+    uint64_t latestVersion() const;
+    LightSet latestLights() const;
+    /// The newest computed update, null before the first one.
+    std::shared_ptr<const Update> latestUpdate() const;
+
+    /// A new subscriber: its slot holds the newest computed update at once (if any), then
+    /// every update published after.
+    std::shared_ptr<SubscriberSlot> subscribe(std::function<void()> wake);
+    void unsubscribe(const SubscriberSlot* slot);
+    size_t subscribers() const;
+
+    /// Blocks until an update of version ≥ `version` is published or `timeout` passes.
+    bool waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const;
+
+private:
+    void run();
+    void publish(std::shared_ptr<const Update> update);
+
+    std::string mId;
+    std::string mEditorToken;
+    std::string mViewerToken;
+    ServedBake& mBake;
+    SessionOptions mOptions;
+
+    std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
+    mutable std::mutex mMutex;
+    mutable std::condition_variable mChanged;
+    bool mStopping = false;
+    uint64_t mNextVersion = 1;
+    LightSet mLatestLights;
+    /// The set waiting to be computed: its version, lights and when it was accepted.
+    struct Pending {
+        uint64_t version = 0;
+        LightSet lights;
+        std::chrono::system_clock::time_point accepted;
+    };
+    std::optional<Pending> mPending;
+    std::shared_ptr<const Update> mLatest;
+    std::vector<std::shared_ptr<SubscriberSlot>> mSlots;
+    std::thread mWorker;
+};
+
+}  // namespace pic
