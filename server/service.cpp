@@ -127,10 +127,14 @@ public:
         // before unsubscribe); the link tells it so.
         mLink = std::make_shared<Link>();
         mLink->writer = this;
-        mSlot = mSession->subscribe([link = mLink] {
+        auto slot = mSession->subscribe([link = mLink] {
             std::lock_guard lock(link->mutex);
             if (link->writer) link->writer->pump();
         });
+        // A publish may wake the link before this runs; pump() waits for the slot.
+        std::lock_guard lock(mLink->mutex);
+        mSlot = std::move(slot);
+        pump();
     }
 
     void OnWriteDone(bool ok) override {
@@ -170,7 +174,7 @@ private:
     /// Starts the next write if none is in flight (under the link's lock). gRPC never runs
     /// OnWriteDone inline from StartWrite, so holding the lock here cannot deadlock.
     void pump() {
-        if (mWriting || mCancelled || mFinished) return;
+        if (!mSlot || mWriting || mCancelled || mFinished) return;
         std::shared_ptr<const Update> update = mSlot->take();
         if (!update) return;
         std::shared_ptr<const v1::Frame> frame = update->frameFor(mHeld);

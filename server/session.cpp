@@ -107,16 +107,11 @@ std::shared_ptr<const Update> Session::latestUpdate() const {
 }
 
 std::shared_ptr<SubscriberSlot> Session::subscribe(std::function<void()> wake) {
-    auto slot = std::make_shared<SubscriberSlot>(std::move(wake));
-    // Under the publish lock, so that no newer update reaches the slot before this one.
+    // Under the publish lock, so that no newer update reaches the slot before the latest.
     std::lock_guard publishing(mPublishMutex);
-    std::shared_ptr<const Update> latest;
-    {
-        std::lock_guard lock(mMutex);
-        mSlots.push_back(slot);
-        latest = mLatest;
-    }
-    if (latest) slot->put(std::move(latest));
+    std::lock_guard lock(mMutex);
+    auto slot = std::make_shared<SubscriberSlot>(std::move(wake), mLatest);
+    mSlots.push_back(slot);
     return slot;
 }
 

@@ -61,8 +61,11 @@ private:
 /// subscriber costs one update of memory and never holds the others up.
 class SubscriberSlot {
 public:
-    /// `wake` runs (outside the slot's lock) whenever an update is put.
-    explicit SubscriberSlot(std::function<void()> wake) : mWake(std::move(wake)) {}
+    /// `wake` runs (outside the slot's lock) whenever an update is put; the slot starts with
+    /// `initial` pending, without a wake.
+    explicit SubscriberSlot(std::function<void()> wake,
+                            std::shared_ptr<const Update> initial = nullptr)
+        : mWake(std::move(wake)), mPending(std::move(initial)) {}
 
     void put(std::shared_ptr<const Update> update);
     /// The pending update, or null.
@@ -114,8 +117,9 @@ public:
     /// The newest computed update, null before the first one.
     std::shared_ptr<const Update> latestUpdate() const;
 
-    /// A new subscriber: its slot holds the newest computed update at once (if any), then
-    /// every update published after.
+    /// A new subscriber: its slot holds the newest computed update at once (if any; `wake`
+    /// is not called for it, the caller takes it when ready), then every update published
+    /// after, each with a call of `wake`.
     std::shared_ptr<SubscriberSlot> subscribe(std::function<void()> wake);
     void unsubscribe(const SubscriberSlot* slot);
     size_t subscribers() const;

@@ -1,0 +1,231 @@
+#include "client/picclient_cli.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "client/connection.h"
+#include "client/load_test.h"
+#include "proto/wire.h"
+
+namespace pic {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int reportError(const Error& error) {
+    std::fprintf(stderr, "picclient: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// Assigns the value of a Result or returns the process exit code of its error.
+#define PIC_TRY_ASSIGN_OR_EXIT(lhs, expr)                              \
+    auto PIC_CONCAT_(picExit_, __LINE__) = (expr);                     \
+    if (!PIC_CONCAT_(picExit_, __LINE__))                              \
+        return reportError(PIC_CONCAT_(picExit_, __LINE__).error());   \
+    lhs = std::move(*PIC_CONCAT_(picExit_, __LINE__))
+
+struct Common {
+    std::string server = "127.0.0.1:50051";
+    std::string session;
+    std::string token;
+    double connectSeconds = 10;
+};
+
+void addServer(CLI::App& app, Common& common) {
+    app.add_option("--server", common.server, "picserver address HOST:PORT");
+    app.add_option("--connect-timeout", common.connectSeconds, "seconds to wait for the server")
+        ->check(CLI::PositiveNumber);
+}
+
+void addSession(CLI::App& app, Common& common) {
+    app.add_option("--session", common.session, "session id (picclient session)")->required();
+    app.add_option("--token", common.token, "the session's editor or viewer token")->required();
+}
+
+Result<std::unique_ptr<PicConnection>> connectTo(const Common& common) {
+    return PicConnection::connect(
+        common.server, std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)));
+}
+
+int runSession(const Common& common, const std::string& bakeId) {
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto created = connection->createSession(bakeId);
+    if (!created) return reportError(created.error());
+    nlohmann::ordered_json json;
+    json["session"] = created->session();
+    json["editor_token"] = created->editor_token();
+    json["viewer_token"] = created->viewer_token();
+    json["bake_id"] = created->bake_id();
+    json["version"] = created->version();
+    std::printf("%s\n", json.dump().c_str());
+    return 0;
+}
+
+int runLights(const Common& common, const std::string& path) {
+    auto lights = readLightSet(path);
+    if (!lights) return reportError(lights.error());
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto version = connection->setLights(common.session, common.token, *lights);
+    if (!version) return reportError(version.error());
+    std::printf("%llu\n", (unsigned long long)*version);
+    return 0;
+}
+
+int runWatch(const Common& common, uint64_t count, double seconds) {
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto stream = connection->subscribe(common.session, common.token);
+    FrameDecoder decoder;
+    v1::Frame frame;
+    uint64_t frames = 0;
+    const auto start = Clock::now();
+    // A timer thread ends the stream after `seconds`, since next() blocks.
+    std::atomic<bool> done{false};
+    std::thread timer;
+    if (seconds > 0.0)
+        timer = std::thread([&] {
+            while (!done && Clock::now() - start < std::chrono::duration<double>(seconds))
+                std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            stream->cancel();
+        });
+    int exit = 0;
+    while ((count == 0 || frames < count) && stream->next(frame)) {
+        const int64_t nowNs = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count();
+        size_t bytes = 0;
+        for (const v1::Plane& plane : frame.planes()) bytes += plane.data().size();
+        const std::string kind = frame.base_version() == 0
+                                     ? std::string("key")
+                                     : fmt::format("delta:{}", frame.base_version());
+        const uint64_t version = frame.version();
+        const double updateMs = frame.update_ms(), encodeMs = frame.encode_ms();
+        const double latencyMs = double(nowNs - frame.lights_set_unix_ns()) / 1e6;
+        const auto decodeStart = Clock::now();
+        auto applied = decoder.apply(frame);
+        const double decodeMs =
+            std::chrono::duration<double, std::milli>(Clock::now() - decodeStart).count();
+        if (!applied) {
+            exit = reportError(applied.error());
+            break;
+        }
+        std::printf("version %llu: %s, %zu bytes, latency %.1f ms (server update %.1f ms, encode "
+                    "%.1f ms; decode %.1f ms)\n",
+                    (unsigned long long)version, kind.c_str(), bytes, latencyMs, updateMs,
+                    encodeMs, decodeMs);
+        std::fflush(stdout);
+        ++frames;
+    }
+    done = true;
+    if (timer.joinable()) timer.join();
+    stream->cancel();
+    if (exit != 0) return exit;
+    grpc::Status status = stream->status();
+    if (!status.ok() && status.error_code() != grpc::StatusCode::CANCELLED)
+        return reportError(wire::fromStatus(status, "Subscribe"));
+    return 0;
+}
+
+int runLoad(const Common& common, const LoadOptions& options, const std::string& reportPath) {
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    std::fprintf(stderr, "picclient load: %u clients, %.1f s, %.2f light changes per second\n",
+                 options.clients, options.durationSeconds, options.updateRate);
+    auto report = runLoadTest(*connection, options);
+    if (!report) return reportError(report.error());
+    std::ofstream out(reportPath);
+    out << report->dump(2) << "\n";
+    if (!out) return reportError(Error{ErrorCode::Io, fmt::format("cannot write {}", reportPath)});
+    const auto& latency = (*report)["latency_ms"];
+    std::printf("updates %llu, frames %llu, skipped %llu, errors %llu; latency ms p50 %.1f p95 %.1f "
+                "p99 %.1f max %.1f; bytes per key frame %.0f, per delta %.0f -> %s\n",
+                (unsigned long long)(*report)["updates"].get<uint64_t>(),
+                (unsigned long long)(*report)["frames_received"].get<uint64_t>(),
+                (unsigned long long)(*report)["versions_skipped"].get<uint64_t>(),
+                (unsigned long long)(*report)["errors"].get<uint64_t>(),
+                latency["p50"].get<double>(), latency["p95"].get<double>(),
+                latency["p99"].get<double>(), latency["max"].get<double>(),
+                (*report)["bytes_per_frame"]["key"].get<double>(),
+                (*report)["bytes_per_frame"]["delta"].get<double>(), reportPath.c_str());
+    return (*report)["errors"].get<uint64_t>() == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int picclientMain(int argc, char** argv) {
+    CLI::App app{"picclient: a thin client of picserver: sessions, light changes, the frame "
+                 "stream, load tests and rendering from the streamed caches"};
+    app.name("picclient");
+    app.require_subcommand(1);
+    Common common;
+
+    std::string bakeId;
+    CLI::App* session = app.add_subcommand(
+        "session", "create a session (its first light set is the glTF's own lights); prints "
+                   "{\"session\", \"editor_token\", \"viewer_token\", ...}");
+    addServer(*session, common);
+    session->add_option("--bake", bakeId, "bake id (default: the server's first bake)");
+
+    std::string lightsPath;
+    CLI::App* lights = app.add_subcommand("lights", "push a light set (editor token); prints the "
+                                                    "version it produces");
+    addServer(*lights, common);
+    addSession(*lights, common);
+    lights->add_option("--set", lightsPath, "light set JSON (ARCHITECTURE.md §4)")->required();
+
+    uint64_t count = 0;
+    double watchSeconds = 0;
+    CLI::App* watch = app.add_subcommand("watch", "subscribe and print each version's latency "
+                                                  "and bytes");
+    addServer(*watch, common);
+    addSession(*watch, common);
+    watch->add_option("--count", count, "stop after this many frames (0: never)");
+    watch->add_option("--duration", watchSeconds, "stop after this many seconds (0: never)")
+        ->check(CLI::NonNegativeNumber);
+
+    LoadOptions load;
+    std::string reportPath;
+    CLI::App* loadCommand = app.add_subcommand(
+        "load", "N subscribers and an editor moving a light; writes a latency report");
+    addServer(*loadCommand, common);
+    loadCommand->add_option("--clients", load.clients, "subscribers")->required()
+        ->check(CLI::Range(1u, 10000u));
+    loadCommand->add_option("--duration", load.durationSeconds, "seconds of light changes")
+        ->required()->check(CLI::PositiveNumber);
+    loadCommand->add_option("--update-rate", load.updateRate, "light changes per second")
+        ->check(CLI::NonNegativeNumber);
+    loadCommand->add_option("--session", load.session, "an existing session (default: a new one)");
+    loadCommand->add_option("--token", load.editorToken, "its editor token");
+    loadCommand->add_option("--move", load.moveMetres,
+                            "radius in metres of the circle a point or spot light moves on")
+        ->check(CLI::PositiveNumber);
+    loadCommand->add_option("--report", reportPath, "JSON report to write")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+    if (session->parsed()) return runSession(common, bakeId);
+    if (lights->parsed()) return runLights(common, lightsPath);
+    if (watch->parsed()) return runWatch(common, count, watchSeconds);
+    if (loadCommand->parsed()) {
+        if (load.session.empty() != load.editorToken.empty()) {
+            std::fprintf(stderr, "picclient: error: --session and --token go together\n");
+            return 2;
+        }
+        return runLoad(common, load, reportPath);
+    }
+    return 2;
+}
+
+}  // namespace pic
