@@ -1,0 +1,612 @@
+// The server, the stream and the thin client on loopback (127.0.0.1, port 0): sessions and
+// tokens, light-set validation, coalescing, latest-wins delivery to fast and stalled
+// subscribers, key frames for late joiners, exact decoding, the scene download, and the
+// picserver / picclient command lines. Every server a test starts is stopped by it.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "bake/bake.h"
+#include "client/connection.h"
+#include "core/bake_file.h"
+#include "core/gltf_loader.h"
+#include "proto/wire.h"
+#include "server/service.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const std::string kScene = std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf";
+
+/// A small bake of the Cornell box, written once per test run.
+const std::string& bakePath() {
+    static const std::string path = [] {
+        const std::string out = (fs::temp_directory_path() /
+                                 fmt::format("pic_stream_test_{}.pic", getpid()))
+                                    .string();
+        auto scene = loadScene(kScene);
+        EXPECT_TRUE(scene);
+        BakeOptions options;
+        options.surfels = 2048;
+        options.links = 32;
+        options.bandsY = 3;
+        options.bandsC = 2;
+        BakeReport report;
+        auto bake = runBake(*scene, options, report);
+        EXPECT_TRUE(bake);
+        EXPECT_TRUE(writeBakeFile(out, *bake));
+        return out;
+    }();
+    return path;
+}
+
+struct Served {
+    std::unique_ptr<PicServer> server;
+    std::unique_ptr<PicConnection> connection;
+};
+
+Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32) {
+    Served served;
+    ServeOptions options;
+    options.backend = backend;
+    options.bounces.bounces = 1;
+    auto bake = ServedBake::load(bakePath(), kScene, options);
+    EXPECT_TRUE(bake) << (bake ? "" : bake.error().message);
+    if (!bake) return served;
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    bakes.push_back(std::move(*bake));
+    ServerOptions serverOptions;
+    serverOptions.session.keyframeInterval = keyframeInterval;
+    auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", serverOptions);
+    EXPECT_TRUE(server) << (server ? "" : server.error().message);
+    if (!server) return served;
+    served.server = std::move(*server);
+    auto connection = PicConnection::connect(served.server->address());
+    EXPECT_TRUE(connection) << (connection ? "" : connection.error().message);
+    if (connection) served.connection = std::move(*connection);
+    return served;
+}
+
+LightSet pointLight(float x) {
+    LightSet lights;
+    Light light;
+    light.id = "lamp";
+    light.type = LightType::Point;
+    light.position = glm::vec3(x, 0.5f, 0.0f);  // inside the box (ceiling at y = 1)
+    light.intensity = 4.0f;
+    lights.lights.push_back(light);
+    return lights;
+}
+
+/// Reads frames on its own thread, decoding each, until cancelled.
+class Reader {
+public:
+    Reader(PicConnection& connection, const std::string& session, const std::string& token)
+        : mStream(connection.subscribe(session, token)), mThread([this] { run(); }) {}
+    ~Reader() {
+        mStream->cancel();
+        mThread.join();
+    }
+
+    /// Waits until a frame of version ≥ `version` was decoded.
+    bool waitFor(uint64_t version, std::chrono::milliseconds timeout = 30s) {
+        const auto start = std::chrono::steady_clock::now();
+        while (std::chrono::steady_clock::now() - start < timeout) {
+            {
+                std::lock_guard lock(mMutex);
+                if (!versions.empty() && versions.back() >= version) return true;
+            }
+            std::this_thread::sleep_for(2ms);
+        }
+        return false;
+    }
+
+    std::vector<uint64_t> received() {
+        std::lock_guard lock(mMutex);
+        return versions;
+    }
+    std::vector<bool> keys() {
+        std::lock_guard lock(mMutex);
+        return keyFrames;
+    }
+    HalfFrame frame() {
+        std::lock_guard lock(mMutex);
+        return mDecoder.frame();
+    }
+    std::vector<std::string> errors() {
+        std::lock_guard lock(mMutex);
+        return mErrors;
+    }
+
+private:
+    void run() {
+        v1::Frame frame;
+        while (mStream->next(frame)) {
+            std::lock_guard lock(mMutex);
+            keyFrames.push_back(frame.base_version() == 0);
+            const uint64_t version = frame.version();
+            if (auto applied = mDecoder.apply(frame); !applied)
+                mErrors.push_back(applied.error().message);
+            versions.push_back(version);
+        }
+    }
+
+    std::unique_ptr<FrameStream> mStream;
+    std::mutex mMutex;
+    FrameDecoder mDecoder;
+    std::vector<uint64_t> versions;
+    std::vector<bool> keyFrames;
+    std::vector<std::string> mErrors;
+    std::thread mThread;
+};
+
+TEST(Stream, TwoSubscribersReceiveEveryVersionTheyCanAndAlwaysTheLastDecodedExactly) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    EXPECT_EQ(session->version(), 1u);
+    Reader editorView(*served.connection, session->session(), session->editor_token());
+    Reader viewer(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(editorView.waitFor(1));
+    ASSERT_TRUE(viewer.waitFor(1));
+
+    auto live = served.server->session(session->session());
+    ASSERT_TRUE(live);
+    uint64_t last = 0;
+    for (int i = 0; i < 6; ++i) {
+        auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                    pointLight(-0.3f + 0.1f * float(i)));
+        ASSERT_TRUE(version) << version.error().message;
+        EXPECT_EQ(*version, uint64_t(i) + 2);
+        last = *version;
+        // Paced: each version is computed before the next set arrives.
+        ASSERT_TRUE(live->waitForVersion(last, 30s));
+    }
+    ASSERT_TRUE(editorView.waitFor(last));
+    ASSERT_TRUE(viewer.waitFor(last));
+
+    const auto update = live->latestUpdate();
+    ASSERT_TRUE(update);
+    ASSERT_EQ(update->version, last);
+    for (Reader* reader : {&editorView, &viewer}) {
+        const auto versions = reader->received();
+        const auto keys = reader->keys();
+        EXPECT_TRUE(reader->errors().empty()) << reader->errors().front();
+        ASSERT_FALSE(versions.empty());
+        EXPECT_TRUE(keys.front()) << "the first frame of a subscriber is a key frame";
+        EXPECT_EQ(versions.back(), last);
+        for (size_t i = 1; i < versions.size(); ++i) EXPECT_LT(versions[i - 1], versions[i]);
+        // Paced updates and fast readers: nothing is skipped.
+        EXPECT_EQ(versions.size(), last) << "versions received";
+        // Lossless: the decoded textures are the server's half floats, bit for bit.
+        EXPECT_TRUE(reader->frame() == *update->frame);
+    }
+}
+
+TEST(Stream, LateJoinerFirstFrameIsAKeyFrameOfTheLatestVersion) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    for (int i = 0; i < 3; ++i) {
+        auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                    pointLight(0.1f * float(i)));
+        ASSERT_TRUE(version);
+        ASSERT_TRUE(live->waitForVersion(*version, 30s));
+    }
+    const auto latest = live->latestUpdate();
+    ASSERT_TRUE(latest);
+    EXPECT_NE(latest->baseVersion, 0u) << "the broadcast frame of version 4 is a delta";
+    Reader late(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(late.waitFor(latest->version));
+    ASSERT_FALSE(late.keys().empty());
+    EXPECT_TRUE(late.keys().front());
+    EXPECT_EQ(late.received().front(), latest->version);
+    EXPECT_TRUE(late.frame() == *latest->frame);
+    EXPECT_TRUE(latest->keyEncoded());
+}
+
+TEST(Stream, KeyFrameOnDemandIsEncodedOncePerVersionForAnyNumberOfSubscribers) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    ASSERT_TRUE(live->waitForVersion(1, 30s));
+    auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                pointLight(0.2f));
+    ASSERT_TRUE(version);
+    ASSERT_TRUE(live->waitForVersion(*version, 30s));
+    const auto update = live->latestUpdate();
+    ASSERT_NE(update->baseVersion, 0u);
+    EXPECT_EQ(update->frameFor(update->baseVersion), update->broadcast);
+    const auto key = update->frameFor(0);
+    ASSERT_TRUE(key);
+    EXPECT_EQ(key->base_version(), 0u);
+    for (uint64_t held : {0u, 1u, 7u}) EXPECT_EQ(update->frameFor(held).get(), held == update->baseVersion ? update->broadcast.get() : key.get());
+}
+
+TEST(Stream, StalledSubscriberDoesNotDelayTheOthersAndSkipsToTheLast) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    ASSERT_TRUE(live->waitForVersion(1, 30s));
+
+    // A subscriber that never reads until the end.
+    auto stalled = served.connection->subscribe(session->session(), session->viewer_token());
+    Reader fast(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(fast.waitFor(1));
+
+    constexpr int kUpdates = 200;
+    uint64_t last = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < kUpdates; ++i) {
+        auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                    pointLight(0.01f * float(i % 20)));
+        ASSERT_TRUE(version);
+        last = *version;
+        ASSERT_TRUE(fast.waitFor(last, 30s)) << "the fast subscriber waited on the stalled one";
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(fast.received().back(), last);
+    size_t bytes = 0;
+    for (const v1::Plane& plane : live->latestUpdate()->broadcast->planes()) bytes += plane.data().size();
+    std::printf("%d updates (%zu bytes each) to the fast subscriber in %.2f s beside a stalled one\n",
+                kUpdates, bytes, seconds);
+
+    // The stalled subscriber now reads: it gets what gRPC had buffered, then the last version,
+    // never all of them.
+    v1::Frame frame;
+    FrameDecoder decoder;
+    int frames = 0;
+    while (decoder.version() < last && stalled->next(frame)) {
+        ASSERT_TRUE(decoder.apply(frame)) << "version " << frame.version();
+        ++frames;
+    }
+    EXPECT_EQ(decoder.version(), last);
+    EXPECT_TRUE(decoder.frame() == *live->latestUpdate()->frame);
+    std::printf("the stalled subscriber received %d frames for %llu versions\n", frames,
+                (unsigned long long)last);
+    EXPECT_LT(frames, int(last));
+}
+
+TEST(Stream, DisconnectedSubscriberIsRemovedAtOnce) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    {
+        Reader a(*served.connection, session->session(), session->viewer_token());
+        Reader b(*served.connection, session->session(), session->viewer_token());
+        ASSERT_TRUE(a.waitFor(1));
+        ASSERT_TRUE(b.waitFor(1));
+        EXPECT_EQ(live->subscribers(), 2u);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    while (live->subscribers() > 0 && std::chrono::steady_clock::now() - start < 5s)
+        std::this_thread::sleep_for(1ms);
+    EXPECT_EQ(live->subscribers(), 0u);
+    std::printf("subscribers removed %.1f ms after they disconnected\n",
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+}
+
+TEST(Stream, TokensAndRoles) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    const LightSet lights = pointLight(0.0f);
+
+    grpc::ClientContext context;
+    v1::SetLightsRequest request;
+    request.set_session(session->session());
+    request.set_token(session->viewer_token());
+    *request.mutable_lights() = wire::toProto(lights);
+    v1::SetLightsResponse response;
+    EXPECT_EQ(served.connection->stub().SetLights(&context, request, &response).error_code(),
+              grpc::StatusCode::PERMISSION_DENIED);
+
+    grpc::ClientContext context2;
+    request.set_token("not-a-token");
+    EXPECT_EQ(served.connection->stub().SetLights(&context2, request, &response).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+
+    grpc::ClientContext context3;
+    request.set_session("no-such-session");
+    EXPECT_EQ(served.connection->stub().SetLights(&context3, request, &response).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+
+    auto joined = served.connection->joinSession(session->session(), session->viewer_token());
+    ASSERT_TRUE(joined);
+    EXPECT_EQ(joined->role(), v1::VIEWER);
+    joined = served.connection->joinSession(session->session(), session->editor_token());
+    ASSERT_TRUE(joined);
+    EXPECT_EQ(joined->role(), v1::EDITOR);
+
+    // A viewer cannot subscribe with a wrong token either.
+    auto stream = served.connection->subscribe(session->session(), "wrong");
+    v1::Frame frame;
+    EXPECT_FALSE(stream->next(frame));
+    EXPECT_EQ(stream->status().error_code(), grpc::StatusCode::UNAUTHENTICATED);
+}
+
+TEST(Stream, MalformedLightSetsAreInvalidArgumentNamingTheField) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+
+    struct Case {
+        const char* field;
+        std::function<void(v1::LightSet&)> spoil;
+    };
+    const std::vector<Case> cases = {
+        {"lights[0].intensity", [&](v1::LightSet& s) { s.mutable_lights(0)->set_intensity(nan); }},
+        {"lights[0].intensity", [&](v1::LightSet& s) { s.mutable_lights(0)->set_intensity(-1.0f); }},
+        {"lights[0].position[1]", [&](v1::LightSet& s) { s.mutable_lights(0)->mutable_position()->set_y(inf); }},
+        {"lights[0].color", [&](v1::LightSet& s) { s.mutable_lights(0)->mutable_color()->set_x(-0.5f); }},
+        {"lights[0].type", [&](v1::LightSet& s) { s.mutable_lights(0)->set_type(v1::Light::TYPE_UNSPECIFIED); }},
+        {"lights[1].direction", [&](v1::LightSet& s) {
+             v1::Light& sun = *s.add_lights();
+             sun.set_type(v1::Light::DIRECTIONAL);
+             sun.mutable_direction()->set_x(0.0f);
+         }},
+        {"lights[1].outerConeAngle", [&](v1::LightSet& s) {
+             v1::Light& spot = *s.add_lights();
+             spot.set_type(v1::Light::SPOT);
+             spot.set_outer_cone_angle(2.0f);
+         }},
+        {"lights[1].innerConeAngle", [&](v1::LightSet& s) {
+             v1::Light& spot = *s.add_lights();
+             spot.set_type(v1::Light::SPOT);
+             spot.set_inner_cone_angle(0.9f);
+             spot.set_outer_cone_angle(0.5f);
+         }},
+        {"lights holds 257", [&](v1::LightSet& s) {
+             for (int i = 1; i < 257; ++i) {
+                 *s.add_lights() = s.lights(0);
+                 s.mutable_lights(i)->set_id(fmt::format("l{}", i));
+             }
+         }},
+        {"emissiveScale", [&](v1::LightSet& s) { (*s.mutable_emissive_scale())["no such material"] = 1.0f; }},
+    };
+    for (const Case& c : cases) {
+        v1::SetLightsRequest request;
+        request.set_session(session->session());
+        request.set_token(session->editor_token());
+        *request.mutable_lights() = wire::toProto(pointLight(0.0f));
+        c.spoil(*request.mutable_lights());
+        grpc::ClientContext context;
+        v1::SetLightsResponse response;
+        grpc::Status status = served.connection->stub().SetLights(&context, request, &response);
+        EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << c.field;
+        EXPECT_NE(status.error_message().find(c.field), std::string::npos)
+            << "message \"" << status.error_message() << "\" names " << c.field;
+    }
+    // Nothing was queued: the version is still the first.
+    auto joined = served.connection->joinSession(session->session(), session->editor_token());
+    ASSERT_TRUE(joined);
+    EXPECT_EQ(joined->version(), 1u);
+}
+
+TEST(Stream, LightSetsCoalesceWhileAnUpdateComputes) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    uint64_t last = 0;
+    for (int i = 0; i < 20; ++i) {
+        auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                    pointLight(0.01f * float(i)));
+        ASSERT_TRUE(version);
+        EXPECT_EQ(*version, uint64_t(i) + 2);
+        last = *version;
+    }
+    ASSERT_TRUE(reader.waitFor(last));
+    const auto versions = reader.received();
+    EXPECT_EQ(versions.back(), last);
+    EXPECT_LT(versions.size(), size_t(last)) << "20 sets sent back to back were coalesced";
+    EXPECT_TRUE(reader.errors().empty());
+}
+
+TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    const fs::path cache = fs::temp_directory_path() / fmt::format("pic_stream_cache_{}", getpid());
+    auto client = served.connection->fetchScene("", cache.string());
+    ASSERT_TRUE(client) << client.error().message;
+    auto bake = readBakeFile(bakePath());
+    ASSERT_TRUE(bake);
+    EXPECT_EQ(client->scene.hash, bake->sceneHash);
+    EXPECT_EQ(client->triangleUvs, bake->lightmap.triangleUvs);
+    ASSERT_EQ(client->gridCoverage.size(), bake->grid.cacheIndex.size());
+    for (size_t i = 0; i < client->gridCoverage.size(); ++i)
+        ASSERT_EQ(client->gridCoverage[i] != 0, bake->grid.cacheIndex[i] != kNoCache);
+    EXPECT_EQ(client->header.bands_y(), 3u);
+    EXPECT_EQ(client->header.bands_c(), 2u);
+
+    // The textures of a streamed frame fit this layout.
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(reader.waitFor(1));
+    auto textures = cacheTexturesOf(*client, reader.frame());
+    ASSERT_TRUE(textures) << textures.error().message;
+    EXPECT_EQ(textures->grid[0].size(), 9 * client->gridCoverage.size());
+    EXPECT_EQ(textures->lightmap[1].size(), 4 * client->lightmapCoverage.size());
+
+    auto missing = served.connection->fetchScene("0123456789abcdef", cache.string());
+    ASSERT_FALSE(missing);
+    EXPECT_EQ(missing.error().code, ErrorCode::NotFound);
+    fs::remove_all(cache);
+}
+
+TEST(Stream, GpuBackendServesTheSameProtocol) {
+    Served served = serve("gpu");
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                pointLight(0.1f));
+    ASSERT_TRUE(version);
+    ASSERT_TRUE(reader.waitFor(*version));
+    EXPECT_TRUE(reader.frame() == *served.server->session(session->session())->latestUpdate()->frame);
+}
+
+/// Runs a command with its stdout on a pipe; the child's pid and the read end.
+struct Child {
+    pid_t pid = -1;
+    FILE* out = nullptr;
+};
+
+Child spawn(const std::vector<std::string>& args) {
+    int fds[2];
+    if (pipe(fds) != 0) return {};
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fds[1], STDOUT_FILENO);
+        close(fds[0]);
+        close(fds[1]);
+        std::vector<char*> argv;
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    close(fds[1]);
+    return {pid, fdopen(fds[0], "r")};
+}
+
+std::string readLine(FILE* file) {
+    char line[4096];
+    if (!std::fgets(line, sizeof line, file)) return {};
+    std::string text(line);
+    if (!text.empty() && text.back() == '\n') text.pop_back();
+    return text;
+}
+
+int waitExit(pid_t pid) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string run(const std::string& command, int& exit) {
+    std::string output;
+    FILE* pipe = popen(command.c_str(), "r");
+    char buffer[4096];
+    while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
+    exit = WEXITSTATUS(pclose(pipe));
+    return output;
+}
+
+TEST(StreamCli, PicserverAndPicclientEndToEnd) {
+    Child server = spawn({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
+                          "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet"});
+    ASSERT_GT(server.pid, 0);
+    const std::string first = readLine(server.out);
+    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
+    const std::string address = first.substr(std::string("listening on ").size());
+    EXPECT_NE(address, "127.0.0.1:0");
+
+    int exit = 0;
+    const std::string client = PIC_PICCLIENT;
+    std::string created = run(client + " session --server " + address, exit);
+    ASSERT_EQ(exit, 0) << created;
+    auto json = nlohmann::json::parse(created);
+    const std::string session = json["session"], editor = json["editor_token"],
+                      viewer = json["viewer_token"];
+
+    const fs::path lightsFile = fs::temp_directory_path() / fmt::format("pic_cli_lights_{}.json", getpid());
+    {
+        std::FILE* f = std::fopen(lightsFile.c_str(), "w");
+        std::fputs(R"({"lights":[{"id":"lamp","type":"point","position":[0,0.6,0],"intensity":3}]})", f);
+        std::fclose(f);
+    }
+    std::string version = run(client + " lights --server " + address + " --session " + session +
+                                  " --token " + editor + " --set " + lightsFile.string(),
+                              exit);
+    EXPECT_EQ(exit, 0);
+    EXPECT_EQ(version, "2\n");
+    std::string denied = run(client + " lights --server " + address + " --session " + session +
+                                 " --token " + viewer + " --set " + lightsFile.string() + " 2>&1",
+                             exit);
+    EXPECT_EQ(exit, 2);
+    EXPECT_NE(denied.find("PERMISSION_DENIED"), std::string::npos) << denied;
+
+    std::string watched = run(client + " watch --server " + address + " --session " + session +
+                                  " --token " + viewer + " --count 1",
+                              exit);
+    EXPECT_EQ(exit, 0) << watched;
+    EXPECT_NE(watched.find("version 2: key"), std::string::npos) << watched;
+
+    const fs::path report = fs::temp_directory_path() / fmt::format("pic_cli_load_{}.json", getpid());
+    std::string loaded = run(client + " load --server " + address + " --clients 3 --duration 1 "
+                                  "--update-rate 4 --report " + report.string(),
+                             exit);
+    EXPECT_EQ(exit, 0) << loaded;
+    std::ifstream reportFile(report);
+    auto loadReport = nlohmann::json::parse(reportFile);
+    for (const char* key : {"p50", "p95", "p99", "max"})
+        EXPECT_GT(loadReport["latency_ms"][key].get<double>(), 0.0) << key;
+    EXPECT_EQ(loadReport["updates"].get<int>(), 4);
+    EXPECT_GE(loadReport["frames_received"].get<int>(), 3);
+    EXPECT_EQ(loadReport["errors"].get<int>(), 0);
+
+    // The update log: one line per update after the first line.
+    const std::string updateLine = readLine(server.out);
+    EXPECT_TRUE(updateLine.starts_with("update session=")) << updateLine;
+    EXPECT_NE(updateLine.find("encode_ms="), std::string::npos);
+    EXPECT_NE(updateLine.find("bytes="), std::string::npos);
+    EXPECT_NE(updateLine.find("subscribers="), std::string::npos);
+
+    kill(server.pid, SIGTERM);
+    EXPECT_EQ(waitExit(server.pid), 0);
+    std::fclose(server.out);
+    fs::remove(lightsFile);
+    fs::remove(report);
+}
+
+TEST(StreamCli, BadInputsExitWithTwoAndAMessage) {
+    int exit = 0;
+    std::string output = run(std::string(PIC_PICSERVER) + " --bake /no/such.pic --scene " + kScene +
+                                 " --listen 127.0.0.1:0 --backend cpu 2>&1",
+                             exit);
+    EXPECT_EQ(exit, 2);
+    EXPECT_NE(output.find("/no/such.pic"), std::string::npos) << output;
+    output = run(std::string(PIC_PICCLIENT) + " session --server 127.0.0.1:1 --connect-timeout 0.5 2>&1", exit);
+    EXPECT_EQ(exit, 1);
+    EXPECT_NE(output.find("cannot reach"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace pic
