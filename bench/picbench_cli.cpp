@@ -5,6 +5,7 @@
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
 #include "bench/codec_benchmark.h"
+#include "bench/stream_benchmark.h"
 #include "bench/runtime_benchmark.h"
 #include "bench/bake_benchmark.h"
 #include "bench/link_error_benchmark.h"
@@ -118,6 +119,28 @@ int picbenchMain(int argc, char** argv) {
     codec->add_option("--zstd-level", codecParams.zstdLevel, "zstd level (default 3)")->check(CLI::Range(1, 19));
     codec->add_option("--json", codecParams.jsonPath, "JSON file (default codec_benchmark.json)");
 
+    CLI::App* stream = app.add_subcommand(
+        "stream", "the server under load: light-change latency to N subscribers, server CPU per "
+                  "update, bytes per key and delta frame");
+    StreamBenchmarkParams streamParams;
+    stream->add_option("--scene", streamParams.scenePath, "scene file (.gltf or .glb)")->required();
+    stream->add_option("--setting", streamParams.setting, "paper 000 Table 2 setting (default: moderate)")
+        ->check(CLI::IsMember({"moderate", "high"}));
+    stream->add_option("--link-mode", streamParams.linkMode, "link form (default: rtp)")
+        ->check(CLI::IsMember({"rtp", "sh"}));
+    stream->add_option("--backend", streamParams.backend, "server backend (default: gpu)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    stream->add_option("--bounces", streamParams.bounces, "cache passes per update (default 1)")
+        ->check(CLI::Range(-1, 64));
+    stream->add_option("--clients", streamParams.clients, "subscriber counts (default: 1 16 64 200)")
+        ->check(CLI::Range(1u, 10000u));
+    stream->add_option("--duration", streamParams.duration, "seconds of light changes per count (default 10)")
+        ->check(CLI::PositiveNumber);
+    stream->add_option("--update-rate", streamParams.updateRate, "light changes per second (default 2)")
+        ->check(CLI::PositiveNumber);
+    stream->add_option("--picserver", streamParams.picserver, "picserver binary (default: the build tree's)");
+    stream->add_option("--json", streamParams.jsonPath, "JSON file (default stream_benchmark.json)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -135,6 +158,7 @@ int picbenchMain(int argc, char** argv) {
     if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
     if (shadows->parsed()) return runShadowBenchmark(shadowParams);
     if (codec->parsed()) return runCodecBenchmark(codecParams);
+    if (stream->parsed()) return runStreamBenchmark(streamParams);
     if (links->parsed()) {
         linkParams.bake = linkFlags.toOptions();
         return runLinkErrorBenchmark(linkParams);

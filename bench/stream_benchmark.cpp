@@ -1,0 +1,176 @@
+#include "bench/stream_benchmark.h"
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench/bench_common.h"
+#include "client/connection.h"
+#include "client/load_test.h"
+#include "core/bake_file.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A picserver child process: its pid and its stdout.
+struct ServerProcess {
+    pid_t pid = -1;
+    FILE* out = nullptr;
+    std::string address;
+
+    ~ServerProcess() {
+        if (pid > 0) {
+            kill(pid, SIGTERM);
+            int status = 0;
+            waitpid(pid, &status, 0);
+        }
+        if (out) std::fclose(out);
+    }
+};
+
+Result<void> startServer(ServerProcess& server, const std::vector<std::string>& args) {
+    int fds[2];
+    if (pipe(fds) != 0) return fail(ErrorCode::Io, "pipe failed");
+    server.pid = fork();
+    if (server.pid == 0) {
+        dup2(fds[1], STDOUT_FILENO);
+        close(fds[0]);
+        close(fds[1]);
+        std::vector<char*> argv;
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        std::fprintf(stderr, "picbench: cannot run %s\n", argv[0]);
+        _exit(127);
+    }
+    close(fds[1]);
+    server.out = fdopen(fds[0], "r");
+    char line[512];
+    if (!server.out || !std::fgets(line, sizeof line, server.out))
+        return fail(ErrorCode::Internal, "{} ended before it listened", args[0]);
+    std::string text(line);
+    const std::string prefix = "listening on ";
+    if (!text.starts_with(prefix))
+        return fail(ErrorCode::Internal, "{} printed \"{}\" instead of listening on", args[0], text);
+    server.address = text.substr(prefix.size());
+    while (!server.address.empty() && server.address.back() == '\n') server.address.pop_back();
+    // The update log goes on; drain it so the server never blocks on a full pipe.
+    std::thread([out = server.out] {
+        char discard[4096];
+        while (std::fgets(discard, sizeof discard, out)) {
+        }
+    }).detach();
+    server.out = nullptr;  // owned by the draining thread
+    return {};
+}
+
+/// User + system CPU seconds of process `pid` (/proc/PID/stat fields 14 and 15).
+double cpuSeconds(pid_t pid) {
+    std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+    std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    const size_t close = text.rfind(')');
+    if (close == std::string::npos) return 0.0;
+    std::istringstream fields(text.substr(close + 2));
+    std::string field;
+    double ticks = 0.0;
+    for (int i = 3; i <= 15 && fields >> field; ++i)
+        if (i == 14 || i == 15) ticks += std::stod(field);
+    return ticks / double(sysconf(_SC_CLK_TCK));
+}
+
+std::string siblingPicserver() {
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    return (self.parent_path().parent_path() / "server" / "picserver").string();
+}
+
+}  // namespace
+
+int runStreamBenchmark(const StreamBenchmarkParams& params) {
+    auto inputs = loadBenchInputs(params.scenePath, "");
+    if (!inputs) return 2;
+    BakeReport bakeReport;
+    std::fprintf(stderr, "picbench: baking %s %s …\n", params.setting.c_str(), params.linkMode.c_str());
+    auto bake = runBake(inputs->scene, settingOptions(params.setting, params.linkMode), bakeReport);
+    if (!bake) return reportError(bake.error());
+    const fs::path bakePath = fs::temp_directory_path() / fmt::format("picbench_stream_{}.pic", getpid());
+    if (auto written = writeBakeFile(bakePath.string(), *bake); !written)
+        return reportError(written.error());
+
+    const std::string picserver = params.picserver.empty() ? siblingPicserver() : params.picserver;
+    ServerProcess server;
+    auto started = startServer(server, {picserver, "--bake", bakePath.string(), "--scene",
+                                        params.scenePath, "--listen", "127.0.0.1:0", "--backend",
+                                        params.backend, "--bounces", std::to_string(params.bounces),
+                                        "--quiet"});
+    fs::remove(bakePath);  // the server has it open or failed
+    if (!started) return reportError(started.error());
+    auto connection = PicConnection::connect(server.address);
+    if (!connection) return reportError(connection.error());
+
+    const double values = [&] {
+        const double lY = bake->params.bandsY, lC = bake->params.bandsC;
+        const double texels = double(bake->grid.cacheIndex.size() + bake->lightmap.cacheIndex.size());
+        return texels * (lY * lY + 2.0 * lC * lC);
+    }();
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    std::printf("%8s %8s %9s %9s %9s %9s %12s %11s %11s %10s %10s %8s\n", "clients", "updates",
+                "p50 ms", "p95 ms", "p99 ms", "max ms", "server ms/up", "key KiB", "delta KiB",
+                "key b/val", "dlt b/val", "errors");
+    int exit = 0;
+    for (uint32_t clients : params.clients) {
+        LoadOptions load;
+        load.clients = clients;
+        load.durationSeconds = params.duration;
+        load.updateRate = params.updateRate;
+        load.moveMetres = 0.01f * inputs->scene.bounds.diagonal();
+        const double cpuBefore = cpuSeconds(server.pid);
+        auto report = runLoadTest(**connection, load);
+        const double cpuAfter = cpuSeconds(server.pid);
+        if (!report) return reportError(report.error());
+        nlohmann::ordered_json row = *report;
+        const double updates = std::max(1.0, double(row["updates"].get<uint64_t>()));
+        row["server_cpu_ms_per_update"] = 1000.0 * (cpuAfter - cpuBefore) / updates;
+        row["values_per_frame"] = values;
+        const double keyBytes = row["bytes_per_frame"]["key"].get<double>();
+        const double deltaBytes = row["bytes_per_frame"]["delta"].get<double>();
+        row["bits_per_value"] = {{"key", 8.0 * keyBytes / values}, {"delta", 8.0 * deltaBytes / values}};
+        const auto& latency = row["latency_ms"];
+        std::printf("%8u %8.0f %9.1f %9.1f %9.1f %9.1f %12.1f %11.1f %11.1f %10.2f %10.2f %8llu\n",
+                    clients, updates, latency["p50"].get<double>(), latency["p95"].get<double>(),
+                    latency["p99"].get<double>(), latency["max"].get<double>(),
+                    row["server_cpu_ms_per_update"].get<double>(), keyBytes / 1024.0,
+                    deltaBytes / 1024.0, row["bits_per_value"]["key"].get<double>(),
+                    row["bits_per_value"]["delta"].get<double>(),
+                    (unsigned long long)row["errors"].get<uint64_t>());
+        std::fflush(stdout);
+        if (row["errors"].get<uint64_t>() > 0) exit = 1;
+        rows.push_back(std::move(row));
+    }
+
+    auto bakes = (*connection)->listBakes();
+    nlohmann::ordered_json json;
+    json["scene"] = params.scenePath;
+    json["setting"] = params.setting;
+    json["link_mode"] = params.linkMode;
+    json["backend"] = params.backend;
+    json["device"] = bakes ? bakes->device() : "";
+    json["bounces"] = params.bounces;
+    json["duration_s"] = params.duration;
+    json["update_rate"] = params.updateRate;
+    json["caches"] = bake->caches.size();
+    json["runs"] = std::move(rows);
+    const int written = writeJson(json, params.jsonPath);
+    return exit != 0 ? exit : written;
+}
+
+}  // namespace pic

@@ -1,0 +1,32 @@
+#pragma once
+/// `picbench stream`: the product end to end under load (issue 5's benchmark). Bakes the
+/// scene at a paper 000 Table 2 setting, starts picserver as a child process on a free
+/// loopback port, and for each subscriber count runs `picclient load`'s test in this process:
+/// an editor moving the first light `updateRate` times a second for `duration` seconds while
+/// N subscribers decode every frame they receive. Per count it prints the latency from the
+/// editor's call to each subscriber holding the frame (p50, p95, p99, max), the server's CPU
+/// time per update (from /proc: it should not grow with N), bytes and bits per SH coefficient
+/// of key and delta frames. Writes JSON.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pic {
+
+struct StreamBenchmarkParams {
+    std::string scenePath;
+    std::string setting = "moderate";
+    std::string linkMode = "rtp";
+    std::string backend = "gpu";
+    int bounces = 1;
+    std::vector<uint32_t> clients = {1, 16, 64, 200};
+    double duration = 10.0;       ///< seconds of light changes per subscriber count
+    double updateRate = 2.0;      ///< light changes per second
+    std::string picserver;        ///< empty: picserver next to picbench in the build tree
+    std::string jsonPath = "stream_benchmark.json";
+};
+
+int runStreamBenchmark(const StreamBenchmarkParams& params);
+
+}  // namespace pic
