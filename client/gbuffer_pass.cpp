@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/bake_data.h"
@@ -71,15 +72,6 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
         textures.push_back(record);
         texels.insert(texels.end(), t.texels.begin(), t.texels.end());
     }
-    const VkDeviceSize texelBytes = texels.size() * sizeof(glm::vec4);
-    if (texelBytes > context.properties().limits.maxStorageBufferRange)
-        return fail(ErrorCode::Unsupported,
-                    "the scene's textures take {:.1f} MiB as float RGBA, more than the {:.1f} MiB "
-                    "one storage buffer of \"{}\" holds",
-                    double(texelBytes) / (1 << 20),
-                    double(context.properties().limits.maxStorageBufferRange) / (1 << 20),
-                    context.deviceName());
-
     std::vector<GbufferMaterial> materials;
     const auto textureOk = [&](int index) {
         return index < 0 || size_t(index) < scene.textures.size();
@@ -133,6 +125,20 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
         triangles.push_back(record);
     }
     pass->mVertexCount = uint32_t(vertices.size());
+
+    // Each array the fragment shader reads is one storage-buffer binding.
+    const VkDeviceSize range = context.properties().limits.maxStorageBufferRange;
+    const std::pair<VkDeviceSize, const char*> arrays[] = {
+        {texels.size() * sizeof(glm::vec4), "the textures as float RGBA"},
+        {triangles.size() * sizeof(GbufferTriangle), "the triangle records"},
+        {materials.size() * sizeof(GbufferMaterial), "the materials"}};
+    for (const auto& [bytes, what] : arrays)
+        if (bytes > range)
+            return fail(ErrorCode::Unsupported,
+                        "{} of scene {} take {:.1f} MiB, more than the {:.1f} MiB one storage "
+                        "buffer of \"{}\" holds",
+                        what, scene.sourcePath, double(bytes) / (1 << 20),
+                        double(range) / (1 << 20), context.deviceName());
 
     PIC_TRY_ASSIGN(pass->mVertices, context.createBufferWith(
                                         std::span<const GbufferVertex>(vertices),

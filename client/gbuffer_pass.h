@@ -34,7 +34,8 @@ public:
     /// Uploads the scene's triangles (3 corners each, with `triangleUvs` as their light-map
     /// UVs, kNotLightmapped for grid-shaded triangles), materials and textures, and builds
     /// the raster pipeline. InvalidInput for a scene whose triangles, materials or textures
-    /// do not index each other; Unsupported when its textures exceed one storage buffer.
+    /// do not index each other; Unsupported when its textures or triangle records exceed one
+    /// storage buffer.
     static Result<std::unique_ptr<GbufferPass>> create(Context& context, const Scene& scene,
                                                        std::span<const glm::vec2> triangleUvs);
     ~GbufferPass();

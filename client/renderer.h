@@ -71,7 +71,8 @@ public:
     /// Uploads the scene (triangles, materials, textures) and allocates the cache textures
     /// for `layout`, which hold no light until setCaches. InvalidInput when the layout does
     /// not fit the scene (other scene hash, UV count, band counts, non-finite numbers);
-    /// Unsupported when a texture does not fit the device's storage buffers.
+    /// Unsupported when the scene's textures or triangles, or one channel of the cache
+    /// textures, exceed one storage buffer of the device (lavapipe: 128 MiB).
     static Result<std::unique_ptr<Renderer>> create(gpu::Context& context, const Scene& scene,
                                                     const ClientLayout& layout,
                                                     const RendererOptions& options = {});
