@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -281,6 +282,11 @@ struct DirectCase {
     ShadeComponent component;
     bool extraLights;  ///< add a narrow spot, a wide spot and a directional light
 };
+
+/// gtest and ctest name a case by its name rather than its bytes.
+void PrintTo(const DirectCase& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class RendererDirect : public testing::TestWithParam<DirectCase> {};
 
