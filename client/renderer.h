@@ -95,6 +95,7 @@ public:
     Result<Image> render(const LightSet& lights, const Camera& camera, const ShadeParams& params,
                          RenderTimings* timings = nullptr);
 
+    /// The Vulkan context it renders with (device name, validation messages).
     const gpu::Context& context() const { return mContext; }
 
 private:
