@@ -295,6 +295,22 @@ Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame&
     return textures;
 }
 
+ClientLayout clientLayoutOf(const ClientScene& scene) {
+    const v1::SceneHeader& header = scene.header;
+    ClientLayout layout;
+    layout.sceneHash = header.scene_hash();
+    layout.bandsY = header.bands_y();
+    layout.bandsC = header.bands_c();
+    layout.gridOrigin = glm::vec3(header.grid().origin().x(), header.grid().origin().y(),
+                                  header.grid().origin().z());
+    layout.gridCellSize = header.grid().cell_size();
+    layout.gridDims = glm::uvec3(header.grid().dims_x(), header.grid().dims_y(), header.grid().dims_z());
+    layout.lightmapWidth = header.lightmap_width();
+    layout.lightmapHeight = header.lightmap_height();
+    layout.triangleUvs = scene.triangleUvs;
+    return layout;
+}
+
 std::string defaultCacheDir() {
     if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
         return (fs::path(xdg) / "pic").string();

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/frame_codec.h"
 #include "core/light_set.h"
+#include "client/renderer.h"
 #include "core/scene.h"
 #include "proto/pic.grpc.pb.h"
 #include "server/cpu/lightmap_copy.h"
@@ -102,6 +103,9 @@ private:
 /// The textures of `frame` for `scene`: halves widened to floats, coverage from the layout.
 /// InvalidInput when the frame's planes do not match the scene's layout and band counts.
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);
+
+/// The renderer's layout (client/renderer.h) of a downloaded scene.
+ClientLayout clientLayoutOf(const ClientScene& scene);
 
 /// The default folder for downloaded scenes: $XDG_CACHE_HOME/pic, else ~/.cache/pic, else
 /// /tmp/pic-cache.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -12,6 +13,9 @@
 
 #include "client/connection.h"
 #include "client/load_test.h"
+#include "client/renderer.h"
+#include "core/camera.h"
+#include "core/image.h"
 #include "proto/wire.h"
 
 namespace pic {
@@ -156,6 +160,150 @@ int runLoad(const Common& common, const LoadOptions& options, const std::string&
     return (*report)["errors"].get<uint64_t>() == 0 ? 0 : 1;
 }
 
+struct RenderCommand {
+    std::string lightsPath;
+    std::string cameraText;
+    int sceneCameraIndex = -1;
+    std::string sizeText;
+    std::string component = "full";
+    std::string outPath;
+    float exposure = 1.0f;
+    std::string device;
+    uint32_t shadowMapSize = 1024;
+    float glossyExponent = 0.0f;
+    float glossyWeight = 0.0f;
+    std::string cacheDir;
+    double waitSeconds = 60;
+};
+
+ShadeComponent toComponent(const std::string& name) {
+    if (name == "direct") return ShadeComponent::Direct;
+    if (name == "indirect") return ShadeComponent::Indirect;
+    return ShadeComponent::Full;
+}
+
+int runRender(const Common& common, const RenderCommand& command) {
+    const auto start = Clock::now();
+    const auto since = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    auto size = parseImageSize(command.sizeText);
+    if (!size) return reportError(size.error());
+    std::optional<LightSet> pushed;
+    if (!command.lightsPath.empty()) {
+        auto lights = readLightSet(command.lightsPath);
+        if (!lights) return reportError(lights.error());
+        pushed = std::move(*lights);
+    }
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto joined = connection->joinSession(common.session, common.token);
+    if (!joined) return reportError(joined.error());
+    const auto sceneStart = Clock::now();
+    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir);
+    if (!client) return reportError(client.error());
+    const double sceneMs = since(sceneStart);
+
+    Camera camera;
+    if (!command.cameraText.empty()) {
+        auto parsed = parseCamera(command.cameraText);
+        if (!parsed) return reportError(parsed.error());
+        camera = *parsed;
+    } else {
+        auto fromScene = sceneCamera(client->scene, command.sceneCameraIndex);
+        if (!fromScene) return reportError(fromScene.error());
+        camera = *fromScene;
+    }
+
+    // Subscribe first, then push: the wait below measures the light change to the frame.
+    auto stream = connection->subscribe(common.session, common.token);
+    uint64_t wanted = joined->version();
+    LightSet lights;
+    const auto pushStart = Clock::now();
+    if (pushed) {
+        auto version = connection->setLights(common.session, common.token, *pushed);
+        if (!version) return reportError(version.error());
+        wanted = *version;
+        lights = *pushed;
+    } else {
+        auto current = wire::fromProto(joined->lights());
+        if (!current) return reportError(current.error());
+        lights = std::move(*current);
+    }
+    // A timer ends the stream if the version never comes.
+    std::atomic<bool> done{false};
+    std::thread timer([&] {
+        while (!done && since(pushStart) < command.waitSeconds * 1000.0)
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (!done) stream->cancel();
+    });
+    FrameDecoder decoder;
+    v1::Frame frame;
+    double decodeMs = 0.0, serverMs = 0.0;
+    size_t bytes = 0;
+    while (decoder.version() < wanted && stream->next(frame)) {
+        bytes = 0;
+        for (const v1::Plane& plane : frame.planes()) bytes += plane.data().size();
+        serverMs = frame.update_ms() + frame.encode_ms();
+        const auto decodeStart = Clock::now();
+        auto applied = decoder.apply(frame);
+        if (!applied) {
+            done = true;
+            timer.join();
+            return reportError(applied.error());
+        }
+        decodeMs = since(decodeStart);
+    }
+    const double latencyMs = since(pushStart);
+    done = true;
+    timer.join();
+    stream->cancel();
+    if (decoder.version() < wanted) {
+        grpc::Status status = stream->status();
+        if (!status.ok() && status.error_code() != grpc::StatusCode::CANCELLED)
+            return reportError(wire::fromStatus(status, "Subscribe"));
+        return reportError(Error{ErrorCode::Internal,
+                                 fmt::format("version {} did not arrive within {} s", wanted,
+                                             command.waitSeconds)});
+    }
+    auto textures = cacheTexturesOf(*client, decoder.frame());
+    if (!textures) return reportError(textures.error());
+
+    gpu::ContextOptions contextOptions;
+    contextOptions.deviceName = command.device;
+    auto context = gpu::Context::create(contextOptions);
+    if (!context) return reportError(context.error());
+    RendererOptions rendererOptions;
+    rendererOptions.shadowMapSize = command.shadowMapSize;
+    auto renderer = Renderer::create(**context, client->scene, clientLayoutOf(*client), rendererOptions);
+    if (!renderer) return reportError(renderer.error());
+    if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
+    ShadeParams params;
+    params.width = size->x;
+    params.height = size->y;
+    params.component = toComponent(command.component);
+    params.glossyExponent = command.glossyExponent;
+    params.glossyWeight = command.glossyWeight;
+    RenderTimings timings;
+    auto image = (*renderer)->render(lights, camera, params, &timings);
+    if (!image) return reportError(image.error());
+    if (auto written = writeImage(command.outPath, *image, command.exposure); !written)
+        return reportError(written.error());
+
+    std::string passes;
+    for (const auto& [pass, ms] : timings.passMs)
+        passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", pass, ms);
+    std::fprintf(stderr,
+                 "picclient render: scene %.0f ms (%s); version %llu: light change to decoded "
+                 "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms); "
+                 "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
+                 sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
+                 serverMs, bytes, decodeMs, size->x, size->y, command.component.c_str(),
+                 (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
+                 command.outPath.c_str());
+    std::printf("%s\n", command.outPath.c_str());
+    return 0;
+}
+
 }  // namespace
 
 int picclientMain(int argc, char** argv) {
@@ -207,8 +355,46 @@ int picclientMain(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     loadCommand->add_option("--report", reportPath, "JSON report to write")->required();
 
+    RenderCommand render;
+    render.cacheDir = defaultCacheDir();
+    CLI::App* renderCommand = app.add_subcommand(
+        "render", "render one frame headless (Vulkan: a GPU, else lavapipe) shaded with the "
+                  "session's current caches; --lights (editor token) is applied first");
+    addServer(*renderCommand, common);
+    addSession(*renderCommand, common);
+    renderCommand->add_option("--lights", render.lightsPath,
+                              "light set JSON to push first (needs the editor token)");
+    auto* cameraOption = renderCommand->add_option("--camera", render.cameraText,
+                                                   "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
+    auto* sceneCameraOption = renderCommand->add_option("--scene-camera", render.sceneCameraIndex,
+                                                        "the glTF's N-th camera (0-based)");
+    cameraOption->excludes(sceneCameraOption);
+    renderCommand->add_option("--size", render.sizeText, "image size WxH")->required();
+    renderCommand->add_option("--component", render.component, "what the image holds")
+        ->check(CLI::IsMember({"full", "direct", "indirect"}));
+    renderCommand->add_option("--out", render.outPath, "image to write (.exr linear, .png sRGB)")
+        ->required();
+    renderCommand->add_option("--exposure", render.exposure, "factor applied before PNG quantisation");
+    renderCommand->add_option("--device", render.device, "Vulkan device whose name contains this");
+    renderCommand->add_option("--shadow-map-size", render.shadowMapSize,
+                              "texels per side of each shadow-map layer")
+        ->check(CLI::Range(16u, 16384u));
+    auto* glossyOption = renderCommand->add_option("--glossy", render.glossyExponent,
+                                                   "Phong exponent of an added glossy lobe (> 0)")
+                             ->check(CLI::PositiveNumber);
+    auto* glossyWeightOption = renderCommand->add_option("--glossy-weight", render.glossyWeight,
+                                                         "factor on the glossy lobe (≥ 0)")
+                                   ->check(CLI::NonNegativeNumber);
+    glossyOption->needs(glossyWeightOption);
+    glossyWeightOption->needs(glossyOption);
+    renderCommand->add_option("--cache-dir", render.cacheDir, "where downloaded scenes are kept");
+    renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
+        ->check(CLI::PositiveNumber);
+
     try {
         app.parse(argc, argv);
+        if (renderCommand->parsed() && cameraOption->count() == 0 && sceneCameraOption->count() == 0)
+            throw CLI::RequiredError("--camera or --scene-camera");
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
@@ -218,6 +404,7 @@ int picclientMain(int argc, char** argv) {
     if (session->parsed()) return runSession(common, bakeId);
     if (lights->parsed()) return runLights(common, lightsPath);
     if (watch->parsed()) return runWatch(common, count, watchSeconds);
+    if (renderCommand->parsed()) return runRender(common, render);
     if (loadCommand->parsed()) {
         if (load.session.empty() != load.editorToken.empty()) {
             std::fprintf(stderr, "picclient: error: --session and --token go together\n");

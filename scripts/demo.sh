@@ -1,20 +1,54 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds pic and runs the main job: bakes the default scene (the
-# generated atrium; pass any .gltf/.glb path to bake that instead), prints the summary, then
-# relights the bake with the GPU runtime (a GPU, else lavapipe) and shades a frame from the
-# caches, printing the update's timings and where the image is.
+# Installs dependencies, builds pic and runs the whole story on one scene (default: the
+# generated atrium; pass any .gltf/.glb path, and optionally a light set JSON for it):
+#   bake → picserver (GPU backend: a GPU, else lavapipe) → a session → a light change pushed
+#   by an editor → a frame rendered by the thin client from the streamed caches → a short
+#   load test; prints the timings, the latencies and where the image is.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 BUILD_DIR=${PIC_BUILD_DIR:-build}
 SCENE=${1:-$BUILD_DIR/scenes/atrium.gltf}
+LIGHTS=${2:-}
+if [[ -z "$LIGHTS" && $# -eq 0 ]]; then LIGHTS=bench/lightsets/atrium_evening.json; fi
 OUT_DIR=${PIC_OUT_DIR:-out}
 mkdir -p "$OUT_DIR"
-OUT="$OUT_DIR/$(basename "${SCENE%.*}").pic"
-"$BUILD_DIR/bake/picbake" bake "$SCENE" -o "$OUT"
-"$BUILD_DIR/bake/picbake" info "$OUT"
-echo "bake written to $OUT (timings in $OUT.timings.json)"
-IMAGE="$OUT_DIR/$(basename "${SCENE%.*}")_gpu.png"
-"$BUILD_DIR/bake/ref/picref" shade "$SCENE" --bake "$OUT" --backend gpu --scene-camera 0 \
-  --size 640x360 --quiet --out "$IMAGE"
-echo "frame shaded from the GPU runtime's caches: $IMAGE"
+NAME=$(basename "${SCENE%.*}")
+BAKE="$OUT_DIR/$NAME.pic"
+
+"$BUILD_DIR/bake/picbake" bake "$SCENE" -o "$BAKE"
+"$BUILD_DIR/bake/picbake" info "$BAKE"
+echo "bake written to $BAKE (timings in $BAKE.timings.json)"
+
+# The server on a free loopback port; its first line says which. Stopped on exit.
+SERVER_LOG="$OUT_DIR/${NAME}_server.log"
+coproc SERVER { exec "$BUILD_DIR/server/picserver" --bake "$BAKE" --scene "$SCENE" \
+  --listen 127.0.0.1:0 --backend gpu --quiet 2>&1; }
+SERVER_PID=$SERVER_PID
+trap 'kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true' EXIT
+ADDRESS=""
+while IFS= read -r line <&"${SERVER[0]}"; do
+  echo "$line" >> "$SERVER_LOG"
+  if [[ "$line" == "listening on "* ]]; then ADDRESS=${line#listening on }; break; fi
+done
+if [[ -z "$ADDRESS" ]]; then echo "picserver did not start; see $SERVER_LOG" >&2; exit 1; fi
+cat <&"${SERVER[0]}" >> "$SERVER_LOG" &
+echo "picserver listening on $ADDRESS (log: $SERVER_LOG)"
+
+SESSION_JSON=$("$BUILD_DIR/client/picclient" session --server "$ADDRESS")
+field() { sed -E "s/.*\"$1\":\"([^\"]*)\".*/\1/" <<<"$SESSION_JSON"; }
+SESSION=$(field session)
+EDITOR=$(field editor_token)
+echo "session $SESSION"
+
+IMAGE="$OUT_DIR/${NAME}_client.png"
+LIGHT_ARGS=()
+if [[ -n "$LIGHTS" ]]; then LIGHT_ARGS=(--lights "$LIGHTS"); fi
+"$BUILD_DIR/client/picclient" render --server "$ADDRESS" --session "$SESSION" --token "$EDITOR" \
+  "${LIGHT_ARGS[@]}" --scene-camera 0 --size 640x360 --out "$IMAGE"
+
+REPORT="$OUT_DIR/${NAME}_load.json"
+"$BUILD_DIR/client/picclient" load --server "$ADDRESS" --clients 8 --duration 4 --update-rate 2 \
+  --report "$REPORT"
+echo "server log (one line per update): $SERVER_LOG"
+echo "frame rendered by the thin client from the streamed caches: $IMAGE"

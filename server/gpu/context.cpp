@@ -143,6 +143,35 @@ void DepthArray::reset() {
     mSize = 0;
 }
 
+RenderTarget& RenderTarget::operator=(RenderTarget&& other) noexcept {
+    if (this != &other) {
+        reset();
+        mDevice = std::exchange(other.mDevice, VK_NULL_HANDLE);
+        mImage = std::exchange(other.mImage, VK_NULL_HANDLE);
+        mMemory = std::exchange(other.mMemory, VK_NULL_HANDLE);
+        mView = std::exchange(other.mView, VK_NULL_HANDLE);
+        mFormat = std::exchange(other.mFormat, VK_FORMAT_UNDEFINED);
+        mWidth = std::exchange(other.mWidth, 0);
+        mHeight = std::exchange(other.mHeight, 0);
+        mBytes = std::exchange(other.mBytes, 0);
+    }
+    return *this;
+}
+
+void RenderTarget::reset() {
+    if (mDevice == VK_NULL_HANDLE) return;
+    if (mView) vkDestroyImageView(mDevice, mView, nullptr);
+    if (mImage) vkDestroyImage(mDevice, mImage, nullptr);
+    if (mMemory) vkFreeMemory(mDevice, mMemory, nullptr);
+    mDevice = VK_NULL_HANDLE;
+    mImage = VK_NULL_HANDLE;
+    mMemory = VK_NULL_HANDLE;
+    mView = VK_NULL_HANDLE;
+    mFormat = VK_FORMAT_UNDEFINED;
+    mWidth = mHeight = 0;
+    mBytes = 0;
+}
+
 // ---------------------------------------------------------------------------------------------
 // PassTimer
 
@@ -550,6 +579,49 @@ Result<DepthArray> Context::createDepthArray(uint32_t size, uint32_t layers) {
                              &toRead);
     }));
     return depth;
+}
+
+Result<RenderTarget> Context::createRenderTarget(uint32_t width, uint32_t height, VkFormat format,
+                                                 const char* what) {
+    if (mLost) return fail(ErrorCode::Internal, "the Vulkan device \"{}\" was lost", mName);
+    const uint32_t limit = mProperties.limits.maxImageDimension2D;
+    if (width == 0 || height == 0 || width > limit || height > limit)
+        return fail(ErrorCode::InvalidInput, "{} of {}x{} is outside the device's 1..{} per side",
+                    what, width, height, limit);
+    const bool depth = format == VK_FORMAT_D32_SFLOAT;
+    RenderTarget target;
+    target.mDevice = mDevice;
+    target.mFormat = format;
+    target.mWidth = width;
+    target.mHeight = height;
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = format;
+    info.extent = {width, height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = depth ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
+                       : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    PIC_VK_TRY(vkCreateImage(mDevice, &info, nullptr, &target.mImage));
+    VkMemoryRequirements requirements;
+    vkGetImageMemoryRequirements(mDevice, target.mImage, &requirements);
+    VkMemoryPropertyFlags flags = 0;
+    PIC_TRY(allocate(requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, target.mMemory, flags,
+                     what));
+    PIC_VK_TRY(vkBindImageMemory(mDevice, target.mImage, target.mMemory, 0));
+    target.mBytes = requirements.size;
+    VkImageViewCreateInfo viewInfo{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    viewInfo.image = target.mImage;
+    viewInfo.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    viewInfo.format = format;
+    viewInfo.subresourceRange = {depth ? VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT)
+                                       : VkImageAspectFlags(VK_IMAGE_ASPECT_COLOR_BIT),
+                                 0, 1, 0, 1};
+    PIC_VK_TRY(vkCreateImageView(mDevice, &viewInfo, nullptr, &target.mView));
+    return target;
 }
 
 Result<VkShaderModule> Context::createShaderModule(std::span<const uint32_t> spirv,

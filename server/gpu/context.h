@@ -93,6 +93,36 @@ private:
     uint32_t mSize = 0;
 };
 
+/// A 2D image with one view over its single layer: a colour or depth target that a raster
+/// pass renders and later passes sample. Its layout is UNDEFINED once created; the pass that
+/// renders it transitions it.
+class RenderTarget {
+public:
+    RenderTarget() = default;
+    RenderTarget(RenderTarget&& other) noexcept { *this = std::move(other); }
+    RenderTarget& operator=(RenderTarget&& other) noexcept;
+    ~RenderTarget() { reset(); }
+
+    VkImage image() const { return mImage; }
+    VkImageView view() const { return mView; }
+    VkFormat format() const { return mFormat; }
+    uint32_t width() const { return mWidth; }
+    uint32_t height() const { return mHeight; }
+    VkDeviceSize bytes() const { return mBytes; }
+    void reset();
+
+private:
+    friend class Context;
+    VkDevice mDevice = VK_NULL_HANDLE;
+    VkImage mImage = VK_NULL_HANDLE;
+    VkDeviceMemory mMemory = VK_NULL_HANDLE;
+    VkImageView mView = VK_NULL_HANDLE;
+    VkFormat mFormat = VK_FORMAT_UNDEFINED;
+    uint32_t mWidth = 0;
+    uint32_t mHeight = 0;
+    VkDeviceSize mBytes = 0;
+};
+
 /// How to open a context.
 struct ContextOptions {
     /// Case-insensitive substring of the device name to use ("llvmpipe", "NVIDIA"); empty:
@@ -170,6 +200,12 @@ public:
     /// A D32 depth array of `layers` square layers of `size`², sampled and rendered to, in
     /// SHADER_READ_ONLY layout once created.
     Result<DepthArray> createDepthArray(uint32_t size, uint32_t layers);
+
+    /// A width × height render target of `format`: a depth attachment for depth formats
+    /// (VK_FORMAT_D32_SFLOAT), else a colour attachment that shaders may sample. InvalidInput
+    /// when a side is 0 or beyond the device's 2D image limit.
+    Result<RenderTarget> createRenderTarget(uint32_t width, uint32_t height, VkFormat format,
+                                            const char* what);
 
     /// A shader module from SPIR-V words.
     Result<VkShaderModule> createShaderModule(std::span<const uint32_t> spirv, const char* what);

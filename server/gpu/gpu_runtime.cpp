@@ -3,13 +3,12 @@
 #include <chrono>
 
 #include "core/color.h"
-#include "core/sh.h"
+#include "server/gpu/sh_tables.h"
 #include "server/passes/cache_lighting_pass.h"
 #include "server/passes/lightmap_copy_pass.h"
 #include "server/passes/pull_pass.h"
 #include "server/passes/shadow_map_pass.h"
 #include "server/passes/surfel_lighting_pass.h"
-#include "shaders/shared/sh_tables.h"
 
 namespace pic {
 namespace {
@@ -23,22 +22,6 @@ double millisecondsSince(Clock::time_point start) {
 /// Timestamp pairs one submission may hold: shadow maps, surfel lighting, pull, cache
 /// lighting, light-map copy, with room to spare.
 constexpr uint32_t kTimedPasses = 16;
-
-gpu::ShTables makeShTables() {
-    const ShRecurrence recurrence = shRecurrence();
-    gpu::ShTables tables{};
-    // Element k of each array is component k % 4 of vec4 k / 4.
-    const auto at = [](glm::vec4* array, int k) -> float& { return array[k / 4][k % 4]; };
-    for (int l = 0; l < kMaxShBands; ++l) {
-        at(tables.diagonal, l) = recurrence.diagonal[l];
-        at(tables.clampedCosine, l) = clampedCosineZonal(l);
-        for (int m = 0; m < kMaxShBands; ++m) {
-            at(tables.a, l * kMaxShBands + m) = recurrence.a[l][m];
-            at(tables.b, l * kMaxShBands + m) = recurrence.b[l][m];
-        }
-    }
-    return tables;
-}
 
 }  // namespace
 

@@ -24,6 +24,11 @@
 
 #include "bake/bake.h"
 #include "client/connection.h"
+#include "client/renderer.h"
+#include "core/camera.h"
+#include "core/image.h"
+#include "server/cpu/cache_shading.h"
+#include "server/cpu/cpu_runtime.h"
 #include "core/bake_file.h"
 #include "core/gltf_loader.h"
 #include "proto/wire.h"
@@ -482,6 +487,59 @@ TEST(Stream, GpuBackendServesTheSameProtocol) {
     EXPECT_TRUE(reader.frame() == *served.server->session(session->session())->latestUpdate()->frame);
 }
 
+TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    const fs::path cache = fs::temp_directory_path() / fmt::format("pic_stream_render_{}", getpid());
+    auto client = served.connection->fetchScene("", cache.string());
+    ASSERT_TRUE(client) << client.error().message;
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    const LightSet lights = pointLight(0.15f);
+    auto version = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(version);
+    ASSERT_TRUE(reader.waitFor(*version));
+    auto textures = cacheTexturesOf(*client, reader.frame());
+    ASSERT_TRUE(textures) << textures.error().message;
+
+    auto context = gpu::Context::create();
+    ASSERT_TRUE(context) << context.error().message;
+    auto renderer = Renderer::create(**context, client->scene, clientLayoutOf(*client));
+    ASSERT_TRUE(renderer) << renderer.error().message;
+    ASSERT_TRUE((*renderer)->setCaches(*textures));
+    auto camera = sceneCamera(client->scene, 0);
+    ASSERT_TRUE(camera);
+    ShadeParams params;
+    params.width = 127;  // odd: no wall corner through a pixel centre (client/renderer_test.cpp)
+    params.height = 112;
+    params.component = ShadeComponent::Indirect;
+    auto image = (*renderer)->render(lights, *camera, params);
+    ASSERT_TRUE(image) << image.error().message;
+
+    // The CPU shading of the same caches: the CPU twin is deterministic, so relighting the
+    // same bake with the same set gives the server's caches.
+    auto bake = readBakeFile(bakePath());
+    ASSERT_TRUE(bake);
+    auto scene = loadScene(kScene);
+    ASSERT_TRUE(scene);
+    auto rays = EmbreeScene::create(*scene);
+    ASSERT_TRUE(rays);
+    auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{1});
+    ASSERT_TRUE(runtime);
+    auto values = (*runtime)->setLights(lights);
+    ASSERT_TRUE(values);
+    auto reference = shadeFromCaches(*scene, **rays, *bake, **values, lights, *camera, params);
+    ASSERT_TRUE(reference);
+    auto error = compareImages(*image, *reference);
+    ASSERT_TRUE(error);
+    std::printf("client indirect vs CPU shading: relative RMSE %.5f, mean ratio %.5f\n",
+                error->relativeRmse, error->meanRatio);
+    EXPECT_LE(error->relativeRmse, 0.01);
+    EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
+    fs::remove_all(cache);
+}
+
 /// Runs a command with its stdout on a pipe; the child's pid and the read end.
 struct Child {
     pid_t pid = -1;
@@ -581,6 +639,27 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_EQ(loadReport["updates"].get<int>(), 4);
     EXPECT_GE(loadReport["frames_received"].get<int>(), 3);
     EXPECT_EQ(loadReport["errors"].get<int>(), 0);
+
+    const fs::path image = fs::temp_directory_path() / fmt::format("pic_cli_render_{}.exr", getpid());
+    const fs::path cacheDir = fs::temp_directory_path() / fmt::format("pic_cli_cache_{}", getpid());
+    std::string rendered = run(client + " render --server " + address + " --session " + session +
+                                   " --token " + editor + " --lights " + lightsFile.string() +
+                                   " --scene-camera 0 --size 63x56 --component indirect --cache-dir " +
+                                   cacheDir.string() + " --out " + image.string() + " 2>&1",
+                               exit);
+    EXPECT_EQ(exit, 0) << rendered;
+    EXPECT_NE(rendered.find("light change to decoded frame"), std::string::npos) << rendered;
+    auto read = readImage(image.string());
+    ASSERT_TRUE(read) << rendered;
+    EXPECT_EQ(read->width, 63);
+    std::string viewerPush = run(client + " render --server " + address + " --session " + session +
+                                     " --token " + viewer + " --lights " + lightsFile.string() +
+                                     " --scene-camera 0 --size 8x8 --cache-dir " + cacheDir.string() +
+                                     " --out " + image.string() + " 2>&1",
+                                 exit);
+    EXPECT_EQ(exit, 2) << viewerPush;
+    fs::remove(image);
+    fs::remove_all(cacheDir);
 
     // The update log: one line per update after the first line.
     const std::string updateLine = readLine(server.out);
