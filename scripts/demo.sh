@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds pic and runs the whole story on one scene (default: the
-# generated atrium; pass any .gltf/.glb path, and optionally a light set JSON for it):
+# generated atrium; pass any .gltf/.glb path, and optionally a light set JSON for it; set
+# PIC_CAMERA for scenes without a camera):
 #   bake → picserver (GPU backend: a GPU, else lavapipe) → a session → a light change pushed
 #   by an editor → a frame rendered by the thin client from the streamed caches → a short
 #   load test; prints the timings, the latencies and where the image is.
@@ -22,17 +23,17 @@ echo "bake written to $BAKE (timings in $BAKE.timings.json)"
 
 # The server on a free loopback port; its first line says which. Stopped on exit.
 SERVER_LOG="$OUT_DIR/${NAME}_server.log"
-coproc SERVER { exec "$BUILD_DIR/server/picserver" --bake "$BAKE" --scene "$SCENE" \
-  --listen 127.0.0.1:0 --backend gpu --quiet 2>&1; }
-SERVER_PID=$SERVER_PID
+"$BUILD_DIR/server/picserver" --bake "$BAKE" --scene "$SCENE" --listen 127.0.0.1:0 \
+  --backend gpu --quiet > "$SERVER_LOG" 2>&1 &
+SERVER_PID=$!
 trap 'kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true' EXIT
 ADDRESS=""
-while IFS= read -r line <&"${SERVER[0]}"; do
-  echo "$line" >> "$SERVER_LOG"
-  if [[ "$line" == "listening on "* ]]; then ADDRESS=${line#listening on }; break; fi
+for _ in $(seq 1 1200); do
+  ADDRESS=$(sed -n 's/^listening on //p' "$SERVER_LOG" | head -n 1)
+  if [[ -n "$ADDRESS" ]] || ! kill -0 "$SERVER_PID" 2>/dev/null; then break; fi
+  sleep 0.1
 done
-if [[ -z "$ADDRESS" ]]; then echo "picserver did not start; see $SERVER_LOG" >&2; exit 1; fi
-cat <&"${SERVER[0]}" >> "$SERVER_LOG" &
+if [[ -z "$ADDRESS" ]]; then echo "picserver did not start; see $SERVER_LOG" >&2; cat "$SERVER_LOG" >&2; exit 1; fi
 echo "picserver listening on $ADDRESS (log: $SERVER_LOG)"
 
 SESSION_JSON=$("$BUILD_DIR/client/picclient" session --server "$ADDRESS")
@@ -42,13 +43,17 @@ EDITOR=$(field editor_token)
 echo "session $SESSION"
 
 IMAGE="$OUT_DIR/${NAME}_client.png"
+# The glTF's first camera, or PIC_CAMERA=ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy for scenes without one.
+CAMERA_ARGS=(--scene-camera 0)
+if [[ -n "${PIC_CAMERA:-}" ]]; then CAMERA_ARGS=(--camera "$PIC_CAMERA"); fi
 LIGHT_ARGS=()
 if [[ -n "$LIGHTS" ]]; then LIGHT_ARGS=(--lights "$LIGHTS"); fi
 "$BUILD_DIR/client/picclient" render --server "$ADDRESS" --session "$SESSION" --token "$EDITOR" \
-  "${LIGHT_ARGS[@]}" --scene-camera 0 --size 640x360 --out "$IMAGE"
+  "${LIGHT_ARGS[@]}" "${CAMERA_ARGS[@]}" --size 640x360 --out "$IMAGE"
 
 REPORT="$OUT_DIR/${NAME}_load.json"
-"$BUILD_DIR/client/picclient" load --server "$ADDRESS" --clients 8 --duration 4 --update-rate 2 \
+"$BUILD_DIR/client/picclient" load --server "$ADDRESS" --session "$SESSION" --token "$EDITOR" \
+  --clients 8 --duration 4 --update-rate 2 \
   --report "$REPORT"
 echo "server log (one line per update): $SERVER_LOG"
 echo "frame rendered by the thin client from the streamed caches: $IMAGE"
