@@ -123,9 +123,9 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
         return texels * (lY * lY + 2.0 * lC * lC);
     }();
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-    std::printf("%8s %8s %9s %9s %9s %9s %12s %11s %11s %10s %10s %8s\n", "clients", "updates",
-                "p50 ms", "p95 ms", "p99 ms", "max ms", "server ms/up", "key KiB", "delta KiB",
-                "key b/val", "dlt b/val", "errors");
+    std::printf("%8s %8s %9s %9s %9s %9s %10s %10s %12s %11s %11s %10s %10s %8s\n", "clients",
+                "updates", "p50 ms", "p95 ms", "p99 ms", "max ms", "update ms", "encode ms",
+                "server CPU", "key KiB", "delta KiB", "key b/val", "dlt b/val", "errors");
     int exit = 0;
     for (uint32_t clients : params.clients) {
         LoadOptions load;
@@ -145,9 +145,12 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
         const double deltaBytes = row["bytes_per_frame"]["delta"].get<double>();
         row["bits_per_value"] = {{"key", 8.0 * keyBytes / values}, {"delta", 8.0 * deltaBytes / values}};
         const auto& latency = row["latency_ms"];
-        std::printf("%8u %8.0f %9.1f %9.1f %9.1f %9.1f %12.1f %11.1f %11.1f %10.2f %10.2f %8llu\n",
+        std::printf("%8u %8.0f %9.1f %9.1f %9.1f %9.1f %10.1f %10.1f %12.1f %11.1f %11.1f %10.2f "
+                    "%10.2f %8llu\n",
                     clients, updates, latency["p50"].get<double>(), latency["p95"].get<double>(),
                     latency["p99"].get<double>(), latency["max"].get<double>(),
+                    row["server_ms"]["update_p50"].get<double>(),
+                    row["server_ms"]["encode_p50"].get<double>(),
                     row["server_cpu_ms_per_update"].get<double>(), keyBytes / 1024.0,
                     deltaBytes / 1024.0, row["bits_per_value"]["key"].get<double>(),
                     row["bits_per_value"]["delta"].get<double>(),

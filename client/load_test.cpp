@@ -33,6 +33,7 @@ struct Received {
     uint64_t keyBytes = 0, keyFrames = 0, deltaBytes = 0, deltaFrames = 0;
     uint64_t skipped = 0;
     std::vector<std::string> errors;
+    std::map<uint64_t, std::pair<double, double>> serverMs;  ///< version → update, encode ms
 };
 
 void subscribeLoop(FrameStream& stream, Received& received, std::atomic<uint32_t>& ready,
@@ -42,6 +43,7 @@ void subscribeLoop(FrameStream& stream, Received& received, std::atomic<uint32_t
     bool first = true;
     while (stream.next(frame)) {
         const bool key = frame.base_version() == 0;
+        const std::pair<double, double> serverMs{frame.update_ms(), frame.encode_ms()};
         size_t bytes = 0;
         for (const v1::Plane& plane : frame.planes()) bytes += plane.data().size();
         const uint64_t previous = decoder.version();
@@ -57,6 +59,7 @@ void subscribeLoop(FrameStream& stream, Received& received, std::atomic<uint32_t
         (key ? received.keyBytes : received.deltaBytes) += bytes;
         ++(key ? received.keyFrames : received.deltaFrames);
         received.versions.emplace_back(frame.version(), now);
+        received.serverMs[frame.version()] = serverMs;
         if (first) ready.fetch_add(1);
         first = false;
     }
@@ -158,6 +161,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     for (auto& thread : threads) thread.join();
 
     std::vector<double> latencies;
+    std::map<uint64_t, std::pair<double, double>> serverMs;
     uint64_t frames = 0, skipped = 0, keyBytes = 0, keyFrames = 0, deltaBytes = 0, deltaFrames = 0;
     uint64_t missingLast = 0;
     std::vector<std::string> errors = editorErrors;
@@ -169,6 +173,8 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
         deltaBytes += r.deltaBytes;
         deltaFrames += r.deltaFrames;
         errors.insert(errors.end(), r.errors.begin(), r.errors.end());
+        for (const auto& [version, ms] : r.serverMs)
+            if (sent.contains(version)) serverMs[version] = ms;
         if (r.versions.empty() || r.versions.back().first < lastVersion) ++missingLast;
         // Each version the editor set counts once per subscriber: the time until the
         // subscriber held it or a newer one.
@@ -193,6 +199,15 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
                             {"max", latencies.empty() ? 0.0 : *std::max_element(latencies.begin(), latencies.end())},
                             {"mean", latencies.empty() ? 0.0 : std::accumulate(latencies.begin(), latencies.end(), 0.0) / double(latencies.size())},
                             {"samples", latencies.size()}};
+    std::vector<double> updateMs, encodeMs;
+    for (const auto& [version, ms] : serverMs) {
+        updateMs.push_back(ms.first);
+        encodeMs.push_back(ms.second);
+    }
+    // Where the latency goes: the server's own time per computed version (frames say it).
+    report["server_ms"] = {{"update_p50", percentile(updateMs, 0.5)},
+                           {"encode_p50", percentile(encodeMs, 0.5)},
+                           {"versions_computed", serverMs.size()}};
     report["frames_received"] = frames;
     report["versions_skipped"] = skipped;
     report["bytes_per_frame"] = {{"key", keyFrames ? double(keyBytes) / double(keyFrames) : 0.0},

@@ -38,10 +38,12 @@ void logUpdate(const UpdateLog& log) {
     for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
     std::string base = update.baseVersion == 0 ? std::string("key")
                                                : fmt::format("delta:{}", update.baseVersion);
-    std::printf("update session=%s version=%llu bounces=%d%s update_ms=%.1f encode_ms=%.1f "
+    std::printf("update session=%s version=%llu bounces=%d%s runtime_ms=%.1f update_ms=%.1f "
+                "encode_ms=%.1f "
                 "bytes=%zu frame=%s subscribers=%zu\n",
                 log.session.c_str(), (unsigned long long)update.version, update.stats.bounces,
-                passes.c_str(), update.broadcast->update_ms(), update.encodeMs, bytes,
+                passes.c_str(), update.stats.totalMs, update.broadcast->update_ms(),
+                update.encodeMs, bytes,
                 base.c_str(), log.subscribers);
     std::fflush(stdout);
 }

@@ -1,5 +1,6 @@
 #include "server/served_bake.h"
 
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -125,8 +126,12 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
 Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame) {
     std::lock_guard lock(mRuntimeMutex);
     PIC_TRY(mRuntime->setLights(lights, &stats));
+    const auto start = std::chrono::steady_clock::now();
     PIC_TRY_ASSIGN(const CacheTextures* textures, mRuntime->textures());
     frame = halfFrameOf(*textures);
+    // Host time, beside the passes' device times: reading the textures back to the host.
+    stats.passMs["readback"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return {};
 }
 
