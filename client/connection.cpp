@@ -76,16 +76,25 @@ grpc::Status FrameStream::status() {
 }
 
 Result<std::unique_ptr<PicConnection>> PicConnection::connect(const std::string& address,
-                                                              std::chrono::milliseconds timeout) {
+                                                              std::chrono::milliseconds timeout,
+                                                              const std::string& rootCertsPem) {
     grpc::ChannelArguments arguments;
     arguments.SetMaxReceiveMessageSize(-1);
     auto connection = std::unique_ptr<PicConnection>(new PicConnection());
     connection->mAddress = address;
-    connection->mChannel =
-        grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments);
+    std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+    if (!rootCertsPem.empty()) {
+        grpc::SslCredentialsOptions ssl;
+        ssl.pem_root_certs = rootCertsPem;
+        credentials = grpc::SslCredentials(ssl);
+    }
+    connection->mChannel = grpc::CreateCustomChannel(address, credentials, arguments);
     if (!connection->mChannel->WaitForConnected(std::chrono::system_clock::now() + timeout))
-        return fail(ErrorCode::Io, "cannot reach a picserver at {} (waited {} ms)", address,
-                    timeout.count());
+        return fail(ErrorCode::Io, "cannot reach a picserver at {} (waited {} ms{})", address,
+                    timeout.count(),
+                    rootCertsPem.empty() ? "; a TLS server needs --tls-ca"
+                                         : "; with TLS: is the server's certificate signed by "
+                                           "--tls-ca and valid for this address?");
     connection->mStub = v1::Pic::NewStub(connection->mChannel);
     return connection;
 }

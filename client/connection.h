@@ -58,9 +58,10 @@ private:
 class PicConnection {
 public:
     /// Connects to `address` ("HOST:PORT"), waiting up to `timeout` for the server; Io when it
-    /// cannot be reached.
+    /// cannot be reached. With `rootCertsPem` the channel is TLS, trusting those certificates.
     static Result<std::unique_ptr<PicConnection>> connect(
-        const std::string& address, std::chrono::milliseconds timeout = std::chrono::seconds(10));
+        const std::string& address, std::chrono::milliseconds timeout = std::chrono::seconds(10),
+        const std::string& rootCertsPem = "");
 
     const std::string& address() const { return mAddress; }
     v1::Pic::Stub& stub() { return *mStub; }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <thread>
@@ -38,6 +39,7 @@ int reportError(const Error& error) {
 
 struct Common {
     std::string server = "127.0.0.1:50051";
+    std::string tlsCa;
     std::string session;
     std::string token;
     double connectSeconds = 10;
@@ -47,6 +49,9 @@ void addServer(CLI::App& app, Common& common) {
     app.add_option("--server", common.server, "picserver address HOST:PORT");
     app.add_option("--connect-timeout", common.connectSeconds, "seconds to wait for the server")
         ->check(CLI::PositiveNumber);
+    app.add_option("--tls-ca", common.tlsCa,
+                   "connect with TLS, trusting the certificates in this PEM file")
+        ->check(CLI::ExistingFile);
 }
 
 void addSession(CLI::App& app, Common& common) {
@@ -55,8 +60,16 @@ void addSession(CLI::App& app, Common& common) {
 }
 
 Result<std::unique_ptr<PicConnection>> connectTo(const Common& common) {
+    std::string rootCerts;
+    if (!common.tlsCa.empty()) {
+        std::ifstream file(common.tlsCa, std::ios::binary);
+        rootCerts.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+        if (rootCerts.empty())
+            return fail(ErrorCode::InvalidInput, "--tls-ca {} is empty or unreadable", common.tlsCa);
+    }
     return PicConnection::connect(
-        common.server, std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)));
+        common.server, std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)),
+        rootCerts);
 }
 
 int runSession(const Common& common, const std::string& bakeId) {

@@ -5,7 +5,10 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <future>
+#include <iterator>
+#include <utility>
 #include <string>
 #include <thread>
 #include <vector>
@@ -27,6 +30,14 @@ using Clock = std::chrono::steady_clock;
 int reportError(const Error& error) {
     std::fprintf(stderr, "picserver: error: %s\n", error.message.c_str());
     return exitCode(error);
+}
+
+Result<std::string> readTextFile(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    if (!file && !file.eof()) return fail(ErrorCode::Io, "cannot read {}", path);
+    if (text.empty()) return fail(ErrorCode::InvalidInput, "{} is empty", path);
+    return text;
 }
 
 /// The update's line on stdout: version, ms per pass, encode ms, bytes, subscribers.
@@ -85,8 +96,20 @@ int picserverMain(int argc, char** argv) {
         ->check(CLI::Range(1, 19));
     app.add_option("--max-sessions", options.maxSessions, "sessions the server holds at most")
         ->check(CLI::Range(size_t(1), size_t(100000)));
+    double idleMinutes = 60.0;
+    app.add_option("--session-idle-minutes", idleMinutes,
+                   "remove a session without subscribers after this long unused")
+        ->check(CLI::PositiveNumber);
     app.add_option("--threads", threads, "worker threads of the CPU passes (0 = all cores)")
         ->check(CLI::NonNegativeNumber);
+    std::string tlsCert;
+    std::string tlsKey;
+    auto* certOption = app.add_option("--tls-cert", tlsCert, "serve TLS with this certificate chain (PEM file)")
+                           ->check(CLI::ExistingFile);
+    auto* keyOption = app.add_option("--tls-key", tlsKey, "the certificate's private key (PEM file)")
+                          ->check(CLI::ExistingFile);
+    certOption->needs(keyOption);
+    keyOption->needs(certOption);
     app.add_flag("--quiet", quiet, "no progress bars");
     try {
         app.parse(argc, argv);
@@ -141,6 +164,13 @@ int picserverMain(int argc, char** argv) {
         bakes.push_back(std::move(*bake));
     }
 
+    for (const auto& [path, pem] : {std::pair{tlsCert, &options.tlsCertPem}, std::pair{tlsKey, &options.tlsKeyPem}}) {
+        if (path.empty()) continue;
+        auto text = readTextFile(path);
+        if (!text) return reportError(text.error());
+        *pem = std::move(*text);
+    }
+    options.sessionIdle = std::chrono::milliseconds(int64_t(idleMinutes * 60000.0));
     options.session.log = logUpdate;
     auto server = PicServer::start(std::move(bakes), listen, std::move(options));
     if (!server) return reportError(server.error());

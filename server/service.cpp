@@ -1,6 +1,9 @@
 #include "server/service.h"
 
+#include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <cstdio>
 #include <chrono>
 #include <random>
 
@@ -19,6 +22,7 @@ struct PicServer::State {
     mutable std::mutex mutex;
     std::map<std::string, std::shared_ptr<Session>> sessions;
     std::atomic<bool> stopping{false};
+    std::condition_variable stopped;  ///< notified (under mutex) when stopping is set
     std::mt19937_64 random{std::random_device{}()};
 
     /// The bake `id` names, or the first one when `id` is empty.
@@ -265,6 +269,7 @@ public:
                                           v1::JoinSessionResponse* response) override {
         Access access = authorise(*mState, request->session(), request->token());
         if (!access.status.ok()) return finish(context, access.status);
+        access.session->touch();
         response->set_role(access.role);
         response->set_bake_id(access.session->bake().id());
         response->set_version(access.session->latestVersion());
@@ -308,6 +313,35 @@ private:
     std::shared_ptr<PicServer::State> mState;
 };
 
+/// Removes sessions without subscribers that nobody used for options.sessionIdle, checking a
+/// few times per idle period, until the server stops.
+void reapIdleSessions(PicServer::State& state) {
+    const auto idle = state.options.sessionIdle;
+    const auto period = std::clamp<std::chrono::steady_clock::duration>(
+        idle / 4, std::chrono::milliseconds(10), std::chrono::seconds(30));
+    std::unique_lock lock(state.mutex);
+    while (!state.stopping) {
+        state.stopped.wait_for(lock, period, [&] { return state.stopping.load(); });
+        std::vector<std::shared_ptr<Session>> expired;
+        for (auto it = state.sessions.begin(); it != state.sessions.end();) {
+            if (it->second->subscribers() == 0 && it->second->idleFor() > idle) {
+                expired.push_back(std::move(it->second));
+                it = state.sessions.erase(it);
+            } else {
+                ++it;
+            }
+        }
+        // Stopping a session joins its worker: not under the lock the handlers need.
+        lock.unlock();
+        for (const auto& session : expired)
+            std::fprintf(stderr, "picserver: session %s removed after %.1f s unused\n",
+                         session->id().c_str(),
+                         std::chrono::duration<double>(session->idleFor()).count());
+        expired.clear();
+        lock.lock();
+    }
+}
+
 }  // namespace
 
 Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<ServedBake>> bakes,
@@ -321,14 +355,22 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     std::unique_ptr<PicServer> server(new PicServer());
     server->mState = std::make_shared<State>();
     server->mState->bakes = std::move(bakes);
-    server->mState->options = std::move(options);
+    server->mState->options = options;
     server->mService = std::make_unique<Service>(server->mState);
 
     grpc::EnableDefaultHealthCheckService(true);
     grpc::reflection::InitProtoReflectionServerBuilderPlugin();
     grpc::ServerBuilder builder;
     int port = 0;
-    builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
+    if (options.tlsCertPem.empty() != options.tlsKeyPem.empty())
+        return fail(ErrorCode::InvalidInput, "TLS needs both a certificate and its key");
+    std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials();
+    if (!options.tlsCertPem.empty()) {
+        grpc::SslServerCredentialsOptions ssl;
+        ssl.pem_key_cert_pairs.push_back({options.tlsKeyPem, options.tlsCertPem});
+        credentials = grpc::SslServerCredentials(ssl);
+    }
+    builder.AddListeningPort(listen, credentials, &port);
     builder.RegisterService(server->mService.get());
     // Scene assets go in 1 MiB chunks, but key frames of large bakes can be bigger.
     builder.SetMaxSendMessageSize(-1);
@@ -339,6 +381,7 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     server->mAddress = fmt::format("{}:{}", listen.substr(0, colon), port);
     if (auto* health = server->mServer->GetHealthCheckService())
         health->SetServingStatus(true);
+    server->mReaper = std::thread([state = server->mState] { reapIdleSessions(*state); });
     return server;
 }
 
@@ -354,7 +397,12 @@ void PicServer::shutdown() {
     std::lock_guard lock(mShutdownMutex);
     if (mShutDown || !mServer) return;
     mShutDown = true;
-    mState->stopping = true;
+    {
+        std::lock_guard stateLock(mState->mutex);
+        mState->stopping = true;
+    }
+    mState->stopped.notify_all();
+    if (mReaper.joinable()) mReaper.join();
     if (auto* health = mServer->GetHealthCheckService()) health->SetServingStatus(false);
     // Streams never end on their own: cancel them after a short grace period.
     mServer->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(200));

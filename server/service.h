@@ -2,11 +2,13 @@
 /// The gRPC server (proto/pic.proto): the bakes it serves, its sessions and the Pic service,
 /// plus gRPC health checking and server reflection, on one listening address.
 
+#include <chrono>
 #include <cstddef>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <grpcpp/server.h>
@@ -20,6 +22,11 @@ namespace pic {
 struct ServerOptions {
     SessionOptions session;
     size_t maxSessions = 64;   ///< CreateSession beyond this: RESOURCE_EXHAUSTED
+    std::string tlsCertPem;    ///< with tlsKeyPem: serve TLS with this certificate chain (PEM)
+    std::string tlsKeyPem;     ///< the certificate's private key (PEM); both empty: plaintext
+    /// A session without subscribers that no client used for this long is removed (its
+    /// tokens then get NOT_FOUND).
+    std::chrono::milliseconds sessionIdle = std::chrono::hours(1);
 };
 
 class PicServer {
@@ -57,6 +64,7 @@ private:
     std::unique_ptr<grpc::Server> mServer;
     std::mutex mShutdownMutex;
     bool mShutDown = false;
+    std::thread mReaper;  ///< removes idle sessions until shutdown
 };
 
 }  // namespace pic

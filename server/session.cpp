@@ -83,12 +83,23 @@ Result<uint64_t> Session::setLights(LightSet lights) {
     {
         std::lock_guard lock(mMutex);
         version = mNextVersion++;
+        mLastUse = std::chrono::steady_clock::now();
         mLatestLights = lights;
         // Coalescing: a set still waiting is replaced, and its version is never produced.
         mPending = Pending{version, std::move(lights), std::chrono::system_clock::now()};
     }
     mChanged.notify_all();
     return version;
+}
+
+void Session::touch() {
+    std::lock_guard lock(mMutex);
+    mLastUse = std::chrono::steady_clock::now();
+}
+
+std::chrono::steady_clock::duration Session::idleFor() const {
+    std::lock_guard lock(mMutex);
+    return std::chrono::steady_clock::now() - mLastUse;
 }
 
 uint64_t Session::latestVersion() const {
@@ -118,6 +129,7 @@ std::shared_ptr<SubscriberSlot> Session::subscribe(std::function<void()> wake) {
 void Session::unsubscribe(const SubscriberSlot* slot) {
     std::lock_guard lock(mMutex);
     std::erase_if(mSlots, [slot](const auto& held) { return held.get() == slot; });
+    mLastUse = std::chrono::steady_clock::now();
 }
 
 size_t Session::subscribers() const {

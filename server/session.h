@@ -124,6 +124,11 @@ public:
     void unsubscribe(const SubscriberSlot* slot);
     size_t subscribers() const;
 
+    /// Records use of the session by a client (joins, light sets, subscriptions).
+    void touch();
+    /// How long since the last use, for removing idle sessions.
+    std::chrono::steady_clock::duration idleFor() const;
+
     /// Blocks until an update of version ≥ `version` is published or `timeout` passes.
     bool waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const;
 
@@ -152,6 +157,7 @@ private:
     std::optional<Pending> mPending;
     std::shared_ptr<const Update> mLatest;
     std::vector<std::shared_ptr<SubscriberSlot>> mSlots;
+    std::chrono::steady_clock::time_point mLastUse = std::chrono::steady_clock::now();
     std::thread mWorker;
 };
 

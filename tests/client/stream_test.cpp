@@ -69,7 +69,8 @@ struct Served {
     std::unique_ptr<PicConnection> connection;
 };
 
-Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32) {
+Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
+             std::chrono::milliseconds sessionIdle = std::chrono::hours(1)) {
     Served served;
     ServeOptions options;
     options.backend = backend;
@@ -81,6 +82,7 @@ Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32)
     bakes.push_back(std::move(*bake));
     ServerOptions serverOptions;
     serverOptions.session.keyframeInterval = keyframeInterval;
+    serverOptions.sessionIdle = sessionIdle;
     auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", serverOptions);
     EXPECT_TRUE(server) << (server ? "" : server.error().message);
     if (!server) return served;
@@ -318,6 +320,22 @@ TEST(Stream, DisconnectedSubscriberIsRemovedAtOnce) {
     EXPECT_EQ(live->subscribers(), 0u);
     std::printf("subscribers removed %.1f ms after they disconnected\n",
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+}
+
+TEST(Stream, IdleSessionsWithoutSubscribersAreRemoved) {
+    Served served = serve("cpu", 32, 300ms);
+    ASSERT_TRUE(served.connection);
+    auto idle = served.connection->createSession();
+    auto watched = served.connection->createSession();
+    ASSERT_TRUE(idle && watched);
+    Reader reader(*served.connection, watched->session(), watched->viewer_token());
+    ASSERT_TRUE(reader.waitFor(1));
+    std::this_thread::sleep_for(1200ms);
+    auto gone = served.connection->joinSession(idle->session(), idle->editor_token());
+    ASSERT_FALSE(gone);
+    EXPECT_EQ(gone.error().code, ErrorCode::NotFound);
+    auto kept = served.connection->joinSession(watched->session(), watched->editor_token());
+    EXPECT_TRUE(kept) << "a session with a subscriber stays";
 }
 
 TEST(Stream, TokensAndRoles) {
@@ -673,6 +691,35 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     std::fclose(server.out);
     fs::remove(lightsFile);
     fs::remove(report);
+}
+
+TEST(StreamCli, TlsServerAndClient) {
+    const std::string tls = PIC_TEST_TLS_DIR;
+    Child server = spawn({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
+                          "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet",
+                          "--tls-cert", tls + "/server.crt", "--tls-key", tls + "/server.key"});
+    ASSERT_GT(server.pid, 0);
+    const std::string first = readLine(server.out);
+    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
+    const std::string address = first.substr(std::string("listening on ").size());
+    int exit = 0;
+    const std::string client = PIC_PICCLIENT;
+    std::string created = run(client + " session --server " + address + " --tls-ca " + tls +
+                                  "/server.crt 2>&1",
+                              exit);
+    EXPECT_EQ(exit, 0) << created;
+    EXPECT_NE(created.find("\"editor_token\""), std::string::npos) << created;
+    std::string plain = run(client + " session --server " + address + " --connect-timeout 1 2>&1", exit);
+    EXPECT_EQ(exit, 1) << plain;
+    EXPECT_NE(plain.find("--tls-ca"), std::string::npos) << plain;
+    kill(server.pid, SIGTERM);
+    EXPECT_EQ(waitExit(server.pid), 0);
+    std::fclose(server.out);
+
+    std::string half = run(std::string(PIC_PICSERVER) + " --bake " + bakePath() + " --scene " +
+                               kScene + " --tls-cert " + tls + "/server.crt 2>&1",
+                           exit);
+    EXPECT_EQ(exit, 2) << half;
 }
 
 TEST(StreamCli, BadInputsExitWithTwoAndAMessage) {
