@@ -1,9 +1,11 @@
 #include "client/connection.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 #include "core/color.h"
@@ -146,11 +148,12 @@ Result<uint64_t> PicConnection::setLights(const std::string& session, const std:
     return response.version();
 }
 
-Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
-                                              const std::string& cacheDir) {
+Result<v1::SceneHeader> PicConnection::getScene(const std::string& bakeId, bool headerOnly,
+                                                const std::string& folder) {
     grpc::ClientContext context;
     v1::GetSceneRequest request;
     request.set_bake_id(bakeId);
+    request.set_header_only(headerOnly);
     auto reader = mStub->GetScene(&context, request);
     v1::SceneChunk chunk;
     if (!reader->Read(&chunk) || !chunk.has_header()) {
@@ -158,41 +161,23 @@ Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
         if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetScene"));
         return fail(ErrorCode::Corrupt, "GetScene: the stream did not start with a header");
     }
-    ClientScene client;
-    client.header = chunk.header();
-    const v1::SceneHeader& header = client.header;
-
-    // Into a fresh folder first, renamed into place when complete: a crash or a second client
-    // never leaves a half-written scene where the next run would load it.
-    const fs::path root = fs::path(cacheDir);
-    const fs::path folder = root / header.bake_id();
-    const fs::path staging = root / fmt::format("{}.tmp-{}", header.bake_id(), getpid());
-    std::error_code ec;
-    fs::remove_all(staging, ec);
-    fs::create_directories(staging, ec);
-    if (ec) return fail(ErrorCode::Io, "cannot create {}: {}", staging.string(), ec.message());
-
-    std::map<std::string, std::string> layout;
-    std::string pending;  // bytes received and not yet assigned to an asset
+    const v1::SceneHeader header = chunk.header();
+    std::string pending;  // bytes received and not yet written to an asset
     int asset = 0;
     const auto flush = [&]() -> Result<void> {
         while (asset < header.assets_size() && pending.size() >= header.assets(asset).size()) {
             const v1::AssetInfo& info = header.assets(asset);
-            std::string bytes = pending.substr(0, info.size());
+            PIC_TRY_ASSIGN(fs::path path, assetPath(folder, info.name()));
+            PIC_TRY(writeFile(path, pending.substr(0, info.size())));
             pending.erase(0, info.size());
-            if (info.name().starts_with("scene/")) {
-                PIC_TRY_ASSIGN(fs::path path, assetPath(staging, info.name().substr(6)));
-                PIC_TRY(writeFile(path, bytes));
-            } else {
-                layout[info.name()] = std::move(bytes);
-            }
             ++asset;
         }
         return {};
     };
     uint64_t received = 0;
     while (reader->Read(&chunk)) {
-        if (!chunk.has_data()) return fail(ErrorCode::Corrupt, "GetScene: a second header");
+        if (headerOnly || !chunk.has_data())
+            return fail(ErrorCode::Corrupt, "GetScene: unexpected chunk after the header");
         received += chunk.data().size();
         if (received > header.total_bytes())
             return fail(ErrorCode::Corrupt, "GetScene: more bytes than the header's {}",
@@ -202,36 +187,46 @@ Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
     }
     grpc::Status status = reader->Finish();
     if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetScene"));
-    PIC_TRY(flush());
-    if (received != header.total_bytes() || asset != header.assets_size())
-        return fail(ErrorCode::Corrupt, "GetScene: received {} of {} bytes", received,
-                    header.total_bytes());
+    if (!headerOnly) {
+        PIC_TRY(flush());
+        if (received != header.total_bytes() || asset != header.assets_size())
+            return fail(ErrorCode::Corrupt, "GetScene: received {} of {} bytes", received,
+                        header.total_bytes());
+    }
+    return header;
+}
 
-    fs::remove_all(folder, ec);
-    fs::rename(staging, folder, ec);
-    if (ec)
-        return fail(ErrorCode::Io, "cannot move {} to {}: {}", staging.string(), folder.string(),
-                    ec.message());
+namespace {
+
+constexpr const char* kHeaderFile = "header.pb";
+
+Result<std::string> readAsset(const fs::path& folder, const std::string& name) {
+    PIC_TRY_ASSIGN(fs::path path, assetPath(folder, name));
+    std::ifstream file(path, std::ios::binary);
+    if (!file) return fail(ErrorCode::Corrupt, "{} is missing", path.string());
+    return std::string{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+/// Loads the scene and layout kept in `folder` for `header`.
+Result<ClientScene> loadClientScene(const fs::path& folder, const v1::SceneHeader& header) {
+    ClientScene client;
+    client.header = header;
     client.folder = folder.string();
-
-    if (!header.scene_file().starts_with("scene/"))
-        return fail(ErrorCode::Corrupt, "GetScene: scene file \"{}\" is not a scene asset",
-                    header.scene_file());
-    PIC_TRY_ASSIGN(fs::path scenePath, assetPath(folder, header.scene_file().substr(6)));
+    PIC_TRY_ASSIGN(fs::path scenePath, assetPath(folder, header.scene_file()));
     PIC_TRY_ASSIGN(client.scene, loadScene(scenePath.string()));
     if (client.scene.hash != header.scene_hash())
         return fail(ErrorCode::Corrupt,
                     "the downloaded scene has hash {:016x}, the server's bake is of {:016x}",
                     client.scene.hash, header.scene_hash());
 
-    const std::string& uvs = layout["layout/triangle_uvs"];
+    PIC_TRY_ASSIGN(std::string uvs, readAsset(folder, "layout/triangle_uvs"));
     if (uvs.size() != client.scene.triangles.size() * 3 * sizeof(glm::vec2))
         return fail(ErrorCode::Corrupt, "layout/triangle_uvs holds {} bytes for {} triangles",
                     uvs.size(), client.scene.triangles.size());
     client.triangleUvs.resize(client.scene.triangles.size() * 3);
     if (!uvs.empty()) std::memcpy(client.triangleUvs.data(), uvs.data(), uvs.size());
-    const std::string& grid = layout["layout/grid_coverage"];
-    const std::string& lightmap = layout["layout/lightmap_coverage"];
+    PIC_TRY_ASSIGN(std::string grid, readAsset(folder, "layout/grid_coverage"));
+    PIC_TRY_ASSIGN(std::string lightmap, readAsset(folder, "layout/lightmap_coverage"));
     const uint64_t vertices =
         uint64_t(header.grid().dims_x()) * header.grid().dims_y() * header.grid().dims_z();
     const uint64_t texels = uint64_t(header.lightmap_width()) * header.lightmap_height();
@@ -242,6 +237,51 @@ Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
     client.gridCoverage.assign(grid.begin(), grid.end());
     client.lightmapCoverage.assign(lightmap.begin(), lightmap.end());
     return client;
+}
+
+}  // namespace
+
+Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
+                                              const std::string& cacheDir, bool* downloaded) {
+    if (downloaded) *downloaded = false;
+    PIC_TRY_ASSIGN(v1::SceneHeader header, getScene(bakeId, true, ""));
+    if (header.bake_id().empty() || header.bake_id().find_first_of("/.") != std::string::npos)
+        return fail(ErrorCode::Corrupt, "GetScene: bake id \"{}\" is not a folder name",
+                    header.bake_id());
+    const fs::path root(cacheDir);
+    const fs::path folder = root / header.bake_id();
+
+    // A kept copy counts only if it was written for exactly this header (written last).
+    std::string serialized;
+    header.SerializeToString(&serialized);
+    if (auto kept = readAsset(folder, kHeaderFile); kept && *kept == serialized) {
+        auto loaded = loadClientScene(folder, header);
+        if (loaded) return loaded;
+        std::fprintf(stderr, "picclient: the scene kept in %s is unusable (%s); downloading it again\n",
+                     folder.string().c_str(), loaded.error().message.c_str());
+    }
+
+    // Into a fresh folder first, renamed into place when complete: a crash or a second client
+    // never leaves a half-written scene where the next run would load it.
+    const fs::path staging = root / fmt::format("{}.tmp-{}", header.bake_id(), getpid());
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    fs::create_directories(staging, ec);
+    if (ec) return fail(ErrorCode::Io, "cannot create {}: {}", staging.string(), ec.message());
+    auto full = getScene(header.bake_id(), false, staging.string());
+    if (!full) {
+        fs::remove_all(staging, ec);
+        return std::unexpected(full.error());
+    }
+    full->SerializeToString(&serialized);
+    PIC_TRY(writeFile(staging / kHeaderFile, serialized));
+    fs::remove_all(folder, ec);
+    fs::rename(staging, folder, ec);
+    if (ec)
+        return fail(ErrorCode::Io, "cannot move {} to {}: {}", staging.string(), folder.string(),
+                    ec.message());
+    if (downloaded) *downloaded = true;
+    return loadClientScene(folder, *full);
 }
 
 std::unique_ptr<FrameStream> PicConnection::subscribe(const std::string& session,

@@ -72,14 +72,20 @@ public:
     /// Pushes a light set; the version it will produce.
     Result<uint64_t> setLights(const std::string& session, const std::string& token,
                                const LightSet& lights);
-    /// Downloads the assets of bake `bakeId` (empty: the server's first) into a fresh folder
-    /// under `cacheDir` (replacing an older copy atomically) and loads them; Corrupt when the
-    /// loaded scene's hash is not the one the server announced.
-    Result<ClientScene> fetchScene(const std::string& bakeId, const std::string& cacheDir);
+    /// The assets of bake `bakeId` (empty: the server's first), kept in `cacheDir`/<bake id>:
+    /// reused when that folder holds exactly the server's header, else downloaded into a
+    /// fresh folder that replaces it atomically. Loads them; Corrupt when the loaded scene's
+    /// hash is not the one the server announced. `downloaded` (optional) says which it was.
+    Result<ClientScene> fetchScene(const std::string& bakeId, const std::string& cacheDir,
+                                   bool* downloaded = nullptr);
     /// Starts a Subscribe stream.
     std::unique_ptr<FrameStream> subscribe(const std::string& session, const std::string& token);
 
 private:
+    /// GetScene: the header, and the assets written under `folder` unless `headerOnly`.
+    Result<v1::SceneHeader> getScene(const std::string& bakeId, bool headerOnly,
+                                     const std::string& folder);
+
     std::string mAddress;
     std::shared_ptr<grpc::Channel> mChannel;
     std::unique_ptr<v1::Pic::Stub> mStub;

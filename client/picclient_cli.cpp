@@ -212,7 +212,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     auto joined = connection->joinSession(common.session, common.token);
     if (!joined) return reportError(joined.error());
     const auto sceneStart = Clock::now();
-    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir);
+    bool downloaded = false;
+    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir, &downloaded);
     if (!client) return reportError(client.error());
     const double sceneMs = since(sceneStart);
 
@@ -306,10 +307,10 @@ int runRender(const Common& common, const RenderCommand& command) {
     for (const auto& [pass, ms] : timings.passMs)
         passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", pass, ms);
     std::fprintf(stderr,
-                 "picclient render: scene %.0f ms (%s); version %llu: light change to decoded "
+                 "picclient render: scene %s in %.0f ms (%s); version %llu: light change to decoded "
                  "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms); "
                  "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
-                 sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
+                 downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
                  serverMs, bytes, decodeMs, size->x, size->y, command.component.c_str(),
                  (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
                  command.outPath.c_str());

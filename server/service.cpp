@@ -89,13 +89,14 @@ Access authorise(const PicServer::State& state, const std::string& id, const std
 /// GetScene: the header, then the assets' bytes in chunks, one write at a time.
 class SceneWriter final : public grpc::ServerWriteReactor<v1::SceneChunk> {
 public:
-    explicit SceneWriter(const ServedBake& bake) : mBake(bake) {
+    SceneWriter(const ServedBake& bake, bool headerOnly) : mBake(bake), mHeaderOnly(headerOnly) {
         *mChunk.mutable_header() = bake.header();
         StartWrite(&mChunk);
     }
 
     void OnWriteDone(bool ok) override {
         if (!ok) return Finish(grpc::Status(grpc::StatusCode::CANCELLED, "write failed"));
+        if (mHeaderOnly) return Finish(grpc::Status::OK);
         const auto& assets = mBake.assetBytes();
         std::string data;
         while (data.size() < kSceneChunkBytes && mAsset < assets.size()) {
@@ -117,6 +118,7 @@ public:
 
 private:
     const ServedBake& mBake;
+    const bool mHeaderOnly;
     v1::SceneChunk mChunk;
     size_t mAsset = 0;
     size_t mOffset = 0;
@@ -229,7 +231,7 @@ public:
             return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::SceneChunk>>(
                 grpc::Status(grpc::StatusCode::NOT_FOUND,
                              fmt::format("no bake \"{}\"", request->bake_id())));
-        return new SceneWriter(*bake);
+        return new SceneWriter(*bake, request->header_only());
     }
 
     grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* context,

@@ -464,8 +464,20 @@ TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
     const fs::path cache = fs::temp_directory_path() / fmt::format("pic_stream_cache_{}", getpid());
-    auto client = served.connection->fetchScene("", cache.string());
+    bool downloaded = false;
+    auto client = served.connection->fetchScene("", cache.string(), &downloaded);
     ASSERT_TRUE(client) << client.error().message;
+    EXPECT_TRUE(downloaded);
+    // Kept: the next fetch reuses the folder; a damaged copy is downloaded again.
+    auto again = served.connection->fetchScene("", cache.string(), &downloaded);
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_FALSE(downloaded);
+    EXPECT_EQ(again->scene.hash, client->scene.hash);
+    fs::remove(fs::path(client->folder) / "layout" / "grid_coverage");
+    again = served.connection->fetchScene("", cache.string(), &downloaded);
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_TRUE(downloaded);
+    EXPECT_EQ(again->gridCoverage, client->gridCoverage);
     auto bake = readBakeFile(bakePath());
     ASSERT_TRUE(bake);
     EXPECT_EQ(client->scene.hash, bake->sceneHash);
