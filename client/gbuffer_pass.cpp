@@ -208,25 +208,6 @@ Result<void> GbufferPass::createPipeline() {
     layoutInfo.pPushConstantRanges = &push;
     PIC_VK_TRY(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &mPipelineLayout));
 
-    PIC_TRY_ASSIGN(VkShaderModule vertex,
-                   mContext.createShaderModule(kSpirvGbufferVert, "gbuffer.vert"));
-    auto fragment = mContext.createShaderModule(kSpirvGbufferFrag, "gbuffer.frag");
-    if (!fragment) {
-        vkDestroyShaderModule(device, vertex, nullptr);
-        return std::unexpected(fragment.error());
-    }
-    VkPipelineShaderStageCreateInfo stages[2] = {
-        {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-        {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-    stages[0].module = vertex;
-    stages[0].pName = "main";
-    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-    stages[1].module = *fragment;
-    stages[1].pName = "main";
-
-    const VkVertexInputBindingDescription binding{0, sizeof(GbufferVertex),
-                                                  VK_VERTEX_INPUT_RATE_VERTEX};
     const VkVertexInputAttributeDescription attributes[] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, uint32_t(offsetof(GbufferVertex, position))},
         {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, uint32_t(offsetof(GbufferVertex, color))},
@@ -234,71 +215,19 @@ Result<void> GbufferPass::createPipeline() {
         {3, 0, VK_FORMAT_R32G32_SFLOAT, uint32_t(offsetof(GbufferVertex, uv1))},
         {4, 0, VK_FORMAT_R32G32_SFLOAT, uint32_t(offsetof(GbufferVertex, lightmapUv))},
     };
-    VkPipelineVertexInputStateCreateInfo vertexInput{
-        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    vertexInput.vertexBindingDescriptionCount = 1;
-    vertexInput.pVertexBindingDescriptions = &binding;
-    vertexInput.vertexAttributeDescriptionCount = uint32_t(std::size(attributes));
-    vertexInput.pVertexAttributeDescriptions = attributes;
-    VkPipelineInputAssemblyStateCreateInfo assembly{
-        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo viewport{
-        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    viewport.viewportCount = 1;
-    viewport.scissorCount = 1;
-    // Both faces: the CPU twin shades whichever side its ray hits.
-    VkPipelineRasterizationStateCreateInfo raster{
-        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    raster.polygonMode = VK_POLYGON_MODE_FILL;
-    raster.cullMode = VK_CULL_MODE_NONE;
-    raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    raster.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo multisample{
-        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    // Reversed depth: nearer is larger.
-    VkPipelineDepthStencilStateCreateInfo depthState{
-        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-    depthState.depthTestEnable = VK_TRUE;
-    depthState.depthWriteEnable = VK_TRUE;
-    depthState.depthCompareOp = VK_COMPARE_OP_GREATER;
-    std::array<VkPipelineColorBlendAttachmentState, kGbufferTargets> blendTargets{};
-    for (auto& target : blendTargets)
-        target.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                                VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo blend{
-        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = kGbufferTargets;
-    blend.pAttachments = blendTargets.data();
-    const VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = 2;
-    dynamic.pDynamicStates = dynamicStates;
     std::array<VkFormat, kGbufferTargets> formats;
     formats.fill(kGbufferFormat);
-    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    rendering.colorAttachmentCount = kGbufferTargets;
-    rendering.pColorAttachmentFormats = formats.data();
-    rendering.depthAttachmentFormat = VK_FORMAT_D32_SFLOAT;
-    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    info.pNext = &rendering;
-    info.stageCount = 2;
-    info.pStages = stages;
-    info.pVertexInputState = &vertexInput;
-    info.pInputAssemblyState = &assembly;
-    info.pViewportState = &viewport;
-    info.pRasterizationState = &raster;
-    info.pMultisampleState = &multisample;
-    info.pDepthStencilState = &depthState;
-    info.pColorBlendState = &blend;
-    info.pDynamicState = &dynamic;
-    info.layout = mPipelineLayout;
-    const VkResult r =
-        vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &mPipeline);
-    vkDestroyShaderModule(device, vertex, nullptr);
-    vkDestroyShaderModule(device, *fragment, nullptr);
-    PIC_VK_TRY(r);
+    RasterPipelineDesc desc;
+    desc.vertexSpirv = kSpirvGbufferVert;
+    desc.vertexName = "gbuffer.vert";
+    desc.fragmentSpirv = kSpirvGbufferFrag;
+    desc.fragmentName = "gbuffer.frag";
+    desc.binding = {0, sizeof(GbufferVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+    desc.attributes = attributes;
+    desc.depthCompare = VK_COMPARE_OP_GREATER;  // reversed depth: nearer is larger
+    desc.colorFormats = formats;
+    desc.layout = mPipelineLayout;
+    PIC_TRY_ASSIGN(mPipeline, mContext.createRasterPipeline(desc));
     return {};
 }
 

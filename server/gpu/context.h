@@ -123,6 +123,21 @@ private:
     VkDeviceSize mBytes = 0;
 };
 
+/// What differs between pic's raster pipelines. The rest is fixed: triangle lists, both faces
+/// drawn (surfels and camera rays see either side of single-sided geometry), one sample,
+/// dynamic viewport and scissor, dynamic rendering into a D32 depth attachment.
+struct RasterPipelineDesc {
+    std::span<const uint32_t> vertexSpirv;
+    const char* vertexName = "";
+    std::span<const uint32_t> fragmentSpirv;  ///< empty: a depth-only pipeline
+    const char* fragmentName = "";
+    VkVertexInputBindingDescription binding{};
+    std::span<const VkVertexInputAttributeDescription> attributes;
+    VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
+    std::span<const VkFormat> colorFormats;   ///< one per colour attachment, all written
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+};
+
 /// How to open a context.
 struct ContextOptions {
     /// Case-insensitive substring of the device name to use ("llvmpipe", "NVIDIA"); empty:
@@ -209,6 +224,9 @@ public:
 
     /// A shader module from SPIR-V words.
     Result<VkShaderModule> createShaderModule(std::span<const uint32_t> spirv, const char* what);
+
+    /// A graphics pipeline as `desc` describes (the caller destroys it).
+    Result<VkPipeline> createRasterPipeline(const RasterPipelineDesc& desc);
 
     /// A timer for up to `passes` pass instances per command buffer.
     Result<PassTimer> createPassTimer(uint32_t passes);
