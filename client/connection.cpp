@@ -134,6 +134,19 @@ Result<v1::JoinSessionResponse> PicConnection::joinSession(const std::string& se
     return response;
 }
 
+Result<v1::SessionStats> PicConnection::stats(const std::string& session,
+                                             const std::string& token) {
+    grpc::ClientContext context;
+    setDeadline(context);
+    v1::GetStatsRequest request;
+    request.set_session(session);
+    request.set_token(token);
+    v1::SessionStats response;
+    grpc::Status status = mStub->GetStats(&context, request, &response);
+    if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetStats"));
+    return response;
+}
+
 Result<uint64_t> PicConnection::setLights(const std::string& session, const std::string& token,
                                           const LightSet& lights) {
     grpc::ClientContext context;

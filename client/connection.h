@@ -78,6 +78,8 @@ public:
     /// hash is not the one the server announced. `downloaded` (optional) says which it was.
     Result<ClientScene> fetchScene(const std::string& bakeId, const std::string& cacheDir,
                                    bool* downloaded = nullptr);
+    /// The session's counters (GetStats).
+    Result<v1::SessionStats> stats(const std::string& session, const std::string& token);
     /// Starts a Subscribe stream.
     std::unique_ptr<FrameStream> subscribe(const std::string& session, const std::string& token);
 

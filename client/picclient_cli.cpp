@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <CLI/CLI.hpp>
+#include <google/protobuf/util/json_util.h>
 #include <nlohmann/json.hpp>
 
 #include "client/connection.h"
@@ -147,6 +148,20 @@ int runWatch(const Common& common, uint64_t count, double seconds) {
     grpc::Status status = stream->status();
     if (!status.ok() && status.error_code() != grpc::StatusCode::CANCELLED)
         return reportError(wire::fromStatus(status, "Subscribe"));
+    return 0;
+}
+
+int runStats(const Common& common) {
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto stats = connection->stats(common.session, common.token);
+    if (!stats) return reportError(stats.error());
+    std::string json;
+    google::protobuf::util::JsonPrintOptions options;
+    options.always_print_primitive_fields = true;
+    options.preserve_proto_field_names = true;
+    if (!google::protobuf::util::MessageToJsonString(*stats, &json, options).ok())
+        return reportError(Error{ErrorCode::Internal, "cannot print the stats as JSON"});
+    std::printf("%s\n", json.c_str());
     return 0;
 }
 
@@ -351,6 +366,11 @@ int picclientMain(int argc, char** argv) {
     watch->add_option("--duration", watchSeconds, "stop after this many seconds (0: never)")
         ->check(CLI::NonNegativeNumber);
 
+    CLI::App* statsCommand = app.add_subcommand(
+        "stats", "print the session's counters (frames, bytes, update and encode ms) as JSON");
+    addServer(*statsCommand, common);
+    addSession(*statsCommand, common);
+
     LoadOptions load;
     std::string reportPath;
     CLI::App* loadCommand = app.add_subcommand(
@@ -419,6 +439,7 @@ int picclientMain(int argc, char** argv) {
     if (lights->parsed()) return runLights(common, lightsPath);
     if (watch->parsed()) return runWatch(common, count, watchSeconds);
     if (renderCommand->parsed()) return runRender(common, render);
+    if (statsCommand->parsed()) return runStats(common);
     if (loadCommand->parsed()) {
         if (load.session.empty() != load.editorToken.empty()) {
             std::fprintf(stderr, "picclient: error: --session and --token go together\n");

@@ -190,6 +190,9 @@ private:
             return;
         }
         mHeld = update->version;
+        uint64_t bytes = 0;
+        for (const v1::Plane& plane : frame->planes()) bytes += plane.data().size();
+        mSession->countSent(bytes);
         mInFlight = std::move(frame);
         mWriting = true;
         StartWrite(mInFlight.get());
@@ -302,6 +305,15 @@ public:
             return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::Frame>>(
                 access.status);
         return new FrameWriter(std::move(access.session));
+    }
+
+    grpc::ServerUnaryReactor* GetStats(grpc::CallbackServerContext* context,
+                                       const v1::GetStatsRequest* request,
+                                       v1::SessionStats* response) override {
+        Access access = authorise(*mState, request->session(), request->token());
+        if (!access.status.ok()) return finish(context, access.status);
+        *response = access.session->stats();
+        return finish(context, grpc::Status::OK);
     }
 
 private:

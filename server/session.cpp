@@ -1,5 +1,6 @@
 #include "server/session.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "proto/wire.h"
@@ -33,6 +34,7 @@ std::shared_ptr<const v1::Frame> Update::frameFor(uint64_t held) const {
         key->set_encode_ms(millisecondsSince(start));
         mKey = std::move(key);
         mKeyEncoded = true;
+        if (keysOnDemand) keysOnDemand->fetch_add(1);
     });
     return mKey;
 }
@@ -65,6 +67,7 @@ Session::Session(std::string id, std::string editorToken, std::string viewerToke
       mOptions(std::move(options)) {
     mLatestLights = defaultLightSet(bake.scene());
     mPending = Pending{mNextVersion++, mLatestLights, std::chrono::system_clock::now()};
+    mStats.set_versions_set(1);
     mWorker = std::thread([this] { run(); });
 }
 
@@ -83,6 +86,7 @@ Result<uint64_t> Session::setLights(LightSet lights) {
     {
         std::lock_guard lock(mMutex);
         version = mNextVersion++;
+        mStats.set_versions_set(version);
         mLastUse = std::chrono::steady_clock::now();
         mLatestLights = lights;
         // Coalescing: a set still waiting is replaced, and its version is never produced.
@@ -129,6 +133,8 @@ std::shared_ptr<SubscriberSlot> Session::subscribe(std::function<void()> wake) {
 void Session::unsubscribe(const SubscriberSlot* slot) {
     std::lock_guard lock(mMutex);
     std::erase_if(mSlots, [slot](const auto& held) { return held.get() == slot; });
+    // Its skips stay counted after it leaves.
+    mStats.set_versions_skipped(mStats.versions_skipped() + slot->skipped());
     mLastUse = std::chrono::steady_clock::now();
 }
 
@@ -143,6 +149,24 @@ bool Session::waitForVersion(uint64_t version, std::chrono::milliseconds timeout
                              [&] { return mLatest && mLatest->version >= version; });
 }
 
+void Session::countSent(uint64_t bytes) {
+    std::lock_guard lock(mMutex);
+    mStats.set_frames_sent(mStats.frames_sent() + 1);
+    mStats.set_bytes_sent(mStats.bytes_sent() + bytes);
+}
+
+v1::SessionStats Session::stats() const {
+    std::lock_guard lock(mMutex);
+    v1::SessionStats stats = mStats;
+    stats.set_key_frames_on_demand(mKeysOnDemand->load());
+    stats.set_subscribers(uint32_t(mSlots.size()));
+    for (const auto& slot : mSlots) stats.set_versions_skipped(stats.versions_skipped() + slot->skipped());
+    const double computed = double(std::max<uint64_t>(1, stats.versions_computed()));
+    stats.set_mean_update_ms(mUpdateMsTotal / computed);
+    stats.set_mean_encode_ms(mEncodeMsTotal / computed);
+    return stats;
+}
+
 void Session::publish(std::shared_ptr<const Update> update) {
     std::lock_guard publishing(mPublishMutex);
     std::vector<std::shared_ptr<SubscriberSlot>> slots;
@@ -150,6 +174,17 @@ void Session::publish(std::shared_ptr<const Update> update) {
         std::lock_guard lock(mMutex);
         mLatest = update;
         slots = mSlots;
+        uint64_t bytes = 0;
+        for (const v1::Plane& plane : update->broadcast->planes()) bytes += plane.data().size();
+        mStats.set_versions_computed(mStats.versions_computed() + 1);
+        if (update->baseVersion == 0)
+            mStats.set_key_frames(mStats.key_frames() + 1);
+        else
+            mStats.set_delta_frames(mStats.delta_frames() + 1);
+        mStats.set_broadcast_bytes(mStats.broadcast_bytes() + bytes);
+        mStats.set_last_frame_bytes(bytes);
+        mUpdateMsTotal += update->broadcast->update_ms();
+        mEncodeMsTotal += update->encodeMs;
     }
     mChanged.notify_all();
     for (const auto& slot : slots) slot->put(update);
@@ -173,6 +208,7 @@ void Session::run() {
         auto update = std::make_shared<Update>();
         update->version = job.version;
         update->zstdLevel = mOptions.zstdLevel;
+        update->keysOnDemand = mKeysOnDemand;
         auto frame = std::make_shared<HalfFrame>();
         const auto start = Clock::now();
         if (auto relit = mBake.relight(job.lights, update->stats, *frame); !relit) {

@@ -44,6 +44,7 @@ public:
     UpdateStats stats;
     double encodeMs = 0.0;
     int zstdLevel = kDefaultZstdLevel;     ///< for the key frame encoded on demand
+    std::shared_ptr<std::atomic<uint64_t>> keysOnDemand;  ///< counts it, when set
 
     /// The frame for a subscriber that holds version `held` (0: none): `broadcast` when it
     /// applies to `held`, else this version's key frame.
@@ -129,6 +130,11 @@ public:
     /// How long since the last use, for removing idle sessions.
     std::chrono::steady_clock::duration idleFor() const;
 
+    /// Counts a frame of `bytes` written to a subscriber.
+    void countSent(uint64_t bytes);
+    /// The session's counters (GetStats).
+    v1::SessionStats stats() const;
+
     /// Blocks until an update of version ≥ `version` is published or `timeout` passes.
     bool waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const;
 
@@ -158,6 +164,11 @@ private:
     std::shared_ptr<const Update> mLatest;
     std::vector<std::shared_ptr<SubscriberSlot>> mSlots;
     std::chrono::steady_clock::time_point mLastUse = std::chrono::steady_clock::now();
+    v1::SessionStats mStats;           ///< counters except subscribers and live skips
+    double mUpdateMsTotal = 0.0;
+    double mEncodeMsTotal = 0.0;
+    /// Key frames encoded on demand, counted by the updates themselves.
+    std::shared_ptr<std::atomic<uint64_t>> mKeysOnDemand = std::make_shared<std::atomic<uint64_t>>(0);
     std::thread mWorker;
 };
 

@@ -195,6 +195,16 @@ TEST(Stream, TwoSubscribersReceiveEveryVersionTheyCanAndAlwaysTheLastDecodedExac
     const auto update = live->latestUpdate();
     ASSERT_TRUE(update);
     ASSERT_EQ(update->version, last);
+
+    auto stats = served.connection->stats(session->session(), session->viewer_token());
+    ASSERT_TRUE(stats) << stats.error().message;
+    EXPECT_EQ(stats->versions_set(), last);
+    EXPECT_EQ(stats->versions_computed(), last);
+    EXPECT_EQ(stats->key_frames() + stats->delta_frames(), last);
+    EXPECT_EQ(stats->subscribers(), 2u);
+    EXPECT_GE(stats->frames_sent(), 2 * last - 1);  // the last frame may still be in flight
+    EXPECT_GT(stats->broadcast_bytes(), 0u);
+    EXPECT_GT(stats->mean_update_ms(), 0.0);
     for (Reader* reader : {&editorView, &viewer}) {
         const auto versions = reader->received();
         const auto keys = reader->keys();
@@ -690,6 +700,15 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_EQ(exit, 2) << viewerPush;
     fs::remove(image);
     fs::remove_all(cacheDir);
+
+    std::string stats = run(client + " stats --server " + address + " --session " + session +
+                                " --token " + viewer,
+                            exit);
+    EXPECT_EQ(exit, 0) << stats;
+    auto statsJson = nlohmann::json::parse(stats);
+    // Protobuf JSON prints 64-bit integers as strings.
+    EXPECT_GE(std::stoull(statsJson["versions_computed"].get<std::string>()), 2u) << stats;
+    EXPECT_TRUE(statsJson.contains("broadcast_bytes")) << stats;
 
     // The update log: one line per update after the first line.
     const std::string updateLine = readLine(server.out);
