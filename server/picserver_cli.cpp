@@ -96,6 +96,8 @@ int picserverMain(int argc, char** argv) {
         ->check(CLI::Range(1, 19));
     app.add_option("--max-sessions", options.maxSessions, "sessions the server holds at most")
         ->check(CLI::Range(size_t(1), size_t(100000)));
+    app.add_option("--db", options.dbPath,
+                   "session database (JSON): sessions, tokens and light sets survive a restart");
     double idleMinutes = 60.0;
     app.add_option("--session-idle-minutes", idleMinutes,
                    "remove a session without subscribers after this long unused")

@@ -13,6 +13,7 @@
 
 #include "proto/pic.grpc.pb.h"
 #include "proto/wire.h"
+#include "server/session_store.h"
 
 namespace pic {
 
@@ -24,6 +25,25 @@ struct PicServer::State {
     std::atomic<bool> stopping{false};
     std::condition_variable stopped;  ///< notified (under mutex) when stopping is set
     std::mt19937_64 random{std::random_device{}()};
+    std::unique_ptr<SessionStore> store;  ///< null without --db
+    std::mutex persistMutex;              ///< snapshots are written in the order they are taken
+
+    /// Writes every session to the database (when there is one); a failure is logged, not
+    /// fatal: the sessions go on, only not durably.
+    void persist() {
+        if (!store) return;
+        std::lock_guard persisting(persistMutex);
+        std::vector<StoredSession> snapshot;
+        {
+            std::lock_guard lock(mutex);
+            for (const auto& [id, session] : sessions)
+                snapshot.push_back({id, session->editorToken(), session->viewerToken(),
+                                    session->bake().id(), session->latestVersion(),
+                                    session->latestLights()});
+        }
+        if (auto saved = store->save(snapshot); !saved)
+            std::fprintf(stderr, "picserver: %s\n", saved.error().message.c_str());
+    }
 
     /// The bake `id` names, or the first one when `id` is empty.
     ServedBake* findBake(const std::string& id) const {
@@ -261,6 +281,7 @@ public:
                                                 *bake, mState->options.session);
             mState->sessions[id] = session;
         }
+        mState->persist();
         response->set_session(session->id());
         response->set_editor_token(session->editorToken());
         response->set_viewer_token(session->viewerToken());
@@ -294,6 +315,7 @@ public:
         if (!lights) return finish(context, wire::toStatus(lights.error()));
         auto version = access.session->setLights(std::move(*lights));
         if (!version) return finish(context, wire::toStatus(version.error()));
+        mState->persist();
         response->set_version(*version);
         return finish(context, grpc::Status::OK);
     }
@@ -351,7 +373,9 @@ void reapIdleSessions(PicServer::State& state) {
             std::fprintf(stderr, "picserver: session %s removed after %.1f s unused\n",
                          session->id().c_str(),
                          std::chrono::duration<double>(session->idleFor()).count());
+        const bool removed = !expired.empty();
         expired.clear();
+        if (removed) state.persist();
         lock.lock();
     }
 }
@@ -371,6 +395,31 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     server->mState->bakes = std::move(bakes);
     server->mState->options = options;
     server->mService = std::make_unique<Service>(server->mState);
+    if (!options.dbPath.empty()) {
+        State& state = *server->mState;
+        state.store = std::make_unique<SessionStore>(options.dbPath);
+        PIC_TRY_ASSIGN(std::vector<StoredSession> stored, state.store->load());
+        for (StoredSession& entry : stored) {
+            ServedBake* bake = state.findBake(entry.bakeId);
+            if (!bake || entry.bakeId.empty()) {
+                std::fprintf(stderr, "picserver: session %s dropped: its bake %s is not served\n",
+                             entry.id.c_str(), entry.bakeId.c_str());
+                continue;
+            }
+            if (auto checked = checkRuntimeLights(entry.lights, bake->scene()); !checked) {
+                std::fprintf(stderr, "picserver: session %s dropped: %s\n", entry.id.c_str(),
+                             checked.error().message.c_str());
+                continue;
+            }
+            SessionStart start{entry.version + 1, std::move(entry.lights)};
+            state.sessions[entry.id] = std::make_shared<Session>(
+                entry.id, entry.editorToken, entry.viewerToken, *bake, options.session, std::move(start));
+        }
+        if (!stored.empty())
+            std::fprintf(stderr, "picserver: %zu of %zu sessions restored from %s\n",
+                         state.sessions.size(), stored.size(), options.dbPath.c_str());
+        state.persist();
+    }
 
     grpc::EnableDefaultHealthCheckService(true);
     grpc::reflection::InitProtoReflectionServerBuilderPlugin();

@@ -27,12 +27,15 @@ struct ServerOptions {
     /// A session without subscribers that no client used for this long is removed (its
     /// tokens then get NOT_FOUND).
     std::chrono::milliseconds sessionIdle = std::chrono::hours(1);
+    /// The session database (server/session_store.h); empty: sessions end with the server.
+    std::string dbPath;
 };
 
 class PicServer {
 public:
     /// Serves `bakes` (at least one; the first is the default) on `listen` ("HOST:PORT"; port 0
-    /// picks a free one). InvalidInput for an address gRPC cannot bind.
+    /// picks a free one), restoring the sessions of `options.dbPath` whose bake is served.
+    /// InvalidInput for an address gRPC cannot bind, Corrupt for an unreadable database.
     static Result<std::unique_ptr<PicServer>> start(std::vector<std::unique_ptr<ServedBake>> bakes,
                                                     const std::string& listen,
                                                     ServerOptions options);

@@ -59,15 +59,16 @@ uint64_t SubscriberSlot::skipped() const {
 }
 
 Session::Session(std::string id, std::string editorToken, std::string viewerToken,
-                 ServedBake& bake, SessionOptions options)
+                 ServedBake& bake, SessionOptions options, SessionStart start)
     : mId(std::move(id)),
       mEditorToken(std::move(editorToken)),
       mViewerToken(std::move(viewerToken)),
       mBake(bake),
       mOptions(std::move(options)) {
-    mLatestLights = defaultLightSet(bake.scene());
+    mLatestLights = start.lights ? std::move(*start.lights) : defaultLightSet(bake.scene());
+    mNextVersion = std::max<uint64_t>(start.version, 1);
+    mStats.set_versions_set(mNextVersion);
     mPending = Pending{mNextVersion++, mLatestLights, std::chrono::system_clock::now()};
-    mStats.set_versions_set(1);
     mWorker = std::thread([this] { run(); });
 }
 

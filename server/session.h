@@ -94,11 +94,18 @@ struct SessionOptions {
     std::function<void(const UpdateLog&)> log;  ///< called once per computed update
 };
 
+/// Where a session starts: version 1 with the scene's own lights, or, for a session restored
+/// from the server's database, the version after the one it had reached, with its last set.
+struct SessionStart {
+    uint64_t version = 1;
+    std::optional<LightSet> lights;
+};
+
 class Session {
 public:
-    /// Starts the session's worker and queues version 1: the scene's own lights.
+    /// Starts the session's worker and queues its first version.
     Session(std::string id, std::string editorToken, std::string viewerToken, ServedBake& bake,
-            SessionOptions options);
+            SessionOptions options, SessionStart start = SessionStart());
     /// Stops the worker (an update in progress finishes first).
     ~Session();
     Session(const Session&) = delete;

@@ -70,7 +70,8 @@ struct Served {
 };
 
 Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
-             std::chrono::milliseconds sessionIdle = std::chrono::hours(1)) {
+             std::chrono::milliseconds sessionIdle = std::chrono::hours(1),
+             const std::string& dbPath = "") {
     Served served;
     ServeOptions options;
     options.backend = backend;
@@ -83,6 +84,7 @@ Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
     ServerOptions serverOptions;
     serverOptions.session.keyframeInterval = keyframeInterval;
     serverOptions.sessionIdle = sessionIdle;
+    serverOptions.dbPath = dbPath;
     auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", serverOptions);
     EXPECT_TRUE(server) << (server ? "" : server.error().message);
     if (!server) return served;
@@ -346,6 +348,59 @@ TEST(Stream, IdleSessionsWithoutSubscribersAreRemoved) {
     EXPECT_EQ(gone.error().code, ErrorCode::NotFound);
     auto kept = served.connection->joinSession(watched->session(), watched->editor_token());
     EXPECT_TRUE(kept) << "a session with a subscriber stays";
+}
+
+TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
+    const fs::path db = fs::temp_directory_path() / fmt::format("pic_sessions_{}.json", getpid());
+    fs::remove(db);
+    std::string id, editor, viewer;
+    const LightSet lights = pointLight(0.25f);
+    {
+        Served served = serve("cpu", 32, std::chrono::hours(1), db.string());
+        ASSERT_TRUE(served.connection);
+        auto session = served.connection->createSession();
+        ASSERT_TRUE(session);
+        id = session->session();
+        editor = session->editor_token();
+        viewer = session->viewer_token();
+        auto version = served.connection->setLights(id, editor, lights);
+        ASSERT_TRUE(version);
+        EXPECT_EQ(*version, 2u);
+    }
+    EXPECT_EQ(fs::status(db).permissions() & fs::perms::others_read, fs::perms::none)
+        << "the database holds tokens";
+    Served restarted = serve("cpu", 32, std::chrono::hours(1), db.string());
+    ASSERT_TRUE(restarted.connection);
+    auto joined = restarted.connection->joinSession(id, viewer);
+    ASSERT_TRUE(joined) << joined.error().message;
+    EXPECT_EQ(joined->version(), 3u) << "versions go on after the restart";
+    auto restored = wire::fromProto(joined->lights());
+    ASSERT_TRUE(restored);
+    ASSERT_EQ(restored->lights.size(), 1u);
+    EXPECT_EQ(restored->lights[0].position, lights.lights[0].position);
+    Reader reader(*restarted.connection, id, viewer);
+    EXPECT_TRUE(reader.waitFor(3));
+    auto denied = restarted.connection->setLights(id, viewer, lights);
+    EXPECT_FALSE(denied) << "roles survive too";
+
+    // A database that is not one is refused, naming the file.
+    {
+        std::ofstream broken(db);
+        broken << "not json";
+    }
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    ServeOptions serveOptions;
+    serveOptions.backend = "cpu";
+    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
+    ASSERT_TRUE(bake);
+    bakes.push_back(std::move(*bake));
+    ServerOptions options;
+    options.dbPath = db.string();
+    auto refused = PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
+    EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
+    fs::remove(db);
 }
 
 TEST(Stream, TokensAndRoles) {

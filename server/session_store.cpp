@@ -1,0 +1,96 @@
+#include "server/session_store.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+namespace pic {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+constexpr int kFormat = 1;
+
+}  // namespace
+
+Result<std::vector<StoredSession>> SessionStore::load() const {
+    std::error_code ec;
+    if (!fs::exists(mPath, ec)) return std::vector<StoredSession>{};
+    std::ifstream file(mPath, std::ios::binary);
+    if (!file) return fail(ErrorCode::Io, "cannot open the session database {}", mPath);
+    const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    const Json root = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (!root.is_object() || root.value("format", 0) != kFormat || !root.contains("sessions") ||
+        !root["sessions"].is_array())
+        return fail(ErrorCode::Corrupt,
+                    "{} is not a pic session database of format {} (move it away to start afresh)",
+                    mPath, kFormat);
+    std::vector<StoredSession> sessions;
+    for (const Json& entry : root["sessions"]) {
+        StoredSession session;
+        try {
+            session.id = entry.at("id").get<std::string>();
+            session.editorToken = entry.at("editor_token").get<std::string>();
+            session.viewerToken = entry.at("viewer_token").get<std::string>();
+            session.bakeId = entry.at("bake_id").get<std::string>();
+            session.version = entry.at("version").get<uint64_t>();
+        } catch (const Json::exception& error) {
+            return fail(ErrorCode::Corrupt, "{}: session entry {}: {}", mPath, sessions.size(),
+                        error.what());
+        }
+        auto lights = parseLightSet(entry.value("lights", Json::object()).dump());
+        if (!lights)
+            return fail(ErrorCode::Corrupt, "{}: session {}: {}", mPath, session.id,
+                        lights.error().message);
+        session.lights = std::move(*lights);
+        sessions.push_back(std::move(session));
+    }
+    return sessions;
+}
+
+Result<void> SessionStore::save(const std::vector<StoredSession>& sessions) {
+    Json root;
+    root["format"] = kFormat;
+    root["sessions"] = Json::array();
+    for (const StoredSession& session : sessions) {
+        Json entry;
+        entry["id"] = session.id;
+        entry["editor_token"] = session.editorToken;
+        entry["viewer_token"] = session.viewerToken;
+        entry["bake_id"] = session.bakeId;
+        entry["version"] = session.version;
+        entry["lights"] = Json::parse(toJson(session.lights));
+        root["sessions"].push_back(std::move(entry));
+    }
+    const std::string text = root.dump(2) + "\n";
+
+    std::lock_guard lock(mMutex);
+    const std::string temp = mPath + ".tmp";
+    // Owner-only: the file holds the sessions' tokens.
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) return fail(ErrorCode::Io, "cannot write the session database {}", temp);
+    size_t written = 0;
+    while (written < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+        if (n <= 0) break;
+        written += size_t(n);
+    }
+    const bool synced = ::fsync(fd) == 0;
+    ::close(fd);
+    if (written != text.size() || !synced || std::rename(temp.c_str(), mPath.c_str()) != 0) {
+        std::remove(temp.c_str());
+        return fail(ErrorCode::Io, "cannot write the session database {}", mPath);
+    }
+    return {};
+}
+
+}  // namespace pic

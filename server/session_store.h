@@ -1,0 +1,43 @@
+#pragma once
+/// The server's database (`picserver --db FILE`): its sessions, so that a restarted server
+/// keeps them, with their tokens, bake and last light set. One JSON file, rewritten atomically
+/// (temporary file, fsync, rename) whenever a session is created, relit or removed; readable
+/// by its owner only, since it holds the tokens.
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/light_set.h"
+
+namespace pic {
+
+/// What the database keeps of one session.
+struct StoredSession {
+    std::string id;
+    std::string editorToken;
+    std::string viewerToken;
+    std::string bakeId;
+    uint64_t version = 0;  ///< the newest version it had accepted
+    LightSet lights;       ///< the light set of that version
+};
+
+class SessionStore {
+public:
+    explicit SessionStore(std::string path) : mPath(std::move(path)) {}
+
+    const std::string& path() const { return mPath; }
+    /// The sessions in the file; none when it does not exist yet. Corrupt naming the file and
+    /// the problem when it cannot be read as a database of this format.
+    Result<std::vector<StoredSession>> load() const;
+    /// Replaces the file's contents with `sessions`; Io naming the file on failure.
+    Result<void> save(const std::vector<StoredSession>& sessions);
+
+private:
+    std::string mPath;
+    std::mutex mMutex;  ///< one writer at a time
+};
+
+}  // namespace pic
