@@ -23,14 +23,25 @@ struct PicServer::State {
     mutable std::mutex mutex;
     std::map<std::string, std::shared_ptr<Session>> sessions;
     std::atomic<bool> stopping{false};
-    std::condition_variable stopped;  ///< notified (under mutex) when stopping is set
+    std::condition_variable wake;     ///< notified (under mutex) when stopping or dirty is set
+    bool dirty = false;               ///< sessions changed since the database was written
     std::mt19937_64 random{std::random_device{}()};
     std::unique_ptr<SessionStore> store;  ///< null without --db
     std::mutex persistMutex;              ///< snapshots are written in the order they are taken
 
+    /// Asks the housekeeping thread to write the database soon: handlers never wait for a disk.
+    void markDirty() {
+        if (!store) return;
+        {
+            std::lock_guard lock(mutex);
+            dirty = true;
+        }
+        wake.notify_all();
+    }
+
     /// Writes every session to the database (when there is one); a failure is logged, not
     /// fatal: the sessions go on, only not durably.
-    void persist() {
+    void saveNow() {
         if (!store) return;
         std::lock_guard persisting(persistMutex);
         std::vector<StoredSession> snapshot;
@@ -281,7 +292,7 @@ public:
                                                 *bake, mState->options.session);
             mState->sessions[id] = session;
         }
-        mState->persist();
+        mState->markDirty();
         response->set_session(session->id());
         response->set_editor_token(session->editorToken());
         response->set_viewer_token(session->viewerToken());
@@ -315,7 +326,7 @@ public:
         if (!lights) return finish(context, wire::toStatus(lights.error()));
         auto version = access.session->setLights(std::move(*lights));
         if (!version) return finish(context, wire::toStatus(version.error()));
-        mState->persist();
+        mState->markDirty();
         response->set_version(*version);
         return finish(context, grpc::Status::OK);
     }
@@ -349,15 +360,16 @@ private:
     std::shared_ptr<PicServer::State> mState;
 };
 
-/// Removes sessions without subscribers that nobody used for options.sessionIdle, checking a
-/// few times per idle period, until the server stops.
-void reapIdleSessions(PicServer::State& state) {
+/// The server's background work until it stops: removes sessions without subscribers that
+/// nobody used for options.sessionIdle (checking a few times per idle period), and writes the
+/// session database when sessions changed (at most once per wake, and once more at the end).
+void housekeeping(PicServer::State& state) {
     const auto idle = state.options.sessionIdle;
     const auto period = std::clamp<std::chrono::steady_clock::duration>(
         idle / 4, std::chrono::milliseconds(10), std::chrono::seconds(30));
     std::unique_lock lock(state.mutex);
-    while (!state.stopping) {
-        state.stopped.wait_for(lock, period, [&] { return state.stopping.load(); });
+    for (;;) {
+        state.wake.wait_for(lock, period, [&] { return state.stopping.load() || state.dirty; });
         std::vector<std::shared_ptr<Session>> expired;
         for (auto it = state.sessions.begin(); it != state.sessions.end();) {
             if (it->second->subscribers() == 0 && it->second->idleFor() > idle) {
@@ -367,15 +379,19 @@ void reapIdleSessions(PicServer::State& state) {
                 ++it;
             }
         }
-        // Stopping a session joins its worker: not under the lock the handlers need.
+        const bool save = state.dirty || !expired.empty();
+        state.dirty = false;
+        const bool stopping = state.stopping;
+        // Stopping a session joins its worker, and saving reads every session: neither under
+        // the lock the handlers need.
         lock.unlock();
         for (const auto& session : expired)
             std::fprintf(stderr, "picserver: session %s removed after %.1f s unused\n",
                          session->id().c_str(),
                          std::chrono::duration<double>(session->idleFor()).count());
-        const bool removed = !expired.empty();
         expired.clear();
-        if (removed) state.persist();
+        if (save) state.saveNow();
+        if (stopping) return;
         lock.lock();
     }
 }
@@ -418,7 +434,7 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
         if (!stored.empty())
             std::fprintf(stderr, "picserver: %zu of %zu sessions restored from %s\n",
                          state.sessions.size(), stored.size(), options.dbPath.c_str());
-        state.persist();
+        state.saveNow();
     }
 
     grpc::EnableDefaultHealthCheckService(true);
@@ -444,7 +460,7 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     server->mAddress = fmt::format("{}:{}", listen.substr(0, colon), port);
     if (auto* health = server->mServer->GetHealthCheckService())
         health->SetServingStatus(true);
-    server->mReaper = std::thread([state = server->mState] { reapIdleSessions(*state); });
+    server->mReaper = std::thread([state = server->mState] { housekeeping(*state); });
     return server;
 }
 
@@ -464,7 +480,7 @@ void PicServer::shutdown() {
         std::lock_guard stateLock(mState->mutex);
         mState->stopping = true;
     }
-    mState->stopped.notify_all();
+    mState->wake.notify_all();
     if (mReaper.joinable()) mReaper.join();
     if (auto* health = mServer->GetHealthCheckService()) health->SetServingStatus(false);
     // Streams never end on their own: cancel them after a short grace period.

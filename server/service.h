@@ -67,7 +67,7 @@ private:
     std::unique_ptr<grpc::Server> mServer;
     std::mutex mShutdownMutex;
     bool mShutDown = false;
-    std::thread mReaper;  ///< removes idle sessions until shutdown
+    std::thread mReaper;  ///< housekeeping: idle sessions, the database; until shutdown
 };
 
 }  // namespace pic

@@ -1,7 +1,8 @@
 #pragma once
 /// The server's database (`picserver --db FILE`): its sessions, so that a restarted server
 /// keeps them, with their tokens, bake and last light set. One JSON file, rewritten atomically
-/// (temporary file, fsync, rename) whenever a session is created, relit or removed; readable
+/// (temporary file, fsync, rename) by the server's housekeeping thread soon after a session is
+/// created, relit or removed (handlers never wait for the disk); readable
 /// by its owner only, since it holds the tokens.
 
 #include <cstdint>
