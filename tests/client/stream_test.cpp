@@ -11,6 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
+
+#include <grpcpp/generic/generic_stub.h>
 #include <limits>
 #include <memory>
 #include <string>
@@ -401,6 +404,73 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
     fs::remove(db);
+}
+
+TEST(Stream, HealthCheckSaysServing) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    // grpc.health.v1.Health/Check with an empty request (the whole server); the reply
+    // HealthCheckResponse{status: SERVING = 1} is the two bytes 08 01.
+    auto channel = grpc::CreateChannel(served.server->address(), grpc::InsecureChannelCredentials());
+    grpc::GenericStub stub(channel);
+    grpc::ClientContext context;
+    grpc::ByteBuffer request, response;
+    grpc::Slice empty("");
+    request = grpc::ByteBuffer(&empty, 1);
+    std::promise<grpc::Status> done;
+    stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
+                   &response, [&](grpc::Status status) { done.set_value(status); });
+    grpc::Status status = done.get_future().get();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    std::vector<grpc::Slice> slices;
+    ASSERT_TRUE(response.Dump(&slices).ok());
+    std::string bytes;
+    for (const auto& slice : slices) bytes.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+    EXPECT_EQ(bytes, std::string("\x08\x01", 2));
+}
+
+/// One ServerReflectionInfo exchange: sends `request`, collects the first reply's bytes.
+class ReflectionCall final : public grpc::ClientBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer> {
+public:
+    ReflectionCall(grpc::GenericStub& stub, const std::string& request) {
+        grpc::Slice slice(request);
+        mRequest = grpc::ByteBuffer(&slice, 1);
+        stub.PrepareBidiStreamingCall(&mContext, "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo",
+                                      grpc::StubOptions(), this);
+        StartWriteLast(&mRequest, grpc::WriteOptions());
+        StartRead(&mResponse);
+        StartCall();
+    }
+    void OnReadDone(bool ok) override {
+        if (ok) {
+            std::vector<grpc::Slice> slices;
+            if (mResponse.Dump(&slices).ok())
+                for (const auto& slice : slices)
+                    mReply.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
+        }
+    }
+    void OnDone(const grpc::Status& status) override { mDone.set_value(status); }
+    std::string reply() {
+        mDone.get_future().get();
+        return mReply;
+    }
+
+private:
+    grpc::ClientContext mContext;
+    grpc::ByteBuffer mRequest, mResponse;
+    std::string mReply;
+    std::promise<grpc::Status> mDone;
+};
+
+TEST(Stream, ReflectionListsThePicService) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto channel = grpc::CreateChannel(served.server->address(), grpc::InsecureChannelCredentials());
+    grpc::GenericStub stub(channel);
+    // ServerReflectionRequest{list_services: ""}: field 7, length-delimited, empty.
+    ReflectionCall call(stub, std::string("\x3a\x00", 2));
+    const std::string reply = call.reply();
+    EXPECT_NE(reply.find("pic.v1.Pic"), std::string::npos) << "reflection lists the service";
 }
 
 TEST(Stream, TokensAndRoles) {
