@@ -127,6 +127,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     std::map<uint64_t, Clock::time_point> sent;  // version → when the editor called
     std::vector<std::string> editorErrors;
     uint64_t lastVersion = joined.version();
+    if (options.onChangesStart) options.onChangesStart();
     const auto start = Clock::now();
     if (options.updateRate > 0.0) {
         const auto period = std::chrono::duration<double>(1.0 / options.updateRate);
@@ -157,6 +158,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     while (!holdsLast() && Clock::now() - drainStart < std::chrono::seconds(30))
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (options.onChangesEnd) options.onChangesEnd();
     for (auto& stream : streams) stream->cancel();
     for (auto& thread : threads) thread.join();
 

@@ -4,6 +4,7 @@
 /// the decoded frame of that version or a newer one.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -22,6 +23,11 @@ struct LoadOptions {
     std::string editorToken;     ///< with `session`
     float moveMetres = 0.25f;    ///< radius of the circle the moved point or spot light follows
     float turnDegrees = 5.0f;    ///< amplitude of a moved directional light's swing
+    /// Called when every subscriber holds its first frame and the editor starts, and when
+    /// every subscriber holds the last version (or the wait for it ended): the window a
+    /// benchmark measures the server in.
+    std::function<void()> onChangesStart;
+    std::function<void()> onChangesEnd;
 };
 
 /// Runs the load test against the server behind `connection` and returns the report:
