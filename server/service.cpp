@@ -25,7 +25,7 @@ struct PicServer::State {
     std::atomic<bool> stopping{false};
     std::condition_variable wake;     ///< notified (under mutex) when stopping or dirty is set
     bool dirty = false;               ///< sessions changed since the database was written
-    std::mt19937_64 random{std::random_device{}()};
+    std::random_device random;  ///< the OS's entropy (/dev/urandom): tokens must not be predictable
     std::unique_ptr<SessionStore> store;  ///< null without --db
     std::mutex persistMutex;              ///< snapshots are written in the order they are taken
 
@@ -70,10 +70,11 @@ struct PicServer::State {
         return it == sessions.end() ? nullptr : it->second;
     }
 
-    /// `bits` random bits as hex (under `mutex`).
+    /// `words` × 32 random bits as hex (under `mutex`). Never a seeded generator: a viewer who
+    /// could recover its state from its own token could derive the editor token.
     std::string randomHex(int words) {
         std::string hex;
-        for (int i = 0; i < words; ++i) hex += fmt::format("{:016x}", random());
+        for (int i = 0; i < words; ++i) hex += fmt::format("{:08x}", uint32_t(random()));
         return hex;
     }
 };
@@ -204,12 +205,14 @@ public:
 
 private:
     struct Link {
-        std::mutex mutex;
+        /// Recursive: should gRPC run OnWriteDone inline from StartWrite (it may when a write
+        /// completes at once), the reaction re-enters under the same lock on the same thread.
+        std::recursive_mutex mutex;
         FrameWriter* writer = nullptr;
     };
 
-    /// Starts the next write if none is in flight (under the link's lock). gRPC never runs
-    /// OnWriteDone inline from StartWrite, so holding the lock here cannot deadlock.
+    /// Starts the next write if none is in flight (under the link's lock). Everything the
+    /// write's reaction reads is set before StartWrite.
     void pump() {
         if (!mSlot || mWriting || mCancelled || mFinished) return;
         std::shared_ptr<const Update> update = mSlot->take();
@@ -286,9 +289,9 @@ public:
                               grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                                            fmt::format("the server holds its maximum of {} sessions",
                                                        mState->options.maxSessions)));
-            std::string id = mState->randomHex(1);
-            while (mState->sessions.contains(id)) id = mState->randomHex(1);
-            session = std::make_shared<Session>(id, mState->randomHex(2), mState->randomHex(2),
+            std::string id = mState->randomHex(2);
+            while (mState->sessions.contains(id)) id = mState->randomHex(2);
+            session = std::make_shared<Session>(id, mState->randomHex(4), mState->randomHex(4),
                                                 *bake, mState->options.session);
             mState->sessions[id] = session;
         }
