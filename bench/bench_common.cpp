@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "core/chart.h"
 #include "core/gltf_loader.h"
 
 namespace pic {
@@ -72,6 +73,19 @@ std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const s
 int reportError(const Error& error) {
     std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
     return exitCode(error);
+}
+
+std::string chartPathFor(const std::string& jsonPath) {
+    const std::string suffix = ".json";
+    if (jsonPath.size() > suffix.size() && jsonPath.ends_with(suffix))
+        return jsonPath.substr(0, jsonPath.size() - suffix.size()) + ".png";
+    return jsonPath + ".png";
+}
+
+int writeChartFile(const Chart& chart, const std::string& path) {
+    if (auto written = writeChart(chart, path); !written) return reportError(written.error());
+    std::printf("written %s\n", path.c_str());
+    return 0;
 }
 
 int writeJson(const nlohmann::ordered_json& json, const std::string& path) {

@@ -11,6 +11,7 @@
 
 #include "bake/bake.h"
 #include "bake/embree_scene.h"
+#include "core/chart.h"
 #include "core/error.h"
 #include "core/light_set.h"
 #include "core/scene.h"
@@ -43,6 +44,12 @@ std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const s
 
 /// Prints `error` on stderr and returns its exit code.
 int reportError(const Error& error);
+
+/// The chart written beside a benchmark's JSON: "x.json" → "x.png".
+std::string chartPathFor(const std::string& jsonPath);
+
+/// Writes `chart` to `path` and says so; returns the exit code.
+int writeChartFile(const Chart& chart, const std::string& path);
 
 /// Writes `json` to `path` and says so; returns the exit code.
 int writeJson(const nlohmann::ordered_json& json, const std::string& path);

@@ -200,6 +200,8 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
     json["sizes"] = nlohmann::ordered_json::array();
     std::printf("%-6s %10s %10s %10s %12s %12s\n", "size", "gpu ms", "cpu ms", "gpu/cpu",
                 "rel L1", "surfels >1%");
+    ChartSeries tradeoff{"relative L1 of direct surfel flux (%)", {0.12f, 0.35f, 0.75f}};
+    ChartSeries differingSeries{"surfels differing by > 1 % (%)", {0.85f, 0.45f, 0.1f}};
     for (uint32_t size : params.sizes) {
         GpuRuntimeOptions options;
         options.deviceName = params.device;
@@ -251,9 +253,20 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
         row["relative_l1"] = relL1;
         row["fraction_surfels_differing"] = fraction;
         json["sizes"].push_back(row);
+        tradeoff.points.push_back({median(gpuMs), 100.0 * relL1});
+        tradeoff.labels.push_back(fmt::format("{0}x{0}", size));
+        differingSeries.points.push_back({median(gpuMs), 100.0 * fraction});
     }
     std::printf("gpu: shadow maps of every light + direct surfel lighting (wall clock, read-back\n"
                 "included); cpu: the twin's rays; errors: GPU direct surfel flux against the rays\n");
+    Chart chart;
+    chart.title = fmt::format("Shadow-map size: time against error ({} rtp, {})", params.setting,
+                              json["sizes"].empty() ? std::string("no device")
+                                                    : json["sizes"][0]["device"].get<std::string>());
+    chart.xLabel = "GPU shadow maps + direct surfel lighting, ms (median)";
+    chart.yLabel = "% against the CPU twin's rays";
+    chart.series = {tradeoff, differingSeries};
+    if (int exit = writeChartFile(chart, chartPathFor(params.jsonPath)); exit != 0) return exit;
     return writeJson(json, params.jsonPath);
 }
 

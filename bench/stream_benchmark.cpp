@@ -163,6 +163,26 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
         rows.push_back(std::move(row));
     }
 
+    Chart chart;
+    chart.title = fmt::format("Light change to decoded frame, {} {} on {}", params.setting,
+                              params.linkMode, params.backend);
+    chart.xLabel = "subscribers";
+    chart.yLabel = "ms";
+    chart.logX = true;
+    ChartSeries p50{"latency p50", {0.2f, 0.6f, 0.2f}}, p99{"latency p99", {0.8f, 0.15f, 0.15f}};
+    ChartSeries update{"server update (p50)", {0.4f, 0.4f, 0.4f}};
+    ChartSeries goal{"goal: p99 <= 100 ms at 64", {0.8f, 0.15f, 0.15f}};
+    goal.dashed = true;
+    for (const auto& row : rows) {
+        const double n = row["clients"].get<double>();
+        p50.points.push_back({n, row["latency_ms"]["p50"].get<double>()});
+        p99.points.push_back({n, row["latency_ms"]["p99"].get<double>()});
+        update.points.push_back({n, row["server_ms"]["update_p50"].get<double>()});
+    }
+    goal.points = {{p50.points.front().x, 100.0}, {p50.points.back().x, 100.0}};
+    chart.series = {p50, p99, update, goal};
+    if (int written = writeChartFile(chart, chartPathFor(params.jsonPath)); written != 0) exit = written;
+
     auto bakes = (*connection)->listBakes();
     nlohmann::ordered_json json;
     json["scene"] = params.scenePath;

@@ -10,7 +10,7 @@ PACKAGES=(
   libembree-dev libtbb-dev
   libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
-  libopenimageio-dev openimageio-tools
+  libopenimageio-dev openimageio-tools fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libzstd-dev
 )
