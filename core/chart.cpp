@@ -76,7 +76,7 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
 
     bool labelled = false;
     for (const ChartSeries& series : chart.series) labelled = labelled || !series.labels.empty();
-    const int left = 90, right = labelled ? 110 : 30, top = 70, bottom = 70;
+    const int left = 90, right = labelled ? 110 : 30, top = 92, bottom = 70;
     const int plotW = width - left - right, plotH = height - top - bottom;
     if (plotW < 100 || plotH < 100)
         return fail(ErrorCode::InvalidInput, "chart size {}x{} is too small", width, height);
@@ -152,14 +152,16 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
     text(width / 2, 28, chart.title, 18, black, OIIO::ImageBufAlgo::TextAlignX::Center);
     text(left + plotW / 2, height - 18, chart.xLabel + (chart.logX ? " (log scale)" : ""), 15,
          black, OIIO::ImageBufAlgo::TextAlignX::Center);
-    text(12, top - 14, chart.yLabel, 15, black);
-    int legendY = top + 22;
+    text(12, top - 10, chart.yLabel, 15, black);
+    // Legend: one row under the title, outside the plot, so that it hides no point.
+    int legendX = left;
     for (const ChartSeries& series : chart.series) {
         const float color[] = {series.color.r, series.color.g, series.color.b};
-        const int x = left + 14;
-        OIIO::ImageBufAlgo::render_box(image, x, legendY - 9, x + 18, legendY - 3, OIIO::cspan<float>(color, 3), true);
-        text(x + 26, legendY, series.name, 14, black);
-        legendY += 22;
+        OIIO::ImageBufAlgo::render_box(image, legendX, 48, legendX + 18, 54,
+                                       OIIO::cspan<float>(color, 3), true);
+        text(legendX + 24, 57, series.name, 14, black);
+        const OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(series.name, 14, kChartFont);
+        legendX += 24 + (extent.defined() ? extent.width() : 8 * int(series.name.size())) + 28;
     }
 
     const std::string temp = path + ".tmp.png";
