@@ -7,7 +7,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers glslang-tools glslang-dev spirv-tools
-  libembree-dev libtbb-dev
+  libembree-dev libtbb-dev libmeshoptimizer-dev
   libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libopenimageio-dev openimageio-tools fonts-dejavu-core

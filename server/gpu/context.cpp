@@ -510,6 +510,41 @@ Result<void> Context::download(const Buffer& buffer, void* data, VkDeviceSize by
     return {};
 }
 
+Result<std::vector<float>> Context::downloadDepthLayer(const DepthArray& depth, uint32_t layer) {
+    PIC_CHECK(layer < depth.layers());
+    const VkDeviceSize bytes = VkDeviceSize{depth.size()} * depth.size() * sizeof(float);
+    PIC_TRY_ASSIGN(Buffer staging, createBuffer(bytes, 0, MemoryUse::Readback, "depth download"));
+    PIC_TRY(submit([&](VkCommandBuffer cmd) {
+        // Earlier depth writes and shader reads finish before the copy reads the layer.
+        VkImageMemoryBarrier toCopy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+        toCopy.srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        toCopy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        toCopy.oldLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        toCopy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        toCopy.srcQueueFamilyIndex = toCopy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        toCopy.image = depth.image();
+        toCopy.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             0, 0, nullptr, 0, nullptr, 1, &toCopy);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, layer, 1};
+        region.imageExtent = {depth.size(), depth.size(), 1};
+        vkCmdCopyImageToBuffer(cmd, depth.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               staging.handle(), 1, &region);
+        // The copy finishes before the layer is sampled or rendered again.
+        VkImageMemoryBarrier back = toCopy;
+        back.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        back.dstAccessMask = 0;
+        back.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        back.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                             0, 0, nullptr, 0, nullptr, 1, &back);
+    }));
+    std::vector<float> texels(size_t(depth.size()) * depth.size());
+    std::memcpy(texels.data(), staging.mapped(), bytes);
+    return texels;
+}
+
 Result<DepthArray> Context::createDepthArray(uint32_t size, uint32_t layers) {
     if (mLost) return fail(ErrorCode::Internal, "the Vulkan device \"{}\" was lost", mName);
     if (size == 0 || layers == 0 || size > mProperties.limits.maxImageDimension2D ||
@@ -529,8 +564,9 @@ Result<DepthArray> Context::createDepthArray(uint32_t size, uint32_t layers) {
     info.arrayLayers = layers;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    // Cleared once at creation; read back by downloadDepthLayer.
     info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                 VK_IMAGE_USAGE_TRANSFER_DST_BIT;  // cleared once at creation
+                 VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     PIC_VK_TRY(vkCreateImage(mDevice, &info, nullptr, &depth.mImage));
     VkMemoryRequirements requirements;
@@ -661,7 +697,7 @@ Result<VkPipeline> Context::createRasterPipeline(const RasterPipelineDesc& desc)
     VkPipelineRasterizationStateCreateInfo raster{
         VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.polygonMode = VK_POLYGON_MODE_FILL;
-    raster.cullMode = VK_CULL_MODE_NONE;
+    raster.cullMode = desc.cullMode;
     raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
     raster.lineWidth = 1.0f;
     VkPipelineMultisampleStateCreateInfo multisample{

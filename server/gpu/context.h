@@ -134,6 +134,7 @@ struct RasterPipelineDesc {
     VkVertexInputBindingDescription binding{};
     std::span<const VkVertexInputAttributeDescription> attributes;
     VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
+    VkCullModeFlags cullMode = VK_CULL_MODE_NONE;  ///< front faces wind counter-clockwise
     std::span<const VkFormat> colorFormats;   ///< one per colour attachment, all written
     VkPipelineLayout layout = VK_NULL_HANDLE;
 };
@@ -215,6 +216,8 @@ public:
     /// A D32 depth array of `layers` square layers of `size`², sampled and rendered to, in
     /// SHADER_READ_ONLY layout once created.
     Result<DepthArray> createDepthArray(uint32_t size, uint32_t layers);
+    /// The depths of one layer, row-major (waits for the device: for tests and debugging).
+    Result<std::vector<float>> downloadDepthLayer(const DepthArray& depth, uint32_t layer);
 
     /// A width × height render target of `format`: a depth attachment for depth formats
     /// (VK_FORMAT_D32_SFLOAT), else a colour attachment that shaders may sample. InvalidInput

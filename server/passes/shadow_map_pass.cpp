@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <meshoptimizer.h>
 
 #include "spirv/shadow_map_vert.h"
 
@@ -26,8 +27,49 @@ glm::vec3 upFor(const glm::vec3& forward) {
 
 }  // namespace
 
+Scene mergeShadowCasters(const Scene& scene) {
+    // Corners welded by position: the simplifier merges only across shared vertices.
+    const size_t nV = scene.vertices.size();
+    std::vector<float> positions(3 * nV);
+    for (size_t v = 0; v < nV; ++v) {
+        const glm::vec3& p = scene.vertices[v].position;
+        positions[3 * v + 0] = p.x;
+        positions[3 * v + 1] = p.y;
+        positions[3 * v + 2] = p.z;
+    }
+    std::vector<uint32_t> remap(nV);
+    const size_t unique = meshopt_generateVertexRemap(remap.data(), nullptr, nV, positions.data(),
+                                                      nV, 3 * sizeof(float));
+    std::vector<float> welded(3 * unique);
+    meshopt_remapVertexBuffer(welded.data(), positions.data(), nV, 3 * sizeof(float), remap.data());
+    std::vector<uint32_t> indices;
+    indices.reserve(3 * scene.triangles.size());
+    for (const Triangle& tri : scene.triangles)
+        for (uint32_t v : tri.v) indices.push_back(remap[v]);
+
+    // Edge collapses whose error stays at float rounding: coplanar triangles merge, curved
+    // surfaces keep their facets, and open borders stay where they are (no cracks where
+    // one object's border meets another's).
+    std::vector<uint32_t> merged(indices.size());
+    merged.resize(meshopt_simplify(merged.data(), indices.data(), indices.size(), welded.data(),
+                                   unique, 3 * sizeof(float), 0, kCasterMergeError,
+                                   meshopt_SimplifyLockBorder, nullptr));
+
+    Scene casters;
+    casters.sourcePath = scene.sourcePath;
+    casters.bounds = scene.bounds;
+    casters.vertices.resize(unique);
+    for (size_t v = 0; v < unique; ++v)
+        casters.vertices[v].position = {welded[3 * v], welded[3 * v + 1], welded[3 * v + 2]};
+    casters.triangles.resize(merged.size() / 3);
+    for (size_t t = 0; t < casters.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) casters.triangles[t].v[k] = merged[3 * t + k];
+    return casters;
+}
+
 std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
-                                                   std::vector<uint32_t>& order) {
+                                                   std::vector<uint32_t>& order,
+                                                   const Solids* solids) {
     std::vector<glm::vec3> centroids(scene.triangles.size());
     for (size_t t = 0; t < scene.triangles.size(); ++t) {
         const Triangle& tri = scene.triangles[t];
@@ -37,21 +79,30 @@ std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t 
     order.resize(scene.triangles.size());
     std::iota(order.begin(), order.end(), 0u);
     const uint32_t leafSize = std::max(maxTriangles, 1u);
+    auto inSolid = [&](uint32_t t) { return solids && solids->solidOf[t] != Solids::kOpen; };
+    // Triangles of solids first, so that no cluster mixes them with open ones.
+    const uint32_t solidEnd =
+        uint32_t(std::stable_partition(order.begin(), order.end(), inSolid) - order.begin());
 
     // Median splits along the longest axis of the centroids' bounds until a range fits in
     // one cluster: compact boxes, which is what culling needs. Ranges are finished in index
     // order, so the clusters come out sorted.
     std::vector<TriangleCluster> clusters;
-    std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t(order.size())}};
+    std::vector<std::pair<uint32_t, uint32_t>> stack{{solidEnd, uint32_t(order.size())},
+                                                     {0u, solidEnd}};
     while (!stack.empty()) {
         const auto [begin, end] = stack.back();
         stack.pop_back();
         if (end - begin <= leafSize) {
-            TriangleCluster cluster{begin, end - begin, {}};
-            for (uint32_t i = begin; i < end; ++i)
+            if (end == begin) continue;
+            TriangleCluster cluster{begin, end - begin, {}, {}};
+            for (uint32_t i = begin; i < end; ++i) {
                 for (uint32_t v : scene.triangles[order[i]].v)
                     cluster.bounds.extend(scene.vertices[v].position);
-            if (cluster.triangleCount > 0) clusters.push_back(cluster);
+                if (inSolid(order[i]))
+                    cluster.solidBounds.extend(solids->bounds[solids->solidOf[order[i]]]);
+            }
+            clusters.push_back(cluster);
             continue;
         }
         Aabb box;
@@ -70,8 +121,15 @@ std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t 
     return clusters;
 }
 
+bool ShadowEye::outside(const Aabb& solidBounds) const {
+    if (atInfinity) return true;
+    return glm::any(glm::lessThan(position, solidBounds.min - margin)) ||
+           glm::any(glm::greaterThan(position, solidBounds.max + margin));
+}
+
 std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
-                                                 const glm::mat4& clipFromWorld) {
+                                                 const glm::mat4& clipFromWorld,
+                                                 const ShadowEye& eye) {
     // The clip volume's planes a·p ≥ 0 in world space (homogeneous p = (x, y, z, 1)), from
     // the rows of the matrix: w ± x, w ± y, z (Vulkan's near plane) and w − z.
     const glm::mat4 rows = glm::transpose(clipFromWorld);  // rows[i] = row i
@@ -92,17 +150,19 @@ std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster
             }
         }
         if (outside) continue;
-        if (!ranges.empty() &&
+        const bool oneSided = !cluster.solidBounds.empty() && eye.outside(cluster.solidBounds);
+        if (!ranges.empty() && ranges.back().oneSided == oneSided &&
             ranges.back().firstTriangle + ranges.back().triangleCount == cluster.firstTriangle)
             ranges.back().triangleCount += cluster.triangleCount;
         else
-            ranges.push_back({cluster.firstTriangle, cluster.triangleCount});
+            ranges.push_back({cluster.firstTriangle, cluster.triangleCount, oneSided});
     }
     return ranges;
 }
 
 Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
-                                                             uint32_t size) {
+                                                             uint32_t size,
+                                                             const ShadowCasterOptions& options) {
     if (size < 16 || size > 16384)
         return fail(ErrorCode::InvalidInput, "shadow-map size must be in [16, 16384], got {}", size);
     if (scene.triangles.empty() || scene.bounds.empty())
@@ -112,27 +172,43 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     pass->mSize = size;
     pass->mBounds = scene.bounds;
 
+    // The casters: the scene's triangles, coplanar runs merged. Solids are wound
+    // counter-clockwise seen from outside (glTF's front faces), inverted ones reversed here,
+    // so that one cull mode keeps the faces that look at the light.
+    const Scene merged = options.mergeCoplanar ? mergeShadowCasters(scene) : Scene{};
+    const Scene& casters = options.mergeCoplanar ? merged : scene;
+    pass->mCasterTriangles = uint32_t(casters.triangles.size());
+    const Solids solids = options.oneSidedSolids ? findSolids(casters) : Solids{};
     // Triangles in cluster order, so that each cluster is one run of the index buffer, and
     // each cluster's vertices (positions only: depth needs nothing else) stored together, so
     // that a draw of a few clusters spans a short vertex range (lavapipe shades the whole
     // range an indexed draw spans).
     std::vector<uint32_t> order;
-    pass->mClusters = buildTriangleClusters(scene, kShadowClusterTriangles, order);
+    pass->mClusters = buildTriangleClusters(casters, kShadowClusterTriangles, order,
+                                            options.oneSidedSolids ? &solids : nullptr);
     std::vector<float> positions;
     std::vector<uint32_t> indices;
     indices.reserve(scene.triangles.size() * 3);
-    std::vector<uint32_t> local(scene.vertices.size(), UINT32_MAX);
+    std::vector<uint32_t> local(casters.vertices.size(), UINT32_MAX);
     for (const TriangleCluster& cluster : pass->mClusters) {
         const uint32_t firstVertex = uint32_t(positions.size() / 3);
-        for (uint32_t i = cluster.firstTriangle; i < cluster.firstTriangle + cluster.triangleCount; ++i)
-            for (uint32_t v : scene.triangles[order[i]].v) {
+        for (uint32_t i = cluster.firstTriangle; i < cluster.firstTriangle + cluster.triangleCount; ++i) {
+            const uint32_t t = order[i];
+            uint32_t corners[3] = {casters.triangles[t].v[0], casters.triangles[t].v[1],
+                                   casters.triangles[t].v[2]};
+            if (!solids.solidOf.empty() && solids.solidOf[t] != Solids::kOpen) {
+                ++pass->mSolidTriangles;
+                if (solids.inverted[solids.solidOf[t]]) std::swap(corners[1], corners[2]);
+            }
+            for (uint32_t v : corners) {
                 if (local[v] == UINT32_MAX || local[v] < firstVertex) {
                     local[v] = uint32_t(positions.size() / 3);
-                    const glm::vec3& p = scene.vertices[v].position;
+                    const glm::vec3& p = casters.vertices[v].position;
                     positions.insert(positions.end(), {p.x, p.y, p.z});
                 }
                 indices.push_back(local[v]);
             }
+        }
     }
     PIC_TRY_ASSIGN(pass->mVertices,
                    context.createBufferWith(std::span<const float>(positions),
@@ -147,8 +223,9 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     // A one-layer placeholder keeps descriptor sets valid before the first light arrives.
     PIC_TRY_ASSIGN(pass->mDepth, context.createDepthArray(size, 1));
 
-    // Depth-only pipeline: no fragment shader, both faces drawn (surfels sit on both sides of
-    // single-sided geometry), viewport and scissor set per layer.
+    // Depth-only pipelines: no fragment shader, viewport and scissor set per layer. Open
+    // triangles are drawn from both sides (surfels sit on both sides of single-sided
+    // geometry); solids seen from outside only from the side that looks at the light.
     VkDevice device = context.device();
     const VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(ShadowMapPush)};
     VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -165,12 +242,15 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     desc.depthCompare = VK_COMPARE_OP_LESS;
     desc.layout = pass->mPipelineLayout;
     PIC_TRY_ASSIGN(pass->mPipeline, context.createRasterPipeline(desc));
+    desc.cullMode = kCullAwayFromLight;
+    PIC_TRY_ASSIGN(pass->mOneSidedPipeline, context.createRasterPipeline(desc));
     return pass;
 }
 
 ShadowMapPass::~ShadowMapPass() {
     VkDevice device = mContext.device();
     if (mPipeline) vkDestroyPipeline(device, mPipeline, nullptr);
+    if (mOneSidedPipeline) vkDestroyPipeline(device, mOneSidedPipeline, nullptr);
     if (mPipelineLayout) vkDestroyPipelineLayout(device, mPipelineLayout, nullptr);
 }
 
@@ -212,6 +292,7 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
         g.depthNear = 0.0f;
         g.depthFar = 2.02f * radius * 1.01f;
         g.texelSlope = 2.0f * radius / float(mSize);
+        slot.eye = ShadowEye{};
         clipFromWorld.push_back(glm::orthoRH_ZO(-radius, radius, -radius, radius, g.depthNear, g.depthFar) * view);
         return slot;
     }
@@ -226,6 +307,9 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     }
     g.depthNear = 1e-3f * diagonal;
     g.depthFar = std::max(farthest * 1.01f, 2.0f * g.depthNear);
+    // The near plane's corners lie within 3 near-plane distances of the light for every
+    // field of view used here (≤ 2 × 61°: √(1 + 2 tan² 61°) = 2.7).
+    slot.eye = ShadowEye{false, light.position, 3.0f * g.depthNear};
     if (slot.layers == 1) {
         // A spot's cone plus a margin of one degree.
         const float fov = 2.0f * light.outerConeAngle + 0.035f;
@@ -289,10 +373,24 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
     return {};
 }
 
+void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer) const {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+    const VkViewport viewport{0.0f, 0.0f, float(mSize), float(mSize), 0.0f, 1.0f};
+    const VkRect2D scissor{{0, 0}, {mSize, mSize}};
+    vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vkCmdSetScissor(cmd, 0, 1, &scissor);
+    const ShadowMapPush push{mClipFromWorld[layer]};
+    vkCmdPushConstants(cmd, mPipelineLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
+    const VkBuffer vertices = mVertices.handle();
+    const VkDeviceSize zero = 0;
+    vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &zero);
+    vkCmdBindIndexBuffer(cmd, mIndices.handle(), 0, VK_INDEX_TYPE_UINT32);
+}
+
 void ShadowMapPass::record(VkCommandBuffer cmd) {
     mRenderedLights = 0;
     mDrawnTriangles = 0;
-    const VkDeviceSize zero = 0;
+    mOneSidedTriangles = 0;
     for (LightSlot& slot : mCurrent) {
         if (!slot.dirty) continue;
         ++mRenderedLights;
@@ -324,19 +422,19 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
             rendering.layerCount = 1;
             rendering.pDepthAttachment = &depth;
             vkCmdBeginRendering(cmd, &rendering);
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipeline);
-            const VkViewport viewport{0.0f, 0.0f, float(mSize), float(mSize), 0.0f, 1.0f};
-            const VkRect2D scissor{{0, 0}, {mSize, mSize}};
-            vkCmdSetViewport(cmd, 0, 1, &viewport);
-            vkCmdSetScissor(cmd, 0, 1, &scissor);
-            const ShadowMapPush push{mClipFromWorld[layer]};
-            vkCmdPushConstants(cmd, mPipelineLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
-            const VkBuffer vertices = mVertices.handle();
-            vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &zero);
-            vkCmdBindIndexBuffer(cmd, mIndices.handle(), 0, VK_INDEX_TYPE_UINT32);
-            for (const TriangleRange& range : visibleTriangleRanges(mClusters, mClipFromWorld[layer])) {
-                vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);
-                mDrawnTriangles += range.triangleCount;
+            const auto ranges = visibleTriangleRanges(mClusters, mClipFromWorld[layer], slot.eye);
+            for (const bool oneSided : {true, false}) {
+                bool bound = false;
+                for (const TriangleRange& range : ranges) {
+                    if (range.oneSided != oneSided) continue;
+                    if (!bound) {
+                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer);
+                        bound = true;
+                    }
+                    vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);
+                    mDrawnTriangles += range.triangleCount;
+                    if (oneSided) mOneSidedTriangles += range.triangleCount;
+                }
             }
             vkCmdEndRendering(cmd);
 

@@ -4,6 +4,10 @@
 /// kMaxPerspectiveSpot, one perspective layer for narrower spots and one orthographic layer
 /// over the scene for directional lights. A light whose position, direction, type and cone
 /// did not change since the previous set keeps its layers: only changed lights re-render.
+/// Two things keep the depths the same while lavapipe rasterises fewer triangles: coplanar
+/// triangles are merged into larger ones, and the closed surfaces of the scene
+/// (core/solids.h) that a light sees from outside are drawn without the faces that look away
+/// from it.
 
 #include <cstdint>
 #include <span>
@@ -14,6 +18,7 @@
 
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "core/solids.h"
 #include "server/gpu/context.h"
 #include "shaders/shared/shadow_map.h"
 
@@ -29,35 +34,80 @@ struct TriangleCluster {
     uint32_t firstTriangle = 0;
     uint32_t triangleCount = 0;
     Aabb bounds;
+    /// The union of the bounds of the solids its triangles belong to; empty when they are
+    /// open (a cluster never mixes the two).
+    Aabb solidBounds;
 };
 
 /// Triangles per cluster: small enough that a cube face skips most of a room, large enough
 /// that one layer needs few draws.
 inline constexpr uint32_t kShadowClusterTriangles = 512;
 
+/// The faces the one-sided pipeline skips. Solids wind counter-clockwise seen from outside;
+/// the light-space matrices are right-handed with y up in clip space, which Vulkan's
+/// framebuffer (y down) mirrors, so a face that looks at the light winds clockwise there:
+/// Vulkan's back face under VK_FRONT_FACE_COUNTER_CLOCKWISE. Skipped are the front ones.
+inline constexpr VkCullModeFlags kCullAwayFromLight = VK_CULL_MODE_FRONT_BIT;
+
+/// Relative error (of the scene's extent) up to which mergeShadowCasters collapses edges: float
+/// rounding, so that only coplanar triangles merge.
+inline constexpr float kCasterMergeError = 1e-6f;
+
+/// The scene's triangles as shadow casters (positions only): corners welded by position and
+/// runs of coplanar triangles merged into fewer, larger ones by meshoptimizer's edge-collapse
+/// simplifier at kCasterMergeError, with open borders locked. The same surfaces.
+Scene mergeShadowCasters(const Scene& scene);
+
 /// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
 /// (median splits of their centroids); `order` receives the triangle indices in cluster order.
+/// With `solids`, the triangles of solids come first and share no cluster with open ones.
 std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
-                                                   std::vector<uint32_t>& order);
+                                                   std::vector<uint32_t>& order,
+                                                   const Solids* solids = nullptr);
+
+/// Where a layer's light sits, as far as solids are concerned.
+struct ShadowEye {
+    bool atInfinity = true;    ///< a directional light: outside every solid
+    glm::vec3 position{0.0f};  ///< a point or spot light's position, metres
+    /// Metres: solids closer to the light than this keep both faces, because the near plane
+    /// may clip the faces where the light's rays enter them.
+    float margin = 0.0f;
+
+    /// Whether the light lies outside every solid within `solidBounds`.
+    bool outside(const Aabb& solidBounds) const;
+};
 
 /// A run of triangles to draw: [firstTriangle, firstTriangle + triangleCount).
 struct TriangleRange {
     uint32_t firstTriangle = 0;
     uint32_t triangleCount = 0;
+    /// Triangles of solids the light sees from outside: their faces that look away from the
+    /// light may be skipped.
+    bool oneSided = false;
 };
 
 /// The clusters whose bounds can intersect the clip volume of `clipFromWorld` (Vulkan's:
-/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w), adjacent ones merged into one range. Conservative: a cluster
-/// is dropped only when its box lies wholly outside one of the six planes.
+/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w), adjacent ones with the same sidedness merged into one range.
+/// Conservative: a cluster is dropped only when its box lies wholly outside one of the six
+/// planes.
 std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
-                                                 const glm::mat4& clipFromWorld);
+                                                 const glm::mat4& clipFromWorld,
+                                                 const ShadowEye& eye = {});
+
+/// How the pass draws the scene. Both are on by default and store the same depths; off only
+/// to measure what they save and to test that claim.
+struct ShadowCasterOptions {
+    bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
+    bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
+};
 
 class ShadowMapPass {
 public:
-    /// Uploads the scene's triangles and builds the depth-only pipeline. `size` is the side of
+    /// Uploads the scene's casters and builds the depth-only pipelines. `size` is the side of
     /// one layer in texels.
     static Result<std::unique_ptr<ShadowMapPass>> create(Context& context, const Scene& scene,
-                                                         uint32_t size);
+                                                         uint32_t size,
+                                                         const ShadowCasterOptions& options = {});
     ~ShadowMapPass();
 
     /// Lays out `lights` on layers, writes their GpuLight records and matrices and marks the
@@ -72,6 +122,11 @@ public:
     uint32_t renderedLights() const { return mRenderedLights; }
     /// Triangles drawn by the last record(), over all layers (after frustum culling).
     uint64_t drawnTriangles() const { return mDrawnTriangles; }
+    /// Of drawnTriangles(), those drawn with faces looking away from the light skipped.
+    uint64_t oneSidedTriangles() const { return mOneSidedTriangles; }
+    /// Caster triangles (the scene's, coplanar ones merged) and those of them in solids.
+    uint32_t casterTriangles() const { return mCasterTriangles; }
+    uint32_t solidTriangles() const { return mSolidTriangles; }
     uint32_t size() const { return mSize; }
     const DepthArray& depth() const { return mDepth; }
     const Buffer& lightBuffer() const { return mLights; }     ///< GpuLight[kMaxLights]
@@ -90,10 +145,13 @@ private:
         float outerConeAngle = 0.0f;
         LightType type = LightType::Point;
         uint32_t layers = 0;
+        ShadowEye eye;
         bool dirty = true;
     };
 
     ShadowMapPass(Context& context) : mContext(context) {}
+    /// Binds `pipeline` with layer `layer`'s viewport, matrix and geometry.
+    void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer) const;
     LightSlot describe(const Light& light, uint32_t firstLayer,
                        std::vector<glm::mat4>& clipFromWorld) const;
 
@@ -107,11 +165,15 @@ private:
     Buffer mMatrices;
     DepthArray mDepth;
     VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
-    VkPipeline mPipeline = VK_NULL_HANDLE;
+    VkPipeline mPipeline = VK_NULL_HANDLE;         ///< both faces
+    VkPipeline mOneSidedPipeline = VK_NULL_HANDLE;  ///< faces looking towards the light
+    uint32_t mCasterTriangles = 0;
+    uint32_t mSolidTriangles = 0;
     std::vector<LightSlot> mCurrent;
     std::vector<glm::mat4> mClipFromWorld;  ///< per layer
     uint32_t mRenderedLights = 0;
     uint64_t mDrawnTriangles = 0;
+    uint64_t mOneSidedTriangles = 0;
 };
 
 }  // namespace pic::gpu

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -38,6 +39,58 @@ Scene randomTriangles(uint32_t count, uint32_t seed) {
 bool insideClip(const glm::mat4& clipFromWorld, const glm::vec3& p) {
     const glm::vec4 c = clipFromWorld * glm::vec4(p, 1.0f);
     return c.w > 0.0f && std::abs(c.x) <= c.w && std::abs(c.y) <= c.w && c.z >= 0.0f && c.z <= c.w;
+}
+
+/// The total area of the scene's triangles, m².
+double totalArea(const Scene& scene) {
+    double area = 0.0;
+    for (const Triangle& t : scene.triangles) {
+        const glm::dvec3 a = scene.vertices[t.v[0]].position, b = scene.vertices[t.v[1]].position,
+                         c = scene.vertices[t.v[2]].position;
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    return area;
+}
+
+TEST(ShadowCasters, CoplanarTrianglesMergeAndCurvedOnesStay) {
+    // A flat 2 m × 1 m floor tessellated into 20 × 10 cells with its own vertices per cell
+    // (as exporters write it), and a tube of 16 facets, open at both ends.
+    Scene scene;
+    auto vertex = [&](const glm::vec3& p) {
+        Vertex v;
+        v.position = p;
+        scene.vertices.push_back(v);
+        scene.bounds.extend(p);
+        return uint32_t(scene.vertices.size() - 1);
+    };
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 10; ++j) {
+            const float x = 0.1f * float(i), z = 0.1f * float(j);
+            const uint32_t a = vertex({x, 0, z}), b = vertex({x, 0, z + 0.1f}),
+                           c = vertex({x + 0.1f, 0, z + 0.1f}), d = vertex({x + 0.1f, 0, z});
+            scene.triangles.push_back(Triangle{{a, b, c}});
+            scene.triangles.push_back(Triangle{{a, c, d}});
+        }
+    const size_t floorTriangles = scene.triangles.size();
+    constexpr int kFacets = 16;
+    for (int k = 0; k < kFacets; ++k) {
+        const float a0 = 2.0f * 3.14159265f * float(k) / kFacets;
+        const float a1 = 2.0f * 3.14159265f * float(k + 1) / kFacets;
+        const glm::vec3 p0(3 + 0.2f * std::cos(a0), 0, 0.2f * std::sin(a0));
+        const glm::vec3 p1(3 + 0.2f * std::cos(a1), 0, 0.2f * std::sin(a1));
+        const uint32_t a = vertex(p0), b = vertex(p1), c = vertex(p1 + glm::vec3(0, 1, 0)),
+                       d = vertex(p0 + glm::vec3(0, 1, 0));
+        scene.triangles.push_back(Triangle{{a, c, b}});
+        scene.triangles.push_back(Triangle{{a, d, c}});
+    }
+    const Scene casters = gpu::mergeShadowCasters(scene);
+    // The floor's interior collapses; its border vertices stay, so what is left is a fan
+    // over them, not 2 triangles. The tube cannot lose a facet.
+    EXPECT_LT(casters.triangles.size(), 2 * kFacets + floorTriangles / 2);
+    EXPECT_GE(casters.triangles.size(), size_t(2 * kFacets + 2));
+    EXPECT_NEAR(totalArea(casters), totalArea(scene), 1e-5 * totalArea(scene));
+    EXPECT_EQ(casters.bounds.min, scene.bounds.min);
+    EXPECT_EQ(casters.bounds.max, scene.bounds.max);
 }
 
 TEST(ShadowCulling, ClustersPartitionTheTrianglesAndBoundThem) {
