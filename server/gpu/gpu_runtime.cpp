@@ -59,7 +59,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                                      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
     PIC_TRY_ASSIGN(mTimer, ctx.createPassTimer(kTimedPasses));
 
-    PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(ctx, mScene, options.shadowMapSize));
+    PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(ctx, mScene, options.shadowMapSize,
+                                                   {.levelsOfDetail = options.casterLevelsOfDetail}));
     PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon()));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake));

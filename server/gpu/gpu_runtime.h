@@ -23,6 +23,9 @@ struct GpuRuntimeOptions {
     std::string deviceName;        ///< --device: substring of the Vulkan device name; empty = best
     bool validation = false;       ///< Vulkan validation layer when installed (PIC_VK_VALIDATION overrides)
     uint32_t shadowMapSize = 1024; ///< texels per side of each shadow-map layer
+    /// Layers with coarse texels draw simplified casters (gpu::ShadowCasterOptions); off only
+    /// to measure what that changes.
+    bool casterLevelsOfDetail = true;
 };
 
 namespace gpu {

@@ -1,12 +1,17 @@
 #include "server/passes/shadow_map_pass.h"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <utility>
 
+#include <embree3/rtcore.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <meshoptimizer.h>
+
+#include "core/parallel.h"
 
 #include "spirv/shadow_map_vert.h"
 
@@ -25,9 +30,10 @@ glm::vec3 upFor(const glm::vec3& forward) {
     return std::abs(forward.y) > 0.9f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
 }
 
-}  // namespace
-
-Scene mergeShadowCasters(const Scene& scene) {
+/// The scene's corners welded by position and its triangles simplified by edge collapses
+/// within `relativeError` of the extent meshoptimizer measures, open borders locked (no
+/// cracks where one object's border meets another's).
+Scene simplifiedCasters(const Scene& scene, float relativeError) {
     // Corners welded by position: the simplifier merges only across shared vertices.
     const size_t nV = scene.vertices.size();
     std::vector<float> positions(3 * nV);
@@ -47,13 +53,10 @@ Scene mergeShadowCasters(const Scene& scene) {
     for (const Triangle& tri : scene.triangles)
         for (uint32_t v : tri.v) indices.push_back(remap[v]);
 
-    // Edge collapses whose error stays at float rounding: coplanar triangles merge, curved
-    // surfaces keep their facets, and open borders stay where they are (no cracks where
-    // one object's border meets another's).
-    std::vector<uint32_t> merged(indices.size());
-    merged.resize(meshopt_simplify(merged.data(), indices.data(), indices.size(), welded.data(),
-                                   unique, 3 * sizeof(float), 0, kCasterMergeError,
-                                   meshopt_SimplifyLockBorder, nullptr));
+    std::vector<uint32_t> simplified(indices.size());
+    simplified.resize(meshopt_simplify(simplified.data(), indices.data(), indices.size(),
+                                       welded.data(), unique, 3 * sizeof(float), 0, relativeError,
+                                       meshopt_SimplifyLockBorder, nullptr));
 
     Scene casters;
     casters.sourcePath = scene.sourcePath;
@@ -61,10 +64,132 @@ Scene mergeShadowCasters(const Scene& scene) {
     casters.vertices.resize(unique);
     for (size_t v = 0; v < unique; ++v)
         casters.vertices[v].position = {welded[3 * v], welded[3 * v + 1], welded[3 * v + 2]};
-    casters.triangles.resize(merged.size() / 3);
+    casters.triangles.resize(simplified.size() / 3);
     for (size_t t = 0; t < casters.triangles.size(); ++t)
-        for (int k = 0; k < 3; ++k) casters.triangles[t].v[k] = merged[3 * t + k];
+        for (int k = 0; k < 3; ++k) casters.triangles[t].v[k] = simplified[3 * t + k];
     return casters;
+}
+
+/// Distance from p to the nearest point of triangle abc (Ericson, Real-Time Collision
+/// Detection §5.1.5: the Voronoi region of p among the corners, edges and face), in double:
+/// in float, long thin triangles (merged strips) lose tens of micrometres to cancellation.
+double distanceToTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
+                          const glm::dvec3& c) {
+    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) return glm::length(ap);
+    const glm::dvec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) return glm::length(bp);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+    const glm::dvec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) return glm::length(cp);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
+        return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+    const double denominator = va + vb + vc;
+    if (!(denominator > 0.0)) return glm::length(ap);  // degenerate: the edges decided above
+    return glm::length(p - (a + ab * (vb / denominator) + ac * (vc / denominator)));
+}
+
+/// Embree point-query callback: shrinks the query radius to the distance of the nearest
+/// triangle of the Scene behind userPtr.
+bool nearerTriangle(RTCPointQueryFunctionArguments* args) {
+    const Scene& scene = *static_cast<const Scene*>(args->userPtr);
+    const Triangle& t = scene.triangles[args->primID];
+    const glm::dvec3 p(args->query->x, args->query->y, args->query->z);
+    const float d = float(distanceToTriangle(p, scene.vertices[t.v[0]].position,
+                                             scene.vertices[t.v[1]].position,
+                                             scene.vertices[t.v[2]].position));
+    if (!(d < args->query->radius)) return false;
+    args->query->radius = d;
+    return true;
+}
+
+/// The eight corners' extreme of the plane function a·(p, 1) over a box: the corner farthest
+/// along the plane's normal (largest) or against it (smallest).
+float planeMax(const glm::vec4& plane, const Aabb& box) {
+    const glm::vec3 corner(plane.x >= 0.0f ? box.max.x : box.min.x,
+                           plane.y >= 0.0f ? box.max.y : box.min.y,
+                           plane.z >= 0.0f ? box.max.z : box.min.z);
+    return glm::dot(glm::vec3(plane), corner) + plane.w;
+}
+float planeMin(const glm::vec4& plane, const Aabb& box) { return -planeMax(-plane, box); }
+
+/// The clip volume's planes a·p ≥ 0 in world space (homogeneous p = (x, y, z, 1)), from the
+/// rows of the matrix: w ± x, w ± y, z (Vulkan's near plane) and w − z.
+std::array<glm::vec4, 6> clipPlanes(const glm::mat4& clipFromWorld) {
+    const glm::mat4 rows = glm::transpose(clipFromWorld);  // rows[i] = row i
+    return {rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1],
+            rows[3] - rows[1], rows[2],           rows[3] - rows[2]};
+}
+
+/// Whether `box` lies wholly outside one of `planes` (then nothing in it can be drawn).
+bool outsideClip(const std::array<glm::vec4, 6>& planes, const Aabb& box) {
+    for (const glm::vec4& plane : planes)
+        if (planeMax(plane, box) < 0.0f) return true;
+    return false;
+}
+
+}  // namespace
+
+Scene mergeShadowCasters(const Scene& scene) {
+    // Float rounding: coplanar triangles merge, curved surfaces keep their facets.
+    return simplifiedCasters(scene, kCasterMergeError);
+}
+
+float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit) {
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
+    if (fine.triangles.empty()) return 0.0f;
+    if (coarse.triangles.empty()) return kInfinity;
+    RTCDevice device = rtcNewDevice(nullptr);
+    if (!device) return kInfinity;
+    RTCScene scene = rtcNewScene(device);
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* positions = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), coarse.vertices.size()));
+    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), coarse.triangles.size()));
+    for (size_t v = 0; v < coarse.vertices.size(); ++v)
+        for (int k = 0; k < 3; ++k) positions[3 * v + k] = coarse.vertices[v].position[k];
+    for (size_t t = 0; t < coarse.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) indices[3 * t + k] = coarse.triangles[t].v[k];
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(scene);
+
+    // Samples: every corner (once per triangle that uses it: cheap, and no index needed)
+    // and every centroid.
+    std::vector<float> worst(fine.triangles.size(), 0.0f);
+    parallelFor(0, fine.triangles.size(), [&](size_t t) {
+        const Triangle& tri = fine.triangles[t];
+        const glm::vec3 a = fine.vertices[tri.v[0]].position, b = fine.vertices[tri.v[1]].position,
+                        c = fine.vertices[tri.v[2]].position;
+        for (const glm::vec3& p : {a, b, c, (a + b + c) / 3.0f}) {
+            RTCPointQuery query{p.x, p.y, p.z, 0.0f, limit};
+            RTCPointQueryContext context;
+            rtcInitPointQueryContext(&context);
+            rtcPointQuery(scene, &query, &context, nearerTriangle, const_cast<Scene*>(&coarse));
+            worst[t] = std::max(worst[t], query.radius < limit ? query.radius : kInfinity);
+        }
+    });
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+    return *std::max_element(worst.begin(), worst.end());
+}
+
+Scene simplifyShadowCasters(const Scene& casters, float error) {
+    std::vector<glm::vec3> positions(casters.vertices.size());
+    for (size_t v = 0; v < positions.size(); ++v) positions[v] = casters.vertices[v].position;
+    const float scale = positions.empty() ? 0.0f
+                                          : meshopt_simplifyScale(&positions[0].x, positions.size(),
+                                                                  sizeof(glm::vec3));
+    return simplifiedCasters(casters, scale > 0.0f ? error / scale : 0.0f);
 }
 
 std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
@@ -127,29 +252,23 @@ bool ShadowEye::outside(const Aabb& solidBounds) const {
            glm::any(glm::greaterThan(position, solidBounds.max + margin));
 }
 
+float nearestClusterDepth(std::span<const TriangleCluster> clusters, const glm::mat4& clipFromWorld) {
+    const auto planes = clipPlanes(clipFromWorld);
+    const glm::vec4 w = glm::transpose(clipFromWorld)[3];  // view depth: w = row 3 · p
+    float nearest = std::numeric_limits<float>::infinity();
+    for (const TriangleCluster& cluster : clusters)
+        if (!cluster.bounds.empty() && !outsideClip(planes, cluster.bounds))
+            nearest = std::min(nearest, planeMin(w, cluster.bounds));
+    return nearest;
+}
+
 std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
                                                  const glm::mat4& clipFromWorld,
                                                  const ShadowEye& eye) {
-    // The clip volume's planes a·p ≥ 0 in world space (homogeneous p = (x, y, z, 1)), from
-    // the rows of the matrix: w ± x, w ± y, z (Vulkan's near plane) and w − z.
-    const glm::mat4 rows = glm::transpose(clipFromWorld);  // rows[i] = row i
-    const glm::vec4 planes[6] = {rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1],
-                                 rows[3] - rows[1], rows[2],           rows[3] - rows[2]};
+    const auto planes = clipPlanes(clipFromWorld);
     std::vector<TriangleRange> ranges;
     for (const TriangleCluster& cluster : clusters) {
-        if (cluster.bounds.empty()) continue;
-        bool outside = false;
-        for (const glm::vec4& plane : planes) {
-            // The box corner farthest along the plane's normal.
-            const glm::vec3 corner(plane.x >= 0.0f ? cluster.bounds.max.x : cluster.bounds.min.x,
-                                   plane.y >= 0.0f ? cluster.bounds.max.y : cluster.bounds.min.y,
-                                   plane.z >= 0.0f ? cluster.bounds.max.z : cluster.bounds.min.z);
-            if (glm::dot(glm::vec3(plane), corner) + plane.w < 0.0f) {
-                outside = true;
-                break;
-            }
-        }
-        if (outside) continue;
+        if (cluster.bounds.empty() || outsideClip(planes, cluster.bounds)) continue;
         const bool oneSided = !cluster.solidBounds.empty() && eye.outside(cluster.solidBounds);
         if (!ranges.empty() && ranges.back().oneSided == oneSided &&
             ranges.back().firstTriangle + ranges.back().triangleCount == cluster.firstTriangle)
@@ -172,43 +291,78 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     pass->mSize = size;
     pass->mBounds = scene.bounds;
 
-    // The casters: the scene's triangles, coplanar runs merged. Solids are wound
-    // counter-clockwise seen from outside (glTF's front faces), inverted ones reversed here,
-    // so that one cull mode keeps the faces that look at the light.
+    // The casters: the scene's triangles, coplanar runs merged (level 0), then coarser
+    // levels of detail for layers whose texels are wide. The coarsest error is the one an
+    // orthographic layer over the scene allows; finer ones a quarter of the previous each.
     const Scene merged = options.mergeCoplanar ? mergeShadowCasters(scene) : Scene{};
-    const Scene& casters = options.mergeCoplanar ? merged : scene;
-    pass->mCasterTriangles = uint32_t(casters.triangles.size());
-    const Solids solids = options.oneSidedSolids ? findSolids(casters) : Solids{};
-    // Triangles in cluster order, so that each cluster is one run of the index buffer, and
-    // each cluster's vertices (positions only: depth needs nothing else) stored together, so
-    // that a draw of a few clusters spans a short vertex range (lavapipe shades the whole
-    // range an indexed draw spans).
-    std::vector<uint32_t> order;
-    pass->mClusters = buildTriangleClusters(casters, kShadowClusterTriangles, order,
-                                            options.oneSidedSolids ? &solids : nullptr);
-    std::vector<float> positions;
-    std::vector<uint32_t> indices;
-    indices.reserve(scene.triangles.size() * 3);
-    std::vector<uint32_t> local(casters.vertices.size(), UINT32_MAX);
-    for (const TriangleCluster& cluster : pass->mClusters) {
-        const uint32_t firstVertex = uint32_t(positions.size() / 3);
-        for (uint32_t i = cluster.firstTriangle; i < cluster.firstTriangle + cluster.triangleCount; ++i) {
-            const uint32_t t = order[i];
-            uint32_t corners[3] = {casters.triangles[t].v[0], casters.triangles[t].v[1],
-                                   casters.triangles[t].v[2]};
-            if (!solids.solidOf.empty() && solids.solidOf[t] != Solids::kOpen) {
-                ++pass->mSolidTriangles;
-                if (solids.inverted[solids.solidOf[t]]) std::swap(corners[1], corners[2]);
-            }
-            for (uint32_t v : corners) {
-                if (local[v] == UINT32_MAX || local[v] < firstVertex) {
-                    local[v] = uint32_t(positions.size() / 3);
-                    const glm::vec3& p = casters.vertices[v].position;
-                    positions.insert(positions.end(), {p.x, p.y, p.z});
-                }
-                indices.push_back(local[v]);
+    const Scene& finest = options.mergeCoplanar ? merged : scene;
+    std::vector<std::pair<float, Scene>> levels;
+    // Level 0's own distance from the scene's surfaces (float rounding where coplanar
+    // triangles merged; more where meshoptimizer's estimate let a curved facet go).
+    const float finestError =
+        options.mergeCoplanar ? surfaceDeviation(scene, finest, 1e-3f * scene.bounds.diagonal()) : 0.0f;
+    levels.emplace_back(finestError, Scene{});
+    if (options.levelsOfDetail && std::isfinite(finestError)) {
+        const float coarsest = kCasterErrorPerTexel * scene.bounds.diagonal() / float(size);
+        size_t kept = finest.triangles.size();
+        for (float error : {coarsest / 64.0f, coarsest / 16.0f, coarsest / 4.0f, coarsest}) {
+            if (error <= finestError) continue;
+            // meshoptimizer's error is an estimate that can fall short of the true distance
+            // (2.4× on a cylinder in the tests): aim at half, measure, and aim lower while the
+            // measured distance exceeds what the level may have.
+            for (float target = 0.5f * error; target > 0.05f * error; target *= 0.5f) {
+                Scene level = simplifyShadowCasters(finest, target);
+                if (float(level.triangles.size()) > kCasterLevelReduction * float(kept)) break;
+                const float measured = finestError + surfaceDeviation(finest, level, error);
+                if (!(measured <= error)) continue;
+                kept = level.triangles.size();
+                levels.emplace_back(measured, std::move(level));
+                break;
             }
         }
+    }
+
+    // Each level's triangles in cluster order, so that each cluster is one run of the index
+    // buffer, and each cluster's vertices (positions only: depth needs nothing else) stored
+    // together, so that a draw of a few clusters spans a short vertex range (lavapipe shades
+    // the whole range an indexed draw spans). Solids are wound counter-clockwise seen from
+    // outside (glTF's front faces), inverted ones reversed here, so that one cull mode keeps
+    // the faces that look at the light.
+    std::vector<float> positions;
+    std::vector<uint32_t> indices;
+    for (const auto& [error, simplified] : levels) {
+        const Scene& casters = pass->mLevels.empty() ? finest : simplified;
+        const Solids solids = options.oneSidedSolids ? findSolids(casters) : Solids{};
+        std::vector<uint32_t> order;
+        std::vector<TriangleCluster> clusters = buildTriangleClusters(
+            casters, kShadowClusterTriangles, order, options.oneSidedSolids ? &solids : nullptr);
+        CasterLevel level{error, uint32_t(pass->mClusters.size()), uint32_t(clusters.size()),
+                          uint32_t(casters.triangles.size())};
+        std::vector<uint32_t> local(casters.vertices.size(), UINT32_MAX);
+        for (TriangleCluster& cluster : clusters) {
+            const uint32_t firstVertex = uint32_t(positions.size() / 3);
+            const uint32_t first = cluster.firstTriangle;
+            cluster.firstTriangle = uint32_t(indices.size() / 3);
+            for (uint32_t i = first; i < first + cluster.triangleCount; ++i) {
+                const uint32_t t = order[i];
+                uint32_t corners[3] = {casters.triangles[t].v[0], casters.triangles[t].v[1],
+                                       casters.triangles[t].v[2]};
+                if (!solids.solidOf.empty() && solids.solidOf[t] != Solids::kOpen) {
+                    if (pass->mLevels.empty()) ++pass->mSolidTriangles;
+                    if (solids.inverted[solids.solidOf[t]]) std::swap(corners[1], corners[2]);
+                }
+                for (uint32_t v : corners) {
+                    if (local[v] == UINT32_MAX || local[v] < firstVertex) {
+                        local[v] = uint32_t(positions.size() / 3);
+                        const glm::vec3& p = casters.vertices[v].position;
+                        positions.insert(positions.end(), {p.x, p.y, p.z});
+                    }
+                    indices.push_back(local[v]);
+                }
+            }
+            pass->mClusters.push_back(cluster);
+        }
+        pass->mLevels.push_back(level);
     }
     PIC_TRY_ASSIGN(pass->mVertices,
                    context.createBufferWith(std::span<const float>(positions),
@@ -252,6 +406,29 @@ ShadowMapPass::~ShadowMapPass() {
     if (mPipeline) vkDestroyPipeline(device, mPipeline, nullptr);
     if (mOneSidedPipeline) vkDestroyPipeline(device, mOneSidedPipeline, nullptr);
     if (mPipelineLayout) vkDestroyPipelineLayout(device, mPipelineLayout, nullptr);
+}
+
+uint32_t ShadowMapPass::levelFor(const LightSlot& slot, uint32_t layer) const {
+    // The allowed error where the layer's texels are finest: an orthographic layer's texels
+    // are one size; a perspective layer's grow with depth from the nearest caster it sees
+    // (level 0's clusters, whose bounds are exact).
+    const GpuLight& g = slot.gpu;
+    float texel = g.texelSlope;
+    if (g.shadowKind != kShadowOrthographic) {
+        const float nearest = nearestClusterDepth(clustersOf(0), mClipFromWorld[layer]);
+        texel *= std::max(nearest, g.depthNear);
+    }
+    const float allowed = kCasterErrorPerTexel * texel;
+    uint32_t level = 0;
+    for (uint32_t l = 1; l < mLevels.size(); ++l)  // level 0 is drawn wherever no other may
+        if (mLevels[l].error <= allowed) level = l;
+    return level;
+}
+
+std::vector<GpuLight> ShadowMapPass::lightRecords() const {
+    std::vector<GpuLight> records;
+    for (const LightSlot& slot : mCurrent) records.push_back(slot.gpu);
+    return records;
 }
 
 VkDeviceSize ShadowMapPass::bytes() const {
@@ -362,9 +539,9 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
     }
     mCurrent = std::move(next);
     mClipFromWorld = std::move(matrices);
+    mLayerLevels.resize(mClipFromWorld.size(), 0);
 
-    std::vector<GpuLight> records;
-    for (const LightSlot& slot : mCurrent) records.push_back(slot.gpu);
+    const std::vector<GpuLight> records = lightRecords();
     if (!records.empty()) {
         PIC_TRY(mContext.upload(mLights, records.data(), records.size() * sizeof(GpuLight)));
         PIC_TRY(mContext.upload(mMatrices, mClipFromWorld.data(),
@@ -422,7 +599,9 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
             rendering.layerCount = 1;
             rendering.pDepthAttachment = &depth;
             vkCmdBeginRendering(cmd, &rendering);
-            const auto ranges = visibleTriangleRanges(mClusters, mClipFromWorld[layer], slot.eye);
+            const uint32_t level = levelFor(slot, layer);
+            mLayerLevels[layer] = level;
+            const auto ranges = visibleTriangleRanges(clustersOf(level), mClipFromWorld[layer], slot.eye);
             for (const bool oneSided : {true, false}) {
                 bool bound = false;
                 for (const TriangleRange& range : ranges) {

@@ -41,7 +41,7 @@ struct TriangleCluster {
 
 /// Triangles per cluster: small enough that a cube face skips most of a room, large enough
 /// that one layer needs few draws.
-inline constexpr uint32_t kShadowClusterTriangles = 512;
+inline constexpr uint32_t kShadowClusterTriangles = 128;
 
 /// The faces the one-sided pipeline skips. Solids wind counter-clockwise seen from outside;
 /// the light-space matrices are right-handed with y up in clip space, which Vulkan's
@@ -57,6 +57,25 @@ inline constexpr float kCasterMergeError = 1e-6f;
 /// runs of coplanar triangles merged into fewer, larger ones by meshoptimizer's edge-collapse
 /// simplifier at kCasterMergeError, with open borders locked. The same surfaces.
 Scene mergeShadowCasters(const Scene& scene);
+
+/// `casters` (welded, as mergeShadowCasters returns them) simplified by edge collapses whose
+/// error stays within `error` metres, open borders locked: a coarser level of detail.
+Scene simplifyShadowCasters(const Scene& casters, float error);
+
+/// How far the surface of `fine` strays from that of `coarse`, metres: the largest distance
+/// from a sample of `fine` (its corners and centroids) to the nearest point of `coarse`,
+/// found with Embree's point queries; +∞ when a sample has nothing of `coarse` within `limit`.
+float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit);
+
+/// How far (in texels of the layer, at the caster's depth) a level of detail may move a
+/// caster's surface. surfel lighting's shadow test moves the receiver one texel along its
+/// normal and allows half a texel more, so a surface moved by half a texel neither shadows
+/// itself nor moves a shadow's edge by more than the map's own resolution does.
+inline constexpr float kCasterErrorPerTexel = 0.5f;
+
+/// Coarser levels of detail are kept only when they have at most this fraction of the
+/// triangles of the previous level (otherwise they would cost memory for nothing).
+inline constexpr float kCasterLevelReduction = 0.75f;
 
 /// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
 /// (median splits of their centroids); `order` receives the triangle indices in cluster order.
@@ -94,11 +113,27 @@ std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster
                                                  const glm::mat4& clipFromWorld,
                                                  const ShadowEye& eye = {});
 
-/// How the pass draws the scene. Both are on by default and store the same depths; off only
-/// to measure what they save and to test that claim.
+/// The nearest view depth (metres; w of clip space) of the clusters whose bounds can meet
+/// the clip volume of `clipFromWorld`, +∞ when none can.
+float nearestClusterDepth(std::span<const TriangleCluster> clusters, const glm::mat4& clipFromWorld);
+
+/// How the pass draws the scene. All are on by default; off only to measure what they save
+/// and to test what they change. The first two store the same depths; levels of detail move
+/// surfaces by at most kCasterErrorPerTexel texels of the layer that draws them.
 struct ShadowCasterOptions {
     bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
     bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
+    bool levelsOfDetail = true;  ///< layers whose texels are coarse draw simplified casters
+};
+
+/// One level of detail of the casters: its clusters, consecutive in the pass's cluster list.
+struct CasterLevel {
+    /// Metres the scene's surfaces moved, measured (surfaceDeviation; for level 0, the
+    /// merged casters, float rounding where only coplanar triangles merged).
+    float error = 0.0f;
+    uint32_t firstCluster = 0;
+    uint32_t clusterCount = 0;
+    uint32_t triangles = 0;
 };
 
 class ShadowMapPass {
@@ -124,9 +159,16 @@ public:
     uint64_t drawnTriangles() const { return mDrawnTriangles; }
     /// Of drawnTriangles(), those drawn with faces looking away from the light skipped.
     uint64_t oneSidedTriangles() const { return mOneSidedTriangles; }
-    /// Caster triangles (the scene's, coplanar ones merged) and those of them in solids.
-    uint32_t casterTriangles() const { return mCasterTriangles; }
+    /// Caster triangles (the scene's, coplanar ones merged) and those of them in solids, at
+    /// level of detail 0.
+    uint32_t casterTriangles() const { return mLevels.front().triangles; }
     uint32_t solidTriangles() const { return mSolidTriangles; }
+    /// The levels of detail, finest (level 0) first.
+    std::span<const CasterLevel> levels() const { return mLevels; }
+    /// The level each layer was last rendered with.
+    std::span<const uint32_t> layerLevels() const { return mLayerLevels; }
+    /// The GpuLight records of the lights prepare() laid out, in order.
+    std::vector<GpuLight> lightRecords() const;
     uint32_t size() const { return mSize; }
     const DepthArray& depth() const { return mDepth; }
     const Buffer& lightBuffer() const { return mLights; }     ///< GpuLight[kMaxLights]
@@ -154,11 +196,18 @@ private:
     void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer) const;
     LightSlot describe(const Light& light, uint32_t firstLayer,
                        std::vector<glm::mat4>& clipFromWorld) const;
+    /// The coarsest level whose error layer `layer` of `slot` allows everywhere it looks.
+    uint32_t levelFor(const LightSlot& slot, uint32_t layer) const;
+    std::span<const TriangleCluster> clustersOf(uint32_t level) const {
+        return std::span(mClusters).subspan(mLevels[level].firstCluster, mLevels[level].clusterCount);
+    }
 
     Context& mContext;
     uint32_t mSize = 0;
     Aabb mBounds;
-    std::vector<TriangleCluster> mClusters;
+    std::vector<TriangleCluster> mClusters;  ///< every level's, level by level
+    std::vector<CasterLevel> mLevels;
+    std::vector<uint32_t> mLayerLevels;
     Buffer mVertices;
     Buffer mIndices;
     Buffer mLights;
@@ -167,7 +216,6 @@ private:
     VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
     VkPipeline mPipeline = VK_NULL_HANDLE;         ///< both faces
     VkPipeline mOneSidedPipeline = VK_NULL_HANDLE;  ///< faces looking towards the light
-    uint32_t mCasterTriangles = 0;
     uint32_t mSolidTriangles = 0;
     std::vector<LightSlot> mCurrent;
     std::vector<glm::mat4> mClipFromWorld;  ///< per layer

@@ -193,6 +193,37 @@ TEST(GpuSurfelLighting, DirectFluxOfSpotMatchesRays) {
     expectDirectMatches(b, defaultLightSet(b.scene));
 }
 
+TEST(GpuSurfelLighting, SimplifiedCastersKeepTheDirectFlux) {
+    // The atrium's columns are finely tessellated: its sun's orthographic layer draws the
+    // coarsest level of detail (ShadowCasters.LevelsOfDetail*). That must not move shadows
+    // by more than the map's texels do: against the exact casters, direct flux changes on
+    // few surfels, and against the rays it is as good as the exact casters' within 0.2 % of
+    // the surfels.
+    const Baked& b = baked("atrium", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    const LightSet lights = defaultLightSet(b.scene);
+    std::vector<glm::vec3> rays(b.bake.surfels.size());
+    directSurfelFlux(b.scene, *b.rays, b.bake, lights, rays);
+    std::vector<glm::vec3> direct[2];
+    for (const bool levels : {false, true}) {
+        auto runtime = GpuRuntime::create(b.scene, *b.rays, b.bake, {},
+                                          {.casterLevelsOfDetail = levels});
+        ASSERT_TRUE(runtime) << runtime.error().message;
+        auto flux = (*runtime)->runDirect(lights);
+        ASSERT_TRUE(flux) << flux.error().message;
+        direct[levels] = std::move(*flux);
+    }
+    EXPECT_LE(fractionDiffering(direct[true], direct[false]), 0.005);
+    EXPECT_LE(fractionDiffering(direct[true], rays), fractionDiffering(direct[false], rays) + 0.002);
+    double exactSum = 0.0, simplifiedSum = 0.0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        exactSum += direct[false][i].g;
+        simplifiedSum += direct[true][i].g;
+    }
+    EXPECT_GT(exactSum, 0.0);
+    EXPECT_NEAR(simplifiedSum / exactSum, 1.0, 0.005);
+}
+
 TEST(GpuSurfelLighting, DirectFluxOfEveryLightTypeMatchesRays) {
     // Two floors, lit by a point light, a narrow spot (one perspective layer), a wide spot
     // (cube) and a directional light (orthographic) at once.

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -91,6 +93,132 @@ TEST(ShadowCasters, CoplanarTrianglesMergeAndCurvedOnesStay) {
     EXPECT_NEAR(totalArea(casters), totalArea(scene), 1e-5 * totalArea(scene));
     EXPECT_EQ(casters.bounds.min, scene.bounds.min);
     EXPECT_EQ(casters.bounds.max, scene.bounds.max);
+}
+
+/// Distance from p to triangle abc (closest point by region: vertices, edges, face).
+float pointTriangleDistance(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
+                            const glm::vec3& c) {
+    const glm::vec3 n = glm::cross(b - a, c - a);
+    const float area2 = glm::dot(n, n);
+    if (area2 > 0.0f) {
+        // Barycentric coordinates of p's projection onto the plane.
+        const glm::vec3 q = p - n * (glm::dot(p - a, n) / area2);
+        const float u = glm::dot(glm::cross(c - b, q - b), n) / area2;
+        const float v = glm::dot(glm::cross(a - c, q - c), n) / area2;
+        if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f) return glm::length(p - q);
+    }
+    auto segment = [&](const glm::vec3& s0, const glm::vec3& s1) {
+        const glm::vec3 d = s1 - s0;
+        const float len2 = glm::dot(d, d);
+        const float t = len2 > 0.0f ? glm::clamp(glm::dot(p - s0, d) / len2, 0.0f, 1.0f) : 0.0f;
+        return glm::length(p - (s0 + t * d));
+    };
+    return std::min({segment(a, b), segment(b, c), segment(c, a)});
+}
+
+/// Largest distance from a point of `fine` (its vertices, edge midpoints and centroids) to
+/// the surface of `coarse`.
+float deviation(const Scene& fine, const Scene& coarse) {
+    float worst = 0.0f;
+    for (const Triangle& t : fine.triangles) {
+        const glm::vec3 a = fine.vertices[t.v[0]].position, b = fine.vertices[t.v[1]].position,
+                        c = fine.vertices[t.v[2]].position;
+        for (const glm::vec3& p : {a, b, c, 0.5f * (a + b), 0.5f * (b + c), 0.5f * (c + a),
+                                   (a + b + c) / 3.0f}) {
+            float nearest = std::numeric_limits<float>::infinity();
+            for (const Triangle& u : coarse.triangles)
+                nearest = std::min(nearest, pointTriangleDistance(p, coarse.vertices[u.v[0]].position,
+                                                                  coarse.vertices[u.v[1]].position,
+                                                                  coarse.vertices[u.v[2]].position));
+            worst = std::max(worst, nearest);
+        }
+    }
+    return worst;
+}
+
+/// A closed surface of revolution about the y axis through the profile points (radius,
+/// height), `around` facets around, capped by fans where the radius is not 0.
+Scene revolution(const std::vector<glm::vec2>& profile, int around) {
+    Scene scene;
+    auto vertex = [&](const glm::vec3& p) {
+        Vertex v;
+        v.position = p;
+        scene.vertices.push_back(v);
+        scene.bounds.extend(p);
+        return uint32_t(scene.vertices.size() - 1);
+    };
+    auto point = [&](int k, size_t j) {
+        const float a = 2.0f * 3.14159265f * float(k % around) / float(around);
+        return glm::vec3(profile[j].x * std::cos(a), profile[j].y, profile[j].x * std::sin(a));
+    };
+    for (size_t j = 0; j + 1 < profile.size(); ++j)
+        for (int k = 0; k < around; ++k) {
+            const uint32_t a = vertex(point(k, j)), b = vertex(point(k + 1, j)),
+                           c = vertex(point(k + 1, j + 1)), d = vertex(point(k, j + 1));
+            scene.triangles.push_back(Triangle{{a, c, b}});
+            scene.triangles.push_back(Triangle{{a, d, c}});
+        }
+    for (size_t j : {size_t{0}, profile.size() - 1}) {
+        if (profile[j].x == 0.0f) continue;
+        const uint32_t centre = vertex({0.0f, profile[j].y, 0.0f});
+        for (int k = 0; k < around; ++k) {
+            const uint32_t a = vertex(point(k, j)), b = vertex(point(k + 1, j));
+            scene.triangles.push_back(j == 0 ? Triangle{{centre, a, b}} : Triangle{{centre, b, a}});
+        }
+    }
+    return scene;
+}
+
+TEST(ShadowCasters, SurfaceDeviationIsMeasuredNotEstimated) {
+    // A cylinder (r 0.5 m, 2 m high, 4 rings: coplanar strips) and a sphere (r 0.5 m), 32
+    // facets around: a facet's sagitta is r·(1 − cos(π/32)) = 2.4 mm.
+    std::vector<glm::vec2> cylinder, sphere;
+    for (int j = 0; j <= 4; ++j) cylinder.push_back({0.5f, 0.5f * float(j)});
+    for (int j = 0; j <= 16; ++j) {
+        const float polar = 3.14159265f * float(j) / 16.0f;
+        sphere.push_back({j == 0 || j == 16 ? 0.0f : 0.5f * std::sin(polar), -0.5f * std::cos(polar)});
+    }
+    for (const auto& profile : {cylinder, sphere}) {
+        const Scene scene = revolution(profile, 32);
+        const Scene merged = gpu::mergeShadowCasters(scene);
+        EXPECT_LE(merged.triangles.size(), scene.triangles.size());
+        EXPECT_NEAR(gpu::surfaceDeviation(scene, merged, 1.0f), deviation(scene, merged), 1e-5f);
+        size_t previous = merged.triangles.size();
+        for (float target : {0.004f, 0.02f, 0.1f}) {
+            const Scene level = gpu::simplifyShadowCasters(merged, target);
+            EXPECT_LT(level.triangles.size(), previous) << target;
+            EXPECT_GT(level.triangles.size(), 0u) << target;
+            // The measure (Embree point queries from corners and centroids) is what the
+            // brute force over every pair finds, edge midpoints included.
+            const float measured = gpu::surfaceDeviation(scene, level, 1.0f);
+            const float exhaustive = deviation(scene, level);
+            EXPECT_NEAR(measured, exhaustive, 0.05f * exhaustive + 1e-5f) << target;
+            // Nothing within the limit: +∞.
+            EXPECT_TRUE(std::isinf(gpu::surfaceDeviation(scene, level, 0.5f * measured)));
+            previous = level.triangles.size();
+        }
+    }
+}
+
+TEST(ShadowCulling, NearestClusterDepthIsTheClosestVisibleBoxCorner) {
+    // A light at the origin looking down −z (view depth = −z); boxes in front at 2 m and
+    // 5 m, one behind it and one outside the 90° frustum at 1 m.
+    const glm::mat4 clip = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, 0.01f, 20.0f) *
+                           glm::lookAtRH(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
+    auto cluster = [](const glm::vec3& lo, const glm::vec3& hi) {
+        gpu::TriangleCluster c;
+        c.bounds.extend(lo);
+        c.bounds.extend(hi);
+        return c;
+    };
+    std::vector<gpu::TriangleCluster> clusters = {
+        cluster({-1, -1, -6}, {1, 1, -5}), cluster({0.5f, 0, -3}, {1, 0.2f, -2}),
+        cluster({-1, -1, 1}, {1, 1, 3}), cluster({3, 0, -1.2f}, {4, 1, -1})};
+    EXPECT_NEAR(gpu::nearestClusterDepth(clusters, clip), 2.0f, 1e-4f);
+    clusters.erase(clusters.begin() + 1);
+    EXPECT_NEAR(gpu::nearestClusterDepth(clusters, clip), 5.0f, 1e-4f);
+    clusters.erase(clusters.begin());
+    EXPECT_TRUE(std::isinf(gpu::nearestClusterDepth(clusters, clip)));
 }
 
 TEST(ShadowCulling, ClustersPartitionTheTrianglesAndBoundThem) {

@@ -87,13 +87,15 @@ TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
         return layers;
     };
     uint64_t oneSided = 0;
-    const auto reference = render({false, false}, oneSided);
+    const auto reference =
+        render({.mergeCoplanar = false, .oneSidedSolids = false, .levelsOfDetail = false}, oneSided);
     EXPECT_EQ(oneSided, 0u);
 
     // Skipping the faces of solids that look away from the light changes no depth beyond
     // rounding (inverted solids are drawn with their corners in another order). Every scene
     // here has solids seen from outside by some light, so the one-sided path runs.
-    const auto solidsOneSided = render({false, true}, oneSided);
+    const auto solidsOneSided =
+        render({.mergeCoplanar = false, .oneSidedSolids = true, .levelsOfDetail = false}, oneSided);
     EXPECT_GT(oneSided, 0u);
     double fraction = 0.0;
     differingTexels(solidsOneSided, reference, 1e-6f, fraction);
@@ -102,11 +104,68 @@ TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
     // Merged coplanar triangles cover the same surfaces. Their longer edges round
     // differently, so texel centres that lie on an edge (within rounding) may change sides:
     // a few texels on silhouettes, nothing else.
-    const auto merged = render({true, true}, oneSided);
+    const auto merged =
+        render({.mergeCoplanar = true, .oneSidedSolids = true, .levelsOfDetail = false}, oneSided);
     differingTexels(merged, reference, 1e-4f, fraction);
     EXPECT_LE(fraction, 5e-3) << GetParam() << ": merged casters, differences > 1e-4";
     differingTexels(merged, reference, 1e-2f, fraction);
     EXPECT_LE(fraction, 5e-4) << GetParam() << ": merged casters, differences > 1e-2";
+    EXPECT_EQ((*context)->validationMessages(), 0u);
+}
+
+/// Metres along the layer's view axis of a stored depth (the pass's near and far planes).
+float metres(const gpu::GpuLight& light, float stored) {
+    const float n = light.depthNear, f = light.depthFar;
+    return light.shadowKind == gpu::kShadowOrthographic ? n + stored * (f - n)
+                                                   : n * f / (f - stored * (f - n));
+}
+
+TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
+    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + GetParam() + ".gltf");
+    ASSERT_TRUE(scene) << scene.error().message;
+    auto context = gpu::Context::create();
+    if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
+    constexpr uint32_t kSize = 256;
+    const LightSet lights = testLights(*scene);
+    auto exact = gpu::ShadowMapPass::create(**context, *scene, kSize, {.levelsOfDetail = false});
+    ASSERT_TRUE(exact) << exact.error().message;
+    auto coarse = gpu::ShadowMapPass::create(**context, *scene, kSize);
+    ASSERT_TRUE(coarse) << coarse.error().message;
+    const auto expected = renderLayers(**context, **exact, lights);
+    const auto actual = renderLayers(**context, **coarse, lights);
+    ASSERT_EQ(actual.size(), expected.size());
+    const auto levels = (*coarse)->levels();
+    for (size_t k = 1; k < levels.size(); ++k) {
+        EXPECT_GT(levels[k].error, levels[k - 1].error);
+        EXPECT_LE(levels[k].triangles, gpu::kCasterLevelReduction * levels[k - 1].triangles);
+    }
+    // Only the atrium has curved surfaces (columns) to simplify.
+    if (GetParam() == "atrium") EXPECT_GE(levels.size(), 2u);
+    for (const gpu::GpuLight& light : (*coarse)->lightRecords()) {
+        const uint32_t layers = light.shadowKind == gpu::kShadowCube ? 6 : 1;
+        for (uint32_t l = light.firstLayer; l < light.firstLayer + layers; ++l) {
+            const uint32_t level = (*coarse)->layerLevels()[l];
+            const float error = levels[level].error;
+            // Where a layer's texels are all one size, it takes the coarsest level.
+            if (light.shadowKind == gpu::kShadowOrthographic) EXPECT_EQ(level, levels.size() - 1);
+            EXPECT_LE(error, gpu::kCasterErrorPerTexel * light.texelSlope *
+                                 (light.shadowKind == gpu::kShadowOrthographic ? 1.0f : light.depthFar));
+            // Depths differ by more than the level's error only on silhouettes and grazing
+            // surfaces, where moving a surface sideways moves the depth along the ray more.
+            size_t beyond = 0, beyondFourfold = 0, drawn = 0;
+            for (size_t i = 0; i < expected[l].size(); ++i) {
+                if (expected[l][i] >= 1.0f && actual[l][i] >= 1.0f) continue;
+                ++drawn;
+                const float depth = metres(light, expected[l][i]);
+                const float dz = std::abs(metres(light, actual[l][i]) - depth);
+                if (dz > error + 1e-5f * depth) ++beyond;
+                if (dz > 4.0f * error + 1e-5f * depth) ++beyondFourfold;
+            }
+            const double share = drawn ? 1.0 / double(drawn) : 0.0;
+            EXPECT_LE(double(beyond) * share, 0.02) << GetParam() << " layer " << l;
+            EXPECT_LE(double(beyondFourfold) * share, 0.005) << GetParam() << " layer " << l;
+        }
+    }
     EXPECT_EQ((*context)->validationMessages(), 0u);
 }
 
