@@ -4,10 +4,11 @@
 /// kMaxPerspectiveSpot, one perspective layer for narrower spots and one orthographic layer
 /// over the scene for directional lights. A light whose position, direction, type and cone
 /// did not change since the previous set keeps its layers: only changed lights re-render.
-/// Two things keep the depths the same while lavapipe rasterises fewer triangles: coplanar
-/// triangles are merged into larger ones, and the closed surfaces of the scene
-/// (core/solids.h) that a light sees from outside are drawn without the faces that look away
-/// from it.
+/// Three things let lavapipe rasterise fewer triangles: coplanar triangles are merged into
+/// larger ones; the closed surfaces of the scene (core/solids.h) that a light sees from outside
+/// are drawn without the faces that look away from it; and layers whose texels are wide draw a
+/// simplified level of detail whose measured distance from the scene stays within half a
+/// texel (which the shadow test's offsets already absorb).
 
 #include <cstdint>
 #include <span>
