@@ -326,6 +326,15 @@ Result<void> Context::init(const ContextOptions& options) {
         return fail(ErrorCode::Unsupported,
                     "Vulkan device \"{}\" lacks storageBuffer16BitAccess or dynamicRendering",
                     mName);
+    // Subgroup sums in compute shaders (surfel lighting's per-workgroup flux).
+    VkPhysicalDeviceSubgroupProperties subgroups{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceProperties2 properties2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    properties2.pNext = &subgroups;
+    vkGetPhysicalDeviceProperties2(mPhysical, &properties2);
+    if (!(subgroups.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+        !(subgroups.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT))
+        return fail(ErrorCode::Unsupported,
+                    "Vulkan device \"{}\" lacks subgroup arithmetic in compute shaders", mName);
 
     // One queue that does graphics and compute and has timestamps.
     uint32_t familyCount = 0;

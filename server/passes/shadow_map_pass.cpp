@@ -568,26 +568,35 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
     mRenderedLights = 0;
     mDrawnTriangles = 0;
     mOneSidedTriangles = 0;
+    // The layers to render: every layer of each light that changed. One barrier before and one
+    // after all of them (layers are separate subresources, so no layer waits for another, and
+    // the rasteriser can bin one layer while it fills the previous).
+    std::vector<VkImageMemoryBarrier> toDepth;
+    for (const LightSlot& slot : mCurrent) {
+        if (!slot.dirty) continue;
+        // Earlier compute reads of these layers finish before they are rendered over.
+        VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+        barrier.srcAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        barrier.dstAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                                VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        barrier.oldLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        barrier.newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        barrier.image = mDepth.image();
+        barrier.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, slot.gpu.firstLayer, slot.layers};
+        toDepth.push_back(barrier);
+    }
+    if (toDepth.empty()) return;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                             VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                         0, 0, nullptr, 0, nullptr, uint32_t(toDepth.size()), toDepth.data());
+
     for (LightSlot& slot : mCurrent) {
         if (!slot.dirty) continue;
         ++mRenderedLights;
         for (uint32_t l = 0; l < slot.layers; ++l) {
             const uint32_t layer = slot.gpu.firstLayer + l;
-            // Earlier compute reads of this layer finish before it is rendered over.
-            VkImageMemoryBarrier toDepth{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-            toDepth.srcAccessMask = VK_ACCESS_SHADER_READ_BIT;
-            toDepth.dstAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                    VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-            toDepth.oldLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            toDepth.newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-            toDepth.srcQueueFamilyIndex = toDepth.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-            toDepth.image = mDepth.image();
-            toDepth.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                                 VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
-                                     VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-                                 0, 0, nullptr, 0, nullptr, 1, &toDepth);
-
             VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
             depth.imageView = mDepth.layerView(layer);
             depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
@@ -616,19 +625,21 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
                 }
             }
             vkCmdEndRendering(cmd);
-
-            // The depth writes finish before surfel lighting samples the layer.
-            VkImageMemoryBarrier toRead = toDepth;
-            toRead.srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-            toRead.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-            toRead.oldLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-            toRead.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1,
-                                 &toRead);
         }
         slot.dirty = false;
     }
+
+    // The depth writes finish before surfel lighting samples the layers.
+    std::vector<VkImageMemoryBarrier> toRead = toDepth;
+    for (VkImageMemoryBarrier& barrier : toRead) {
+        barrier.srcAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        barrier.oldLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        barrier.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    }
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr,
+                         uint32_t(toRead.size()), toRead.data());
 }
 
 }  // namespace pic::gpu

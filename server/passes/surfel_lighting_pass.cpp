@@ -30,9 +30,12 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(Context& 
     layout.bindings[kSamplerBinding] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     layout.bindings[kShTablesBinding] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     layout.pushBytes = sizeof(SurfelLightingPush);
-    layout.specialization = {bake.params.bandsY, bake.params.bandsC};
-    PIC_TRY_ASSIGN(pass->mKernel,
-                   Kernel::create(context, kSpirvSurfelLightingComp, layout, "surfel_lighting"));
+    layout.specialization = {bake.params.bandsY, bake.params.bandsC, kSurfelModeDirect};
+    PIC_TRY_ASSIGN(pass->mDirect, Kernel::create(context, kSpirvSurfelLightingComp, layout,
+                                                 "surfel_lighting (direct)"));
+    layout.specialization.back() = kSurfelModeBounce;
+    PIC_TRY_ASSIGN(pass->mBounce, Kernel::create(context, kSpirvSurfelLightingComp, layout,
+                                                 "surfel_lighting (bounce)"));
 
     // The bounce reads the caches at fixed points: each surfel's stencil is computed once.
     const size_t nS = bake.surfels.size();
@@ -91,8 +94,10 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         BindingResource::storage(11, *r.shTables),
         BindingResource::storage(12, mGroupFlux),
     };
-    PIC_TRY(mKernel.resetSets());
-    PIC_TRY_ASSIGN(mSet, mKernel.makeSet(resources));
+    PIC_TRY(mDirect.resetSets());
+    PIC_TRY(mBounce.resetSets());
+    PIC_TRY_ASSIGN(mDirectSet, mDirect.makeSet(resources));
+    PIC_TRY_ASSIGN(mBounceSet, mBounce.makeSet(resources));
     return {};
 }
 
@@ -106,15 +111,16 @@ Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
 void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
                                 uint32_t sumSlot) {
     PIC_CHECK(sumSlot < 2);
-    PIC_CHECK(mSet != VK_NULL_HANDLE);
+    PIC_CHECK(mDirectSet != VK_NULL_HANDLE && mBounceSet != VK_NULL_HANDLE);
     SurfelLightingPush push{};
     push.surfelCount = mSurfelCount;
     push.lightCount = lightCount;
-    push.mode = bounce ? kSurfelModeBounce : kSurfelModeDirect;
     push.epsilon = mEpsilon;
     push.shadowSize = mShadowSize;
     push.sumSlot = sumSlot;
-    mKernel.dispatch(cmd, mSet, &push, groupsFor(mSurfelCount, kSurfelLightingGroup));
+    const Kernel& kernel = bounce ? mBounce : mDirect;
+    kernel.dispatch(cmd, bounce ? mBounceSet : mDirectSet, &push,
+                    groupsFor(mSurfelCount, kSurfelLightingGroup));
 }
 
 Result<glm::dvec3> SurfelLightingPass::totalFlux(uint32_t sumSlot) {

@@ -51,8 +51,10 @@ private:
     SurfelLightingPass(Context& context, const Scene& scene) : mContext(context), mScene(scene) {}
     Context& mContext;
     const Scene& mScene;
-    Kernel mKernel;
-    VkDescriptorSet mSet = VK_NULL_HANDLE;
+    Kernel mDirect;  ///< the shader specialised to kSurfelModeDirect
+    Kernel mBounce;  ///< and to kSurfelModeBounce
+    VkDescriptorSet mDirectSet = VK_NULL_HANDLE;
+    VkDescriptorSet mBounceSet = VK_NULL_HANDLE;
     uint32_t mSurfelCount = 0;
     float mEpsilon = 0.0f;
     uint32_t mShadowSize = 0;

@@ -7,6 +7,7 @@
 PIC_NAMESPACE_BEGIN
 
 PIC_CONST(uint, kSurfelLightingGroup, 64u);
+// The pass's mode (specialization constant 2):
 PIC_CONST(uint, kSurfelModeDirect, 0u);  // directFlux = lights + emission; leaves = directFlux
 PIC_CONST(uint, kSurfelModeBounce, 1u);  // leaves = directFlux + ρ·A·E(previous caches)
 
@@ -22,10 +23,10 @@ PIC_STRUCT_CHECK(SurfelStencil, 64);
 struct SurfelLightingPush {
     uint surfelCount;  // nS
     uint lightCount;
-    uint mode;         // kSurfelModeDirect or kSurfelModeBounce
     float epsilon;     // metres: the CPU twin's ray offset along the normal
     uint shadowSize;   // texels per side of a shadow-map layer
     uint sumSlot;      // 0 or 1: which half of groupFlux takes this pass's workgroup sums
+    uint pad0;
     uint pad1;
     uint pad2;
 };
