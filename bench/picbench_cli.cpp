@@ -82,6 +82,12 @@ int picbenchMain(int argc, char** argv) {
     runtime->add_option("--device", runtimeParams.device, "Vulkan device name substring");
     runtime->add_option("--shadow-map-size", runtimeParams.shadowMapSize, "texels per shadow-map side (default 1024)")
         ->check(CLI::Range(16u, 16384u));
+    runtime->add_option_function<std::string>(
+               "--shadow-sides",
+               [&](const std::string& sides) { runtimeParams.shadowEqualFootprint = sides == "footprint"; },
+               "perspective shadow-map layers: footprint (as wide as gives the orthographic texel at "
+               "the median surface distance) or uniform (all --shadow-map-size; default footprint)")
+        ->check(CLI::IsMember({"footprint", "uniform"}));
     runtime->add_option("--changes", runtimeParams.changes,
                         "light changes: move-all, move-one, recolour (default: all three)")
         ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));
@@ -96,6 +102,9 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::IsMember({"moderate", "high"}));
     shadows->add_option("--sizes", shadowParams.sizes, "texels per shadow-map side (default: 256 512 1024 2048)")
         ->check(CLI::Range(16u, 16384u));
+    shadows->add_option("--sides", shadowParams.sides,
+                        "perspective layer sides: uniform, footprint (default: both)")
+        ->check(CLI::IsMember({"uniform", "footprint"}));
     shadows->add_option("--repeat", shadowParams.repeat, "timed light changes per size (default 5)")
         ->check(CLI::Range(1, 1000));
     shadows->add_option("--device", shadowParams.device, "Vulkan device name substring");

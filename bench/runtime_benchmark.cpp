@@ -44,6 +44,7 @@ struct BackendFigures {
     std::map<std::string, std::vector<double>> passMs;  ///< per update
     int bounces = 0;
     uint64_t shadowTriangles = 0;  ///< GPU: triangles rasterised per update, after culling
+    uint64_t shadowTexels = 0;     ///< GPU: texels of the layers rendered per update
 };
 
 Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step,
@@ -57,6 +58,7 @@ Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int r
         for (const auto& [pass, ms] : stats.passMs) figures.passMs[pass].push_back(ms);
         figures.bounces = stats.bounces;
         figures.shadowTriangles = stats.shadowTriangles;
+        figures.shadowTexels = stats.shadowTexels;
     }
     return figures;
 }
@@ -87,6 +89,7 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     json["update_ms"] = f.totalMs;
     json["bounces"] = f.bounces;
     json["shadow_triangles"] = f.shadowTriangles;
+    json["shadow_texels"] = f.shadowTexels;
     json["pass_ms_median"] = nlohmann::ordered_json::object();
     for (const auto& [pass, ms] : f.passMs) json["pass_ms_median"][pass] = median(ms);
     return json;
@@ -107,9 +110,9 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
     json["triangles"] = scene.triangles.size();
     json["memcpy_bytes_per_second"] = bandwidth;
     json["runs"] = nlohmann::ordered_json::array();
-    std::printf("%-9s %-4s %-7s %-8s %6s %9s %9s %6s %9s %8s %9s %9s %9s %8s\n", "setting", "link",
-                "bounces", "change", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris", "surfels",
-                "pull", "caches*", "bw ratio");
+    std::printf("%-9s %-4s %-7s %-8s %6s %9s %9s %6s %9s %8s %8s %9s %9s %9s %8s\n", "setting",
+                "link", "bounces", "change", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris",
+                "M texels", "surfels", "pull", "caches*", "bw ratio");
     for (const std::string& setting : params.settings) {
         for (const std::string& linkMode : params.linkModes) {
             BakeReport bakeReport;
@@ -123,6 +126,7 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                 GpuRuntimeOptions options;
                 options.deviceName = params.device;
                 options.shadowMapSize = params.shadowMapSize;
+                options.shadowEqualFootprint = params.shadowEqualFootprint;
                 auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
                 if (!gpu) return reportError(gpu.error());
                 // Link bytes per second of one GPU cache-lighting pass (wall clock): every
@@ -143,11 +147,12 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                         return it == f.passMs.end() ? 0.0 : median(it->second);
                     };
                     const double cpuMs = median(cpuFigures->totalMs), gpuMs = median(gpuFigures->totalMs);
-                    std::printf("%-9s %-4s %-7d %-8s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %9.1f %9.1f %9.1f %8.2f\n",
+                    std::printf("%-9s %-4s %-7d %-8s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %8.2f %9.1f %9.1f %9.1f %8.2f\n",
                                 setting.c_str(), linkMode.c_str(), gpuFigures->bounces, change.c_str(),
                                 bake->caches.size(), cpuMs, gpuMs, gpuMs / cpuMs,
                                 passMedian(*gpuFigures, "shadow_maps"),
                                 double(gpuFigures->shadowTriangles) * 1e-3,
+                                double(gpuFigures->shadowTexels) * 1e-6,
                                 passMedian(*gpuFigures, "surfel_lighting"),
                                 passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
 
@@ -162,6 +167,7 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                     run["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
                     run["device"] = (*gpu)->context().deviceName();
                     run["shadow_map_size"] = params.shadowMapSize;
+                    run["shadow_sides"] = params.shadowEqualFootprint ? "footprint" : "uniform";
                     run["cpu"] = figuresJson(*cpuFigures);
                     run["gpu"] = figuresJson(*gpuFigures);
                     run["gpu_over_cpu"] = gpuMs / cpuMs;
@@ -197,75 +203,93 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
     json["triangles"] = scene.triangles.size();
     json["setting"] = params.setting;
     json["surfels"] = nS;
-    json["sizes"] = nlohmann::ordered_json::array();
-    std::printf("%-6s %10s %10s %10s %12s %12s\n", "size", "gpu ms", "cpu ms", "gpu/cpu",
-                "rel L1", "surfels >1%");
-    ChartSeries tradeoff{"relative L1 of direct surfel flux (%)", {0.12f, 0.35f, 0.75f}};
-    ChartSeries differingSeries{"surfels differing by > 1 % (%)", {0.85f, 0.45f, 0.1f}};
-    for (uint32_t size : params.sizes) {
-        GpuRuntimeOptions options;
-        options.deviceName = params.device;
-        options.shadowMapSize = size;
-        auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options);
-        if (!gpu) return reportError(gpu.error());
-        std::vector<double> gpuMs, cpuMs;
-        double l1 = 0.0, norm = 0.0;
-        size_t differing = 0, compared = 0;
-        for (int k = 0; k <= params.repeat; ++k) {  // k = 0 warms up
-            // Every light moves, so every shadow map is rendered in each timed call.
-            const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
-            Clock::time_point start = Clock::now();
-            auto direct = (*gpu)->runDirect(lights);
-            if (!direct) return reportError(direct.error());
-            const double g = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-            std::vector<glm::vec3> rays(nS);
-            start = Clock::now();
-            directSurfelFlux(scene, *inputs->rays, *bake, lights, rays);
-            const double c = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-            if (k == 0) continue;
-            gpuMs.push_back(g);
-            cpuMs.push_back(c);
-            float brightest = 0.0f;
-            for (const glm::vec3& f : rays) brightest = std::max({brightest, f.r, f.g, f.b});
-            for (size_t i = 0; i < nS; ++i) {
-                bool differs = false;
-                for (int ch = 0; ch < 3; ++ch) {
-                    const double d = std::abs(double((*direct)[i][ch]) - double(rays[i][ch]));
-                    l1 += d;
-                    norm += std::abs(double(rays[i][ch]));
-                    differs |= d > 0.01 * std::max(std::abs(rays[i][ch]), std::abs((*direct)[i][ch])) &&
-                               d > 1e-6 * brightest;
+    json["runs"] = nlohmann::ordered_json::array();
+    std::printf("%-6s %-9s %9s %10s %10s %10s %12s %12s\n", "size", "sides", "M texels", "gpu ms",
+                "cpu ms", "gpu/cpu", "rel L1", "surfels >1%");
+    std::vector<ChartSeries> series;
+    for (const std::string& sides : params.sides) {
+        const bool footprint = sides == "footprint";
+        ChartSeries tradeoff{fmt::format("relative L1, {} sides", sides),
+                             footprint ? glm::vec3(0.85f, 0.35f, 0.1f) : glm::vec3(0.12f, 0.35f, 0.75f)};
+        ChartSeries differingSeries{fmt::format("surfels > 1 % off, {} sides", sides),
+                                    footprint ? glm::vec3(0.9f, 0.65f, 0.2f) : glm::vec3(0.35f, 0.6f, 0.9f),
+                                    {}, {}, true};
+        for (uint32_t size : params.sizes) {
+            GpuRuntimeOptions options;
+            options.deviceName = params.device;
+            options.shadowMapSize = size;
+            options.shadowEqualFootprint = footprint;
+            auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options);
+            if (!gpu) return reportError(gpu.error());
+            std::vector<double> gpuMs, cpuMs;
+            double l1 = 0.0, norm = 0.0;
+            size_t differing = 0, compared = 0;
+            uint64_t texels = 0;
+            for (int k = 0; k <= params.repeat; ++k) {  // k = 0 warms up
+                // Every light moves, so every shadow map is rendered in each timed call.
+                const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
+                UpdateStats stats;
+                Clock::time_point start = Clock::now();
+                auto direct = (*gpu)->runDirect(lights, &stats);
+                if (!direct) return reportError(direct.error());
+                const double g = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+                texels = stats.shadowTexels;
+                std::vector<glm::vec3> rays(nS);
+                start = Clock::now();
+                directSurfelFlux(scene, *inputs->rays, *bake, lights, rays);
+                const double c = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+                if (k == 0) continue;
+                gpuMs.push_back(g);
+                cpuMs.push_back(c);
+                float brightest = 0.0f;
+                for (const glm::vec3& f : rays) brightest = std::max({brightest, f.r, f.g, f.b});
+                for (size_t i = 0; i < nS; ++i) {
+                    bool differs = false;
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const double d = std::abs(double((*direct)[i][ch]) - double(rays[i][ch]));
+                        l1 += d;
+                        norm += std::abs(double(rays[i][ch]));
+                        differs |= d > 0.01 * std::max(std::abs(rays[i][ch]), std::abs((*direct)[i][ch])) &&
+                                   d > 1e-6 * brightest;
+                    }
+                    differing += differs;
                 }
-                differing += differs;
+                compared += nS;
             }
-            compared += nS;
+            const double relL1 = norm > 0.0 ? l1 / norm : 0.0;
+            const double fraction = compared ? double(differing) / double(compared) : 0.0;
+            std::printf("%-6u %-9s %9.2f %10.1f %10.1f %10.2f %11.2f%% %11.2f%%\n", size, sides.c_str(),
+                        double(texels) * 1e-6, median(gpuMs), median(cpuMs),
+                        median(gpuMs) / median(cpuMs), 100.0 * relL1, 100.0 * fraction);
+            nlohmann::ordered_json row;
+            row["size"] = size;
+            row["sides"] = sides;
+            row["texels"] = texels;
+            row["device"] = (*gpu)->context().deviceName();
+            row["gpu_direct_ms_median"] = median(gpuMs);
+            row["cpu_direct_ms_median"] = median(cpuMs);
+            row["gpu_direct_ms"] = gpuMs;
+            row["relative_l1"] = relL1;
+            row["fraction_surfels_differing"] = fraction;
+            json["runs"].push_back(row);
+            tradeoff.points.push_back({median(gpuMs), 100.0 * relL1});
+            tradeoff.labels.push_back(fmt::format("{0}x{0}", size));
+            differingSeries.points.push_back({median(gpuMs), 100.0 * fraction});
         }
-        const double relL1 = norm > 0.0 ? l1 / norm : 0.0;
-        const double fraction = compared ? double(differing) / double(compared) : 0.0;
-        std::printf("%-6u %10.1f %10.1f %10.2f %11.2f%% %11.2f%%\n", size, median(gpuMs),
-                    median(cpuMs), median(gpuMs) / median(cpuMs), 100.0 * relL1, 100.0 * fraction);
-        nlohmann::ordered_json row;
-        row["size"] = size;
-        row["device"] = (*gpu)->context().deviceName();
-        row["gpu_direct_ms_median"] = median(gpuMs);
-        row["cpu_direct_ms_median"] = median(cpuMs);
-        row["gpu_direct_ms"] = gpuMs;
-        row["relative_l1"] = relL1;
-        row["fraction_surfels_differing"] = fraction;
-        json["sizes"].push_back(row);
-        tradeoff.points.push_back({median(gpuMs), 100.0 * relL1});
-        tradeoff.labels.push_back(fmt::format("{0}x{0}", size));
-        differingSeries.points.push_back({median(gpuMs), 100.0 * fraction});
+        series.push_back(tradeoff);
+        series.push_back(differingSeries);
     }
     std::printf("gpu: shadow maps of every light + direct surfel lighting (wall clock, read-back\n"
-                "included); cpu: the twin's rays; errors: GPU direct surfel flux against the rays\n");
+                "included); cpu: the twin's rays; errors: GPU direct surfel flux against the rays;\n"
+                "sides: uniform, every layer size²; footprint, perspective layers only as wide as\n"
+                "give an orthographic layer's texel at the median distance of the lit surfaces\n");
     Chart chart;
     chart.title = fmt::format("Shadow-map size: time against error ({} rtp, {})", params.setting,
-                              json["sizes"].empty() ? std::string("no device")
-                                                    : json["sizes"][0]["device"].get<std::string>());
+                              json["runs"].empty() ? std::string("no device")
+                                                   : json["runs"][0]["device"].get<std::string>());
     chart.xLabel = "GPU shadow maps + direct surfel lighting, ms (median)";
-    chart.yLabel = "% against the CPU twin's rays";
-    chart.series = {tradeoff, differingSeries};
+    chart.yLabel = "% of the direct surfel flux against the CPU twin's rays";
+    chart.series = std::move(series);
     if (int exit = writeChartFile(chart, chartPathFor(params.jsonPath)); exit != 0) return exit;
     return writeJson(json, params.jsonPath);
 }

@@ -29,6 +29,7 @@ struct RuntimeBenchmarkParams {
     int repeat = 5;
     std::string device;                            ///< Vulkan device name substring
     uint32_t shadowMapSize = 1024;
+    bool shadowEqualFootprint = true;              ///< GpuRuntimeOptions::shadowEqualFootprint
     std::string jsonPath = "runtime_benchmark.json";
 };
 
@@ -40,6 +41,7 @@ struct ShadowBenchmarkParams {
     std::string lightsPath;                        ///< empty: the scene's lights
     std::string setting = "moderate";
     std::vector<uint32_t> sizes{256, 512, 1024, 2048};
+    std::vector<std::string> sides{"uniform", "footprint"};  ///< GpuRuntimeOptions::shadowEqualFootprint
     int repeat = 5;
     std::string device;
     std::string jsonPath = "shadow_benchmark.json";

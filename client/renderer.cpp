@@ -247,7 +247,6 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     push.lightmapWidth = mLayout.lightmapWidth;
     push.lightmapHeight = mLayout.lightmapHeight;
     push.epsilon = mEpsilon;
-    push.shadowSize = mShadows->size();
     // The CPU twin adds the lobe only when both its exponent and weight are positive.
     const bool glossy = params.glossyExponent > 0.0f && params.glossyWeight > 0.0f;
     push.glossyWeight = glossy ? params.glossyWeight : 0.0f;

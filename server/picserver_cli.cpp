@@ -85,6 +85,13 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--shadow-map-size", serve.shadowMapSize,
                    "gpu backend: texels per side of each shadow-map layer")
         ->check(CLI::Range(16u, 8192u));
+    app.add_option_function<std::string>(
+           "--shadow-sides",
+           [&](const std::string& sides) { serve.shadowEqualFootprint = sides == "footprint"; },
+           "gpu backend: footprint (default; point and spot layers only as wide as gives the "
+           "directional layer's texel at the median distance of the surfaces they light) or "
+           "uniform (every layer --shadow-map-size wide)")
+        ->check(CLI::IsMember({"footprint", "uniform"}));
     app.add_option("--bounces", serve.bounces.bounces,
                    "cache passes per update: 0 = direct light only, B = up to B reflections "
                    "(default: until a bounce adds < 0.5 % of the flux, at most 8)")

@@ -30,6 +30,7 @@ struct UpdateStats {
     double surfelFlux = 0.0;                  ///< W, luminance of the last bounce's surfel flux
     int shadowMapsRendered = 0;               ///< lights whose shadow maps were re-rendered (GPU)
     uint64_t shadowTriangles = 0;             ///< triangles rasterised into them, after culling (GPU)
+    uint64_t shadowTexels = 0;                ///< texels of the layers rendered (GPU)
 };
 
 /// A runtime backend over one bake of one scene.

@@ -61,6 +61,7 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
         GpuRuntimeOptions gpuOptions;
         gpuOptions.deviceName = options.device;
         gpuOptions.shadowMapSize = options.shadowMapSize;
+        gpuOptions.shadowEqualFootprint = options.shadowEqualFootprint;
         PIC_TRY_ASSIGN(auto gpu, GpuRuntime::create(served->mScene, *served->mRays, served->mBake,
                                                     options.bounces, gpuOptions));
         served->mDevice = gpu->context().deviceName();

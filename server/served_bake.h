@@ -23,6 +23,7 @@ struct ServeOptions {
     std::string backend = "gpu";    ///< "gpu" or "cpu" (the CPU twin)
     std::string device;             ///< gpu: substring of the Vulkan device name; empty = best
     uint32_t shadowMapSize = 1024;  ///< gpu: texels per side of each shadow-map layer
+    bool shadowEqualFootprint = true;  ///< gpu: GpuRuntimeOptions::shadowEqualFootprint
     BounceParams bounces;           ///< progressive by default, as everywhere
 };
 

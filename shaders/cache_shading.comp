@@ -160,7 +160,7 @@ void main() {
             const vec3 e = lightIrradiance(light, position, normal, toLight, distance);
             // Points facing away, outside the cone or past the range need no shadow test.
             if (!(e.r > 0.0 || e.g > 0.0 || e.b > 0.0)) continue;
-            if (shadowVisible(light, position, normal, dot(normal, toLight), pc.epsilon, pc.shadowSize))
+            if (shadowVisible(light, position, normal, dot(normal, toLight), pc.epsilon))
                 irradiance += e;
         }
         result += albedo * (1.0 / kPi) * irradiance;

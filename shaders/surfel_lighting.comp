@@ -61,7 +61,7 @@ void main() {
                 // Surfels facing away, outside the cone or past the range need no shadow test.
                 if (!(e.r > 0.0 || e.g > 0.0 || e.b > 0.0)) continue;
                 if (shadowVisible(light, surfel.position, surfel.normal, dot(surfel.normal, toLight),
-                                  pc.epsilon, pc.shadowSize))
+                                  pc.epsilon))
                     irradiance += e;
             }
             flux = surfel.albedo * (surfel.area * irradiance) +

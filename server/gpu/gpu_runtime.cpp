@@ -60,7 +60,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY_ASSIGN(mTimer, ctx.createPassTimer(kTimedPasses));
 
     PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(ctx, mScene, options.shadowMapSize,
-                                                   {.levelsOfDetail = options.casterLevelsOfDetail}));
+                                                   {.levelsOfDetail = options.casterLevelsOfDetail,
+                                                    .equalFootprint = options.shadowEqualFootprint}));
     PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon()));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake));
@@ -145,6 +146,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     }, stats));
     stats.shadowMapsRendered = int(mShadows->renderedLights());
     stats.shadowTriangles = mShadows->drawnTriangles();
+    stats.shadowTexels = mShadows->renderedTexels();
     PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
     double total = luminance(glm::vec3(sum));
     stats.bounces = 1;
@@ -240,6 +242,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, Upd
     }, stats));
     stats.shadowMapsRendered = int(mShadows->renderedLights());
     stats.shadowTriangles = mShadows->drawnTriangles();
+    stats.shadowTexels = mShadows->renderedTexels();
     return downloadFlux(mSurfels->directFlux(), mBake.surfels.size());
 }
 

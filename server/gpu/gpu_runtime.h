@@ -23,9 +23,13 @@ struct GpuRuntimeOptions {
     std::string deviceName;        ///< --device: substring of the Vulkan device name; empty = best
     bool validation = false;       ///< Vulkan validation layer when installed (PIC_VK_VALIDATION overrides)
     uint32_t shadowMapSize = 1024; ///< texels per side of each shadow-map layer
-    /// Layers with coarse texels draw simplified casters (gpu::ShadowCasterOptions); off only
+    /// Layers with coarse texels draw simplified casters (gpu::ShadowMapOptions); off only
     /// to measure what that changes.
     bool casterLevelsOfDetail = true;
+    /// Perspective layers as wide as give the orthographic texel at the median distance of
+    /// the surfaces a light reaches (gpu::ShadowMapOptions::equalFootprint): the surfels are
+    /// spread over those surfaces by area. Off: every layer shadowMapSize wide.
+    bool shadowEqualFootprint = true;
 };
 
 namespace gpu {

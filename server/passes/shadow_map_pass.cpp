@@ -12,6 +12,7 @@
 #include <meshoptimizer.h>
 
 #include "core/parallel.h"
+#include "core/sampling.h"
 
 #include "spirv/shadow_map_vert.h"
 
@@ -23,6 +24,33 @@ uint32_t layersOf(const Light& light) {
     if (light.type == LightType::Point) return 6;
     if (light.type == LightType::Spot && light.outerConeAngle > kMaxPerspectiveSpot) return 6;
     return 1;
+}
+
+/// `count` points spread over the scene's surfaces by area: stratified along the triangles'
+/// cumulative area, at Halton barycentrics within each triangle.
+std::vector<glm::vec3> surfaceSamples(const Scene& scene, uint32_t count) {
+    std::vector<double> cumulative(scene.triangles.size());
+    double total = 0.0;
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+        total += double(scene.triangleArea(t));
+        cumulative[t] = total;
+    }
+    std::vector<glm::vec3> samples;
+    if (!(total > 0.0)) return samples;
+    samples.reserve(count);
+    for (uint32_t k = 0; k < count; ++k) {
+        const double at = (double(k) + 0.5) / double(count) * total;
+        const size_t t = std::min<size_t>(
+            size_t(std::lower_bound(cumulative.begin(), cumulative.end(), at) - cumulative.begin()),
+            cumulative.size() - 1);
+        const Triangle& tri = scene.triangles[t];
+        const float r1 = std::sqrt(float(radicalInverse(2, k)));
+        const float r2 = float(radicalInverse(3, k));
+        samples.push_back((1.0f - r1) * scene.vertices[tri.v[0]].position +
+                          r1 * (1.0f - r2) * scene.vertices[tri.v[1]].position +
+                          r1 * r2 * scene.vertices[tri.v[2]].position);
+    }
+    return samples;
 }
 
 /// An up vector not parallel to `forward`.
@@ -279,9 +307,18 @@ std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster
     return ranges;
 }
 
+uint32_t footprintSide(float slopeAtOneTexel, float distance, float footprint, uint32_t maxSide) {
+    const uint32_t top = std::max(maxSide, kMinShadowSide);
+    const float texels = slopeAtOneTexel * distance / footprint;
+    if (!(texels < float(top))) return top;  // also NaN
+    if (!(texels > float(kMinShadowSide))) return kMinShadowSide;
+    const uint32_t side = (uint32_t(std::ceil(texels)) + kMinShadowSide - 1) / kMinShadowSide * kMinShadowSide;
+    return std::min(side, top);
+}
+
 Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
                                                              uint32_t size,
-                                                             const ShadowCasterOptions& options) {
+                                                             const ShadowMapOptions& options) {
     if (size < 16 || size > 16384)
         return fail(ErrorCode::InvalidInput, "shadow-map size must be in [16, 16384], got {}", size);
     if (scene.triangles.empty() || scene.bounds.empty())
@@ -290,6 +327,7 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     std::unique_ptr<ShadowMapPass> pass(new ShadowMapPass(context));
     pass->mSize = size;
     pass->mBounds = scene.bounds;
+    if (options.equalFootprint) pass->mSurfaceSamples = surfaceSamples(scene, kFootprintSamples);
 
     // The casters: the scene's triangles, coplanar runs merged (level 0), then coarser
     // levels of detail for layers whose texels are wide. The coarsest error is the one an
@@ -459,10 +497,11 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     g.firstLayer = firstLayer;
 
     const float diagonal = std::max(mBounds.diagonal(), 1e-3f);
+    g.side = mSize;
     if (light.type == LightType::Directional) {
         // An orthographic box around the scene's bounding sphere, looking along the light.
         const glm::vec3 centre = mBounds.center();
-        const float radius = 0.5f * diagonal * 1.01f;
+        const float radius = 0.5f * diagonal * 1.01f;  // perspectiveSide's footprint assumes it
         const glm::vec3 eye = centre - light.direction * (radius * 1.01f);
         const glm::mat4 view = glm::lookAtRH(eye, centre, upFor(light.direction));
         g.shadowKind = kShadowOrthographic;
@@ -491,7 +530,9 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
         // A spot's cone plus a margin of one degree.
         const float fov = 2.0f * light.outerConeAngle + 0.035f;
         g.shadowKind = kShadowPerspective;
-        g.texelSlope = 2.0f * std::tan(0.5f * fov) / float(mSize);
+        const float slope = 2.0f * std::tan(0.5f * fov);
+        g.side = perspectiveSide(light, slope);
+        g.texelSlope = slope / float(g.side);
         const glm::mat4 view = glm::lookAtRH(light.position, light.position + light.direction,
                                              upFor(light.direction));
         clipFromWorld.push_back(glm::perspectiveRH_ZO(fov, 1.0f, g.depthNear, g.depthFar) * view);
@@ -500,13 +541,38 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     // Cube faces +x, −x, +y, −y, +z, −z: 90° frusta whose union is every direction; the
     // surfel-lighting pass picks the face by the major axis of (p − light).
     g.shadowKind = kShadowCube;
-    g.texelSlope = 2.0f / float(mSize);
+    g.side = perspectiveSide(light, 2.0f);
+    g.texelSlope = 2.0f / float(g.side);
     const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     const glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, g.depthNear, g.depthFar);
     for (const glm::vec3& axis : axes)
         clipFromWorld.push_back(projection *
                                 glm::lookAtRH(light.position, light.position + axis, upFor(axis)));
     return slot;
+}
+
+uint32_t ShadowMapPass::perspectiveSide(const Light& light, float slopeAtOneTexel) const {
+    if (mSurfaceSamples.empty()) return mSize;
+    // The samples the light can reach (occlusion aside): within its range and, for spots,
+    // its outer cone.
+    const float cosOuter = std::cos(light.outerConeAngle);
+    std::vector<float> distances;
+    distances.reserve(mSurfaceSamples.size());
+    for (const glm::vec3& p : mSurfaceSamples) {
+        const glm::vec3 offset = p - light.position;
+        const float distance = glm::length(offset);
+        if (!(distance > 0.0f)) continue;
+        if (std::isfinite(light.range) && light.range > 0.0f && distance >= light.range) continue;
+        if (light.type == LightType::Spot && glm::dot(offset, light.direction) < cosOuter * distance)
+            continue;
+        distances.push_back(distance);
+    }
+    if (distances.empty()) return kMinShadowSide;  // the map is never sampled where lit
+    const auto median = distances.begin() + distances.size() / 2;
+    std::nth_element(distances.begin(), median, distances.end());
+    // An orthographic layer's texel: its box spans the scene's bounding sphere (describe).
+    const float orthographicTexel = 1.01f * std::max(mBounds.diagonal(), 1e-3f) / float(mSize);
+    return footprintSide(slopeAtOneTexel, *median, orthographicTexel, mSize);
 }
 
 Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
@@ -534,6 +600,7 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
         const LightSlot& old = mCurrent[i];
         slot.dirty = !(old.id == slot.id && old.type == slot.type &&
                        old.gpu.firstLayer == slot.gpu.firstLayer && old.layers == slot.layers &&
+                       old.gpu.side == slot.gpu.side &&
                        old.position == slot.position && old.direction == slot.direction &&
                        old.outerConeAngle == slot.outerConeAngle && !old.dirty);
     }
@@ -550,10 +617,11 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
     return {};
 }
 
-void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer) const {
+void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer,
+                                 uint32_t side) const {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-    const VkViewport viewport{0.0f, 0.0f, float(mSize), float(mSize), 0.0f, 1.0f};
-    const VkRect2D scissor{{0, 0}, {mSize, mSize}};
+    const VkViewport viewport{0.0f, 0.0f, float(side), float(side), 0.0f, 1.0f};
+    const VkRect2D scissor{{0, 0}, {side, side}};
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
     const ShadowMapPush push{mClipFromWorld[layer]};
@@ -567,6 +635,7 @@ void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint3
 void ShadowMapPass::record(VkCommandBuffer cmd) {
     mRenderedLights = 0;
     mDrawnTriangles = 0;
+    mRenderedTexels = 0;
     mOneSidedTriangles = 0;
     // The layers to render: every layer of each light that changed. One barrier before and one
     // after all of them (layers are separate subresources, so no layer waits for another, and
@@ -604,10 +673,11 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
             depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
             depth.clearValue.depthStencil = {1.0f, 0};
             VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-            rendering.renderArea = {{0, 0}, {mSize, mSize}};
+            rendering.renderArea = {{0, 0}, {slot.gpu.side, slot.gpu.side}};
             rendering.layerCount = 1;
             rendering.pDepthAttachment = &depth;
             vkCmdBeginRendering(cmd, &rendering);
+            mRenderedTexels += uint64_t(slot.gpu.side) * slot.gpu.side;
             const uint32_t level = levelFor(slot, layer);
             mLayerLevels[layer] = level;
             const auto ranges = visibleTriangleRanges(clustersOf(level), mClipFromWorld[layer], slot.eye);
@@ -616,7 +686,7 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
                 for (const TriangleRange& range : ranges) {
                     if (range.oneSided != oneSided) continue;
                     if (!bound) {
-                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer);
+                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer, slot.gpu.side);
                         bound = true;
                     }
                     vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);

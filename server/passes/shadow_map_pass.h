@@ -9,6 +9,8 @@
 /// are drawn without the faces that look away from it; and layers whose texels are wide draw a
 /// simplified level of detail whose measured distance from the scene stays within half a
 /// texel (which the shadow test's offsets already absorb).
+/// Perspective layers may also be smaller than the image's layers (ShadowMapOptions::
+/// equalFootprint): each light then renders and samples the top-left side × side texels.
 
 #include <cstdint>
 #include <span>
@@ -78,6 +80,12 @@ inline constexpr float kCasterErrorPerTexel = 0.5f;
 /// triangles of the previous level (otherwise they would cost memory for nothing).
 inline constexpr float kCasterLevelReduction = 0.75f;
 
+/// Area-weighted points on the scene's surfaces from which a perspective light's typical
+/// receiver distance is taken (ShadowMapOptions::equalFootprint).
+inline constexpr uint32_t kFootprintSamples = 4096;
+/// Smallest side of a layer, and the step sides are rounded up to (texels).
+inline constexpr uint32_t kMinShadowSide = 16;
+
 /// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
 /// (median splits of their centroids); `order` receives the triangle indices in cluster order.
 /// With `solids`, the triangles of solids come first and share no cluster with open ones.
@@ -118,14 +126,25 @@ std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster
 /// the clip volume of `clipFromWorld`, +∞ when none can.
 float nearestClusterDepth(std::span<const TriangleCluster> clusters, const glm::mat4& clipFromWorld);
 
-/// How the pass draws the scene. All are on by default; off only to measure what they save
-/// and to test what they change. The first two store the same depths; levels of detail move
-/// surfaces by at most kCasterErrorPerTexel texels of the layer that draws them.
-struct ShadowCasterOptions {
+/// How the pass draws the scene. The caster options are on by default; off only to measure
+/// what they save and to test what they change. The first two store the same depths; levels
+/// of detail move surfaces by at most kCasterErrorPerTexel texels of the layer that draws them.
+struct ShadowMapOptions {
     bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
     bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
     bool levelsOfDetail = true;  ///< layers whose texels are coarse draw simplified casters
+    /// Every layer `size` texels wide (false), or perspective layers only as wide as needed
+    /// for texels, at the median distance of the scene's surfaces from the light (within its
+    /// range and cone), as wide as an orthographic layer's over the scene (at most `size`).
+    /// Off for pixels (a camera may look at the nearest surfaces); on for surfels, which are
+    /// spread over the surfaces by area.
+    bool equalFootprint = false;
 };
+
+/// The side (texels) of a perspective layer whose texels are `footprint` metres wide at
+/// `distance` metres, for a layer `slopeAtOneTexel` wide per metre of depth (2·tan(fov/2)):
+/// rounded up to a multiple of kMinShadowSide, within [kMinShadowSide, maxSide].
+uint32_t footprintSide(float slopeAtOneTexel, float distance, float footprint, uint32_t maxSide);
 
 /// One level of detail of the casters: its clusters, consecutive in the pass's cluster list.
 struct CasterLevel {
@@ -143,7 +162,7 @@ public:
     /// one layer in texels.
     static Result<std::unique_ptr<ShadowMapPass>> create(Context& context, const Scene& scene,
                                                          uint32_t size,
-                                                         const ShadowCasterOptions& options = {});
+                                                         const ShadowMapOptions& options = {});
     ~ShadowMapPass();
 
     /// Lays out `lights` on layers, writes their GpuLight records and matrices and marks the
@@ -158,6 +177,8 @@ public:
     uint32_t renderedLights() const { return mRenderedLights; }
     /// Triangles drawn by the last record(), over all layers (after frustum culling).
     uint64_t drawnTriangles() const { return mDrawnTriangles; }
+    /// Texels of the layers the last record() rendered (side² each).
+    uint64_t renderedTexels() const { return mRenderedTexels; }
     /// Of drawnTriangles(), those drawn with faces looking away from the light skipped.
     uint64_t oneSidedTriangles() const { return mOneSidedTriangles; }
     /// Caster triangles (the scene's, coplanar ones merged) and those of them in solids, at
@@ -193,8 +214,12 @@ private:
     };
 
     ShadowMapPass(Context& context) : mContext(context) {}
-    /// Binds `pipeline` with layer `layer`'s viewport, matrix and geometry.
-    void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer) const;
+    /// Binds `pipeline` with layer `layer`'s matrix and geometry and a side × side viewport.
+    void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer, uint32_t side) const;
+    /// The side of `light`'s perspective layers (slopeAtOneTexel: 2·tan(fov/2)): with
+    /// equalFootprint, the one whose texels at the median distance of the surface samples the
+    /// light reaches are as wide as an orthographic layer's; otherwise mSize.
+    uint32_t perspectiveSide(const Light& light, float slopeAtOneTexel) const;
     LightSlot describe(const Light& light, uint32_t firstLayer,
                        std::vector<glm::mat4>& clipFromWorld) const;
     /// The coarsest level whose error layer `layer` of `slot` allows everywhere it looks.
@@ -206,6 +231,7 @@ private:
     Context& mContext;
     uint32_t mSize = 0;
     Aabb mBounds;
+    std::vector<glm::vec3> mSurfaceSamples;  ///< kFootprintSamples (equalFootprint), else none
     std::vector<TriangleCluster> mClusters;  ///< every level's, level by level
     std::vector<CasterLevel> mLevels;
     std::vector<uint32_t> mLayerLevels;
@@ -222,6 +248,7 @@ private:
     std::vector<glm::mat4> mClipFromWorld;  ///< per layer
     uint32_t mRenderedLights = 0;
     uint64_t mDrawnTriangles = 0;
+    uint64_t mRenderedTexels = 0;
     uint64_t mOneSidedTriangles = 0;
 };
 

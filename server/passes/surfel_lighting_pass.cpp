@@ -78,7 +78,6 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(Context& 
 
 Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     PIC_CHECK(r.shadows && r.nodeFlux && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
-    mShadowSize = r.shadows->size();
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::storage(0, mSurfels),
         BindingResource::storage(1, r.shadows->lightBuffer()),
@@ -116,7 +115,6 @@ void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t light
     push.surfelCount = mSurfelCount;
     push.lightCount = lightCount;
     push.epsilon = mEpsilon;
-    push.shadowSize = mShadowSize;
     push.sumSlot = sumSlot;
     const Kernel& kernel = bounce ? mBounce : mDirect;
     kernel.dispatch(cmd, bounce ? mBounceSet : mDirectSet, &push,

@@ -57,7 +57,6 @@ private:
     VkDescriptorSet mBounceSet = VK_NULL_HANDLE;
     uint32_t mSurfelCount = 0;
     float mEpsilon = 0.0f;
-    uint32_t mShadowSize = 0;
     Buffer mSurfels;
     Buffer mEmissiveScale;
     Buffer mStencils;

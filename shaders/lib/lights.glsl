@@ -40,11 +40,11 @@ vec3 lightIrradiance(GpuLight light, vec3 p, vec3 n, out vec3 toLight, out float
 
 /// Shadow-map visibility of the light from a surface point p with normal n (cosTheta the
 /// cosine between n and the direction to the light; epsilon the CPU twin's ray offset in
-/// metres; shadowSize the texels per side of a layer). The point moves off the surface by the
+/// metres). The point moves off the surface by the
 /// ray offset plus one shadow texel's footprint along the normal (normal-offset shadows), and
 /// the depth test allows half a texel plus a slope term, so that a lit plane never shadows
 /// itself while contact shadows keep their place.
-bool shadowVisible(GpuLight light, vec3 p, vec3 n, float cosTheta, float epsilon, uint shadowSize) {
+bool shadowVisible(GpuLight light, vec3 p, vec3 n, float cosTheta, float epsilon) {
     // Layer and depth along its view axis.
     uint layer = light.firstLayer;
     if (light.shadowKind == kShadowCube) {
@@ -66,7 +66,7 @@ bool shadowVisible(GpuLight light, vec3 p, vec3 n, float cosTheta, float epsilon
     if (!ortho && clip.w <= 0.0) return true;  // behind the light's near plane
     const vec3 ndc = clip.xyz / clip.w;
     const vec2 uv = ndc.xy * 0.5 + 0.5;
-    const int size = int(shadowSize);
+    const int size = int(light.side);
     const ivec2 xy = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
     const float stored = texelFetch(shadowMaps, ivec3(xy, int(layer)), 0).r;
     if (stored >= 1.0) return true;  // nothing drawn there: the far plane

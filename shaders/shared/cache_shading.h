@@ -25,7 +25,7 @@ struct CacheShadingPush {
     uint lightmapWidth;   // texels (0: no light map; every surface reads the grid)
     uint lightmapHeight;  // texels
     float epsilon;        // metres: the CPU twin's ray offset along the normal
-    uint shadowSize;      // texels per side of a shadow-map layer
+    uint pad0;
     float glossyWeight;   // factor on the glossy lobe (0: diffuse only)
     uint firstPixel;      // pixel of invocation 0 (large images take several dispatches)
     vec4 glossyLobe[2];   // s_l(n) of band l at [l / 4][l % 4] (core/sh.h cosineLobeFactor)

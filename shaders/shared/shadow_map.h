@@ -29,7 +29,7 @@ struct GpuLight {
     float depthFar;      // metres: perspective far plane, or orthographic depth of z = 1
     float texelSlope;    // perspective: texel width per metre of depth; ortho: texel width (m)
     uint hardCone;       // spot: 1 when inner ≥ outer (hard edge)
-    uint pad0;
+    uint side;           // texels per side of its layers: each uses its top-left side × side
 };
 PIC_STRUCT_CHECK(GpuLight, 80);
 

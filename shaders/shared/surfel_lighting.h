@@ -24,13 +24,9 @@ struct SurfelLightingPush {
     uint surfelCount;  // nS
     uint lightCount;
     float epsilon;     // metres: the CPU twin's ray offset along the normal
-    uint shadowSize;   // texels per side of a shadow-map layer
     uint sumSlot;      // 0 or 1: which half of groupFlux takes this pass's workgroup sums
-    uint pad0;
-    uint pad1;
-    uint pad2;
 };
-PIC_STRUCT_CHECK(SurfelLightingPush, 32);
+PIC_STRUCT_CHECK(SurfelLightingPush, 16);
 
 PIC_NAMESPACE_END
 

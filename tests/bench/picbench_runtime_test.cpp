@@ -74,18 +74,28 @@ TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {
     const fs::path json = mDir / "shadows.json";
     std::string err;
     ASSERT_EQ(run(std::string("shadows --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf "
-                  "--sizes 64 512 --repeat 1 --json " + json.string(), err), 0) << err;
+                  "--sizes 64 512 --sides uniform footprint --repeat 1 --json " + json.string(), err), 0)
+        << err;
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);
-    const nlohmann::json& sizes = report.at("sizes");
-    ASSERT_EQ(sizes.size(), 2u);
-    for (const nlohmann::json& row : sizes) {
+    const nlohmann::json& runs = report.at("runs");
+    ASSERT_EQ(runs.size(), 4u);
+    for (const nlohmann::json& row : runs) {
         EXPECT_GE(row.at("relative_l1").get<double>(), 0.0);
         EXPECT_LE(row.at("fraction_surfels_differing").get<double>(), 1.0);
         EXPECT_GT(row.at("gpu_direct_ms_median").get<double>(), 0.0);
     }
-    // Eight times the resolution: the edges of cornell's box shadow get sharper.
-    EXPECT_LT(sizes[1].at("relative_l1").get<double>(), sizes[0].at("relative_l1").get<double>());
+    for (size_t first : {0, 2}) {
+        SCOPED_TRACE(runs[first].at("sides").get<std::string>());
+        EXPECT_EQ(runs[first].at("size").get<int>(), 64);
+        EXPECT_EQ(runs[first + 1].at("size").get<int>(), 512);
+        // Eight times the resolution: the edges of cornell's box shadow get sharper.
+        EXPECT_LT(runs[first + 1].at("relative_l1").get<double>(),
+                  runs[first].at("relative_l1").get<double>());
+    }
+    // Cornell's one point light: six uniform layers; footprint sides are never wider.
+    EXPECT_EQ(runs[1].at("texels").get<uint64_t>(), 6u * 512u * 512u);
+    EXPECT_LE(runs[3].at("texels").get<uint64_t>(), runs[1].at("texels").get<uint64_t>());
 }
 
 TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {

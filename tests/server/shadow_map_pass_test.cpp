@@ -1,6 +1,7 @@
 // The shadow-map pass on lavapipe (or the machine's GPU): merged coplanar casters and solids
 // drawn from one side store the same depths as the scene's own triangles drawn from both
-// sides.
+// sides; levels of detail stay within their error; footprint sides give the orthographic
+// texel at the median receiver distance.
 
 #include <gtest/gtest.h>
 
@@ -77,7 +78,7 @@ TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
     if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
     constexpr uint32_t kSize = 256;
     const LightSet lights = testLights(*scene);
-    auto render = [&](gpu::ShadowCasterOptions options, uint64_t& oneSided) {
+    auto render = [&](gpu::ShadowMapOptions options, uint64_t& oneSided) {
         auto pass = gpu::ShadowMapPass::create(**context, *scene, kSize, options);
         EXPECT_TRUE(pass) << pass.error().message;
         if (!pass) return std::vector<std::vector<float>>{};
@@ -140,14 +141,18 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
         EXPECT_LE(levels[k].triangles, gpu::kCasterLevelReduction * levels[k - 1].triangles);
     }
     // Only the atrium has curved surfaces (columns) to simplify.
-    if (GetParam() == "atrium") EXPECT_GE(levels.size(), 2u);
+    if (GetParam() == "atrium") {
+        EXPECT_GE(levels.size(), 2u);
+    }
     for (const gpu::GpuLight& light : (*coarse)->lightRecords()) {
         const uint32_t layers = light.shadowKind == gpu::kShadowCube ? 6 : 1;
         for (uint32_t l = light.firstLayer; l < light.firstLayer + layers; ++l) {
             const uint32_t level = (*coarse)->layerLevels()[l];
             const float error = levels[level].error;
             // Where a layer's texels are all one size, it takes the coarsest level.
-            if (light.shadowKind == gpu::kShadowOrthographic) EXPECT_EQ(level, levels.size() - 1);
+            if (light.shadowKind == gpu::kShadowOrthographic) {
+                EXPECT_EQ(level, levels.size() - 1);
+            }
             EXPECT_LE(error, gpu::kCasterErrorPerTexel * light.texelSlope *
                                  (light.shadowKind == gpu::kShadowOrthographic ? 1.0f : light.depthFar));
             // Depths differ by more than the level's error only on silhouettes and grazing
@@ -171,6 +176,141 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
 
 // cornell: closed boxes in an open room; closed_box: a closed room with the lights inside
 // it (its walls must keep both sides); two_floors: slabs; atrium: every kind of part.
+/// A 20 m × 20 m floor at y = 0 of 2 × 200 × 200 triangles.
+Scene floorScene() {
+    Scene scene;
+    constexpr int kCells = 200;
+    constexpr float kHalf = 10.0f;
+    for (int j = 0; j <= kCells; ++j)
+        for (int i = 0; i <= kCells; ++i) {
+            Vertex v;
+            v.position = glm::vec3(-kHalf + 2.0f * kHalf * float(i) / kCells, 0.0f,
+                                   -kHalf + 2.0f * kHalf * float(j) / kCells);
+            scene.vertices.push_back(v);
+            scene.bounds.extend(v.position);
+        }
+    for (int j = 0; j < kCells; ++j)
+        for (int i = 0; i < kCells; ++i) {
+            const uint32_t a = uint32_t(j * (kCells + 1) + i), b = a + 1, c = a + kCells + 1, d = c + 1;
+            scene.triangles.push_back(Triangle{{a, c, b}});
+            scene.triangles.push_back(Triangle{{b, c, d}});
+        }
+    return scene;
+}
+
+/// The median distance from `light` of the floor points it reaches (within its range and
+/// cone), over a fine grid of the floor: what footprint sides take from 4096 area samples.
+float medianFloorDistance(const Light& light) {
+    std::vector<float> distances;
+    constexpr int kSteps = 1000;
+    for (int j = 0; j < kSteps; ++j)
+        for (int i = 0; i < kSteps; ++i) {
+            const glm::vec3 p(-10.0f + 20.0f * (float(i) + 0.5f) / kSteps, 0.0f,
+                              -10.0f + 20.0f * (float(j) + 0.5f) / kSteps);
+            const glm::vec3 offset = p - light.position;
+            const float d = glm::length(offset);
+            if (std::isfinite(light.range) && d >= light.range) continue;
+            if (light.type == LightType::Spot &&
+                glm::dot(offset, light.direction) < std::cos(light.outerConeAngle) * d)
+                continue;
+            distances.push_back(d);
+        }
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    return distances[distances.size() / 2];
+}
+
+TEST(ShadowSides, FootprintSideRoundsUpWithinTheLimits) {
+    // 2·5 m / 1 cm = 1000 texels, rounded up to a multiple of 16.
+    EXPECT_EQ(gpu::footprintSide(2.0f, 5.0f, 0.01f, 2048), 1008u);
+    EXPECT_EQ(gpu::footprintSide(2.0f, 5.0f, 0.01f, 1024), 1008u);
+    EXPECT_EQ(gpu::footprintSide(2.0f, 5.0f, 0.01f, 512), 512u);     // at most the image's side
+    EXPECT_EQ(gpu::footprintSide(2.0f, 0.01f, 0.01f, 512), gpu::kMinShadowSide);
+    EXPECT_EQ(gpu::footprintSide(2.0f, 0.0f, 0.01f, 512), gpu::kMinShadowSide);
+    EXPECT_EQ(gpu::footprintSide(2.0f, std::nanf(""), 0.01f, 512), 512u);
+    EXPECT_EQ(gpu::footprintSide(2.0f, 1e30f, 0.01f, 512), 512u);
+}
+
+TEST(ShadowSides, EqualFootprintGivesTheOrthographicTexelAtTheMedianDistance) {
+    const Scene scene = floorScene();
+    auto context = gpu::Context::create();
+    if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
+    constexpr uint32_t kSize = 1024;
+    LightSet lights;
+    Light sun;
+    sun.id = "sun";
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.1f));
+    Light bulb;  // low over one corner: most of the floor is far away
+    bulb.id = "bulb";
+    bulb.type = LightType::Point;
+    bulb.position = glm::vec3(-8.0f, 1.0f, -8.0f);
+    Light nearBulb = bulb;  // its range keeps it to the corner
+    nearBulb.id = "near bulb";
+    nearBulb.range = 4.0f;
+    Light spot;  // a narrow cone straight down from high up
+    spot.id = "spot";
+    spot.type = LightType::Spot;
+    spot.position = glm::vec3(2.0f, 12.0f, 0.0f);
+    spot.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    spot.outerConeAngle = 0.3f;
+    lights.lights = {sun, bulb, nearBulb, spot};
+
+    auto uniform = gpu::ShadowMapPass::create(**context, scene, kSize);
+    ASSERT_TRUE(uniform) << uniform.error().message;
+    auto footprint = gpu::ShadowMapPass::create(**context, scene, kSize, {.equalFootprint = true});
+    ASSERT_TRUE(footprint) << footprint.error().message;
+    const auto uniformLayers = renderLayers(**context, **uniform, lights);
+    const auto footprintLayers = renderLayers(**context, **footprint, lights);
+    ASSERT_EQ(footprintLayers.size(), uniformLayers.size());
+
+    const auto uniformRecords = (*uniform)->lightRecords();
+    const auto records = (*footprint)->lightRecords();
+    ASSERT_EQ(records.size(), 4u);
+    const float orthographicTexel = records[0].texelSlope;
+    for (size_t k = 0; k < records.size(); ++k) {
+        const gpu::GpuLight& g = records[k];
+        SCOPED_TRACE(lights.lights[k].id);
+        EXPECT_EQ(uniformRecords[k].side, kSize);
+        EXPECT_EQ(g.side % gpu::kMinShadowSide, 0u);
+        if (g.shadowKind == gpu::kShadowOrthographic) {
+            EXPECT_EQ(g.side, kSize);
+            continue;
+        }
+        // The texel at the median distance is the orthographic one, but for rounding the side
+        // up to kMinShadowSide and the 4096 samples' scatter about the median (1 %).
+        const float slopeAtOneTexel = g.texelSlope * float(g.side);
+        const float texelAtMedian = g.texelSlope * medianFloorDistance(lights.lights[k]);
+        EXPECT_LE(texelAtMedian, 1.01f * orthographicTexel);
+        EXPECT_GE(texelAtMedian, 0.99f * orthographicTexel * float(g.side - gpu::kMinShadowSide) / float(g.side));
+        EXPECT_LT(g.side, kSize);
+        EXPECT_NEAR(slopeAtOneTexel, g.shadowKind == gpu::kShadowCube ? 2.0f : uniformRecords[k].texelSlope * kSize,
+                    1e-4f);
+    }
+    // The far bulb sees more of the floor from farther away than the near one.
+    EXPECT_GT(records[1].side, records[2].side);
+
+    // A footprint layer holds the same depths as the uniform one, seen through fewer texels:
+    // each of its texels matches the uniform texel under its centre (a plane's depth is linear
+    // in the layer's coordinates, so only edges and the far plane differ).
+    for (size_t k = 1; k < records.size(); ++k) {
+        const uint32_t side = records[k].side;
+        const uint32_t layers = records[k].shadowKind == gpu::kShadowCube ? 6 : 1;
+        for (uint32_t l = records[k].firstLayer; l < records[k].firstLayer + layers; ++l) {
+            size_t compared = 0, differing = 0;
+            for (uint32_t y = 0; y < side; ++y)
+                for (uint32_t x = 0; x < side; ++x) {
+                    const uint32_t ux = uint32_t((float(x) + 0.5f) * kSize / side);
+                    const uint32_t uy = uint32_t((float(y) + 0.5f) * kSize / side);
+                    const float a = footprintLayers[l][size_t(y) * kSize + x];
+                    const float b = uniformLayers[l][size_t(uy) * kSize + ux];
+                    ++compared;
+                    differing += std::abs(a - b) > 1e-3f;
+                }
+            EXPECT_LE(double(differing), 0.02 * double(compared)) << "layer " << l;
+        }
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, ShadowCasters,
                          testing::Values("cornell", "closed_box", "two_floors", "atrium"));
 
