@@ -76,7 +76,25 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
 
     bool labelled = false;
     for (const ChartSeries& series : chart.series) labelled = labelled || !series.labels.empty();
-    const int left = 90, right = labelled ? 110 : 30, top = 92, bottom = 70;
+    // Legend: rows under the title, outside the plot, so that it hides no point; an entry
+    // that would run past the right edge starts a new row.
+    constexpr int kLegendRow = 22;
+    const int left = 90, right = labelled ? 110 : 30, bottom = 70;
+    std::vector<glm::ivec2> legendAt;  // per series: x and the row's baseline
+    {
+        int x = left, y = 57;
+        for (const ChartSeries& series : chart.series) {
+            const OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(series.name, 14, kChartFont);
+            const int entry = 24 + (extent.defined() ? extent.width() : 8 * int(series.name.size()));
+            if (x > left && x + entry > width - 12) {
+                x = left;
+                y += kLegendRow;
+            }
+            legendAt.push_back({x, y});
+            x += entry + 28;
+        }
+    }
+    const int top = 92 + (legendAt.empty() ? 0 : legendAt.back().y - 57);
     const int plotW = width - left - right, plotH = height - top - bottom;
     if (plotW < 100 || plotH < 100)
         return fail(ErrorCode::InvalidInput, "chart size {}x{} is too small", width, height);
@@ -153,15 +171,13 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
     text(left + plotW / 2, height - 18, chart.xLabel + (chart.logX ? " (log scale)" : ""), 15,
          black, OIIO::ImageBufAlgo::TextAlignX::Center);
     text(12, top - 10, chart.yLabel, 15, black);
-    // Legend: one row under the title, outside the plot, so that it hides no point.
-    int legendX = left;
-    for (const ChartSeries& series : chart.series) {
+    for (size_t i = 0; i < chart.series.size(); ++i) {
+        const ChartSeries& series = chart.series[i];
         const float color[] = {series.color.r, series.color.g, series.color.b};
-        OIIO::ImageBufAlgo::render_box(image, legendX, 48, legendX + 18, 54,
+        const glm::ivec2 at = legendAt[i];
+        OIIO::ImageBufAlgo::render_box(image, at.x, at.y - 9, at.x + 18, at.y - 3,
                                        OIIO::cspan<float>(color, 3), true);
-        text(legendX + 24, 57, series.name, 14, black);
-        const OIIO::ROI extent = OIIO::ImageBufAlgo::text_size(series.name, 14, kChartFont);
-        legendX += 24 + (extent.defined() ? extent.width() : 8 * int(series.name.size())) + 28;
+        text(at.x + 24, at.y, series.name, 14, black);
     }
 
     const std::string temp = path + ".tmp.png";
