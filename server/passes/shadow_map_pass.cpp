@@ -501,13 +501,13 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     if (light.type == LightType::Directional) {
         // An orthographic box around the scene's bounding sphere, looking along the light.
         const glm::vec3 centre = mBounds.center();
-        const float radius = 0.5f * diagonal * 1.01f;  // perspectiveSide's footprint assumes it
+        const float radius = 0.5f * float(mSize) * orthographicTexel();
         const glm::vec3 eye = centre - light.direction * (radius * 1.01f);
         const glm::mat4 view = glm::lookAtRH(eye, centre, upFor(light.direction));
         g.shadowKind = kShadowOrthographic;
         g.depthNear = 0.0f;
         g.depthFar = 2.02f * radius * 1.01f;
-        g.texelSlope = 2.0f * radius / float(mSize);
+        g.texelSlope = orthographicTexel();
         slot.eye = ShadowEye{};
         clipFromWorld.push_back(glm::orthoRH_ZO(-radius, radius, -radius, radius, g.depthNear, g.depthFar) * view);
         return slot;
@@ -570,9 +570,7 @@ uint32_t ShadowMapPass::perspectiveSide(const Light& light, float slopeAtOneTexe
     if (distances.empty()) return kMinShadowSide;  // the map is never sampled where lit
     const auto median = distances.begin() + distances.size() / 2;
     std::nth_element(distances.begin(), median, distances.end());
-    // An orthographic layer's texel: its box spans the scene's bounding sphere (describe).
-    const float orthographicTexel = 1.01f * std::max(mBounds.diagonal(), 1e-3f) / float(mSize);
-    return footprintSide(slopeAtOneTexel, *median, orthographicTexel, mSize);
+    return footprintSide(slopeAtOneTexel, *median, orthographicTexel(), mSize);
 }
 
 Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {

@@ -12,6 +12,7 @@
 /// Perspective layers may also be smaller than the image's layers (ShadowMapOptions::
 /// equalFootprint): each light then renders and samples the top-left side × side texels.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -220,6 +221,9 @@ private:
     /// equalFootprint, the one whose texels at the median distance of the surface samples the
     /// light reaches are as wide as an orthographic layer's; otherwise mSize.
     uint32_t perspectiveSide(const Light& light, float slopeAtOneTexel) const;
+    /// Metres per texel of an orthographic layer: its box spans the scene's bounding sphere
+    /// with a 1 % margin.
+    float orthographicTexel() const { return 1.01f * std::max(mBounds.diagonal(), 1e-3f) / float(mSize); }
     LightSlot describe(const Light& light, uint32_t firstLayer,
                        std::vector<glm::mat4>& clipFromWorld) const;
     /// The coarsest level whose error layer `layer` of `slot` allows everywhere it looks.
