@@ -1,6 +1,7 @@
 #include "server/gpu/context.h"
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
@@ -401,6 +402,7 @@ Result<void> Context::init(const ContextOptions& options) {
 Context::~Context() {
     if (mDevice) {
         vkDeviceWaitIdle(mDevice);
+        mStaging.reset();
         if (mNearestSampler) vkDestroySampler(mDevice, mNearestSampler, nullptr);
         if (mFence) vkDestroyFence(mDevice, mFence, nullptr);
         if (mCommandPool) vkDestroyCommandPool(mDevice, mCommandPool, nullptr);
@@ -488,6 +490,14 @@ Result<Buffer> Context::createBufferWith(const void* data, VkDeviceSize bytes,
     return buffer;
 }
 
+Result<Buffer*> Context::staging(VkDeviceSize bytes) {
+    if (mStaging.size() < bytes) {
+        mStaging.reset();
+        PIC_TRY_ASSIGN(mStaging, createBuffer(std::bit_ceil(bytes), 0, MemoryUse::Readback, "staging"));
+    }
+    return &mStaging;
+}
+
 Result<void> Context::upload(Buffer& buffer, const void* data, VkDeviceSize bytes,
                              VkDeviceSize offset) {
     PIC_CHECK(offset + bytes <= buffer.size());
@@ -495,11 +505,11 @@ Result<void> Context::upload(Buffer& buffer, const void* data, VkDeviceSize byte
         std::memcpy(static_cast<char*>(buffer.mapped()) + offset, data, bytes);
         return {};
     }
-    PIC_TRY_ASSIGN(Buffer staging, createBuffer(bytes, 0, MemoryUse::Readback, "staging upload"));
-    std::memcpy(staging.mapped(), data, bytes);
+    PIC_TRY_ASSIGN(Buffer* staging, this->staging(bytes));
+    std::memcpy(staging->mapped(), data, bytes);
     return submit([&](VkCommandBuffer cmd) {
         const VkBufferCopy region{0, offset, bytes};
-        vkCmdCopyBuffer(cmd, staging.handle(), buffer.handle(), 1, &region);
+        vkCmdCopyBuffer(cmd, staging->handle(), buffer.handle(), 1, &region);
     });
 }
 
@@ -510,13 +520,22 @@ Result<void> Context::download(const Buffer& buffer, void* data, VkDeviceSize by
         std::memcpy(data, static_cast<const char*>(buffer.mapped()) + offset, bytes);
         return {};
     }
-    PIC_TRY_ASSIGN(Buffer staging, createBuffer(bytes, 0, MemoryUse::Readback, "staging download"));
+    PIC_TRY_ASSIGN(Buffer* staging, this->staging(bytes));
     PIC_TRY(submit([&](VkCommandBuffer cmd) {
         const VkBufferCopy region{offset, 0, bytes};
-        vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
+        vkCmdCopyBuffer(cmd, buffer.handle(), staging->handle(), 1, &region);
+        hostReadBarrier(cmd);
     }));
-    std::memcpy(data, staging.mapped(), bytes);
+    std::memcpy(data, staging->mapped(), bytes);
     return {};
+}
+
+void Context::hostReadBarrier(VkCommandBuffer cmd) {
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                         &barrier, 0, nullptr, 0, nullptr);
 }
 
 Result<std::vector<float>> Context::downloadDepthLayer(const DepthArray& depth, uint32_t layer) {
@@ -540,6 +559,7 @@ Result<std::vector<float>> Context::downloadDepthLayer(const DepthArray& depth, 
         region.imageExtent = {depth.size(), depth.size(), 1};
         vkCmdCopyImageToBuffer(cmd, depth.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                staging.handle(), 1, &region);
+        hostReadBarrier(cmd);
         // The copy finishes before the layer is sampled or rendered again.
         VkImageMemoryBarrier back = toCopy;
         back.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;

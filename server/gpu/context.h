@@ -242,6 +242,10 @@ public:
     /// The nearest-filtering, clamp-to-edge sampler the passes read depth images with.
     VkSampler nearestSampler() const { return mNearestSampler; }
 
+    /// Records a barrier that makes transfer writes recorded before it visible to host reads
+    /// once the submission's fence has signalled.
+    static void hostReadBarrier(VkCommandBuffer cmd);
+
 private:
     Context() = default;
     Result<void> init(const ContextOptions& options);
@@ -250,6 +254,8 @@ private:
     Result<void> allocate(VkMemoryRequirements requirements, VkMemoryPropertyFlags required,
                           VkMemoryPropertyFlags preferred, VkDeviceMemory& memory,
                           VkMemoryPropertyFlags& flags, const char* what);
+    /// The staging buffer, at least `bytes` long.
+    Result<Buffer*> staging(VkDeviceSize bytes);
 
     VkInstance mInstance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT mMessenger = VK_NULL_HANDLE;
@@ -264,6 +270,10 @@ private:
     VkCommandBuffer mCommandBuffer = VK_NULL_HANDLE;
     VkFence mFence = VK_NULL_HANDLE;
     VkSampler mNearestSampler = VK_NULL_HANDLE;
+    /// Host-visible go-between of uploads to and downloads from memory the host cannot map,
+    /// kept and grown rather than allocated per transfer: on a discrete GPU an allocation
+    /// costs more than the copy.
+    Buffer mStaging;
     bool mLost = false;
     uint32_t mValidationMessages = 0;
 

@@ -54,6 +54,10 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY_ASSIGN(mCacheY, ctx.createBuffer(2 * nC * countY, 0, MemoryUse::Device, "caches Y"));
     PIC_TRY_ASSIGN(mCacheCo, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Co"));
     PIC_TRY_ASSIGN(mCacheCg, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Cg"));
+    if (!mCacheY.mapped() || !mCacheCo.mapped() || !mCacheCg.mapped()) {
+        const VkDeviceSize bytes = mCacheY.size() + mCacheCo.size() + mCacheCg.size();
+        PIC_TRY_ASSIGN(mCacheReadback, ctx.createBuffer(bytes, 0, MemoryUse::Readback, "cache readback"));
+    }
     const ShTables tables = makeShTables();
     PIC_TRY_ASSIGN(mShTables, ctx.createBufferWith(&tables, sizeof(tables),
                                                      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
@@ -171,8 +175,9 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
         mTimer.begin(cmd, "lightmap_copy");
         mLightmapCopy->record(cmd);
+        recordCacheReadback(cmd);
     }, stats));
-    PIC_TRY(downloadCaches(mValues));
+    readCaches(mValues);
     stats.totalMs = millisecondsSince(start);
     return &mValues;
 }
@@ -216,17 +221,29 @@ Result<void> GpuRuntime::uploadCaches(const CacheValues& values) {
     return put(values.cg, mCacheCg);
 }
 
-Result<void> GpuRuntime::downloadCaches(CacheValues& values) {
-    const auto get = [&](const gpu::Buffer& buffer, std::vector<float>& v) -> Result<void> {
-        std::vector<uint16_t> halves(v.size());
-        if (!halves.empty())
-            PIC_TRY(mContext->download(buffer, halves.data(), halves.size() * sizeof(uint16_t)));
+void GpuRuntime::recordCacheReadback(VkCommandBuffer cmd) {
+    if (!mCacheReadback.handle()) return;
+    // The cache lighting's writes are done before the copy reads them.
+    gpu::computeBarrier(cmd);
+    VkDeviceSize offset = 0;
+    for (const gpu::Buffer* buffer : {&mCacheY, &mCacheCo, &mCacheCg}) {
+        const VkBufferCopy region{0, offset, buffer->size()};
+        vkCmdCopyBuffer(cmd, buffer->handle(), mCacheReadback.handle(), 1, &region);
+        offset += buffer->size();
+    }
+    gpu::Context::hostReadBarrier(cmd);
+}
+
+void GpuRuntime::readCaches(CacheValues& values) const {
+    const char* readback = static_cast<const char*>(mCacheReadback.mapped());
+    const auto get = [&](const gpu::Buffer& buffer, std::vector<float>& v) {
+        const auto* halves = static_cast<const uint16_t*>(readback ? readback : buffer.mapped());
         for (size_t i = 0; i < v.size(); ++i) v[i] = halfToFloat(halves[i]);
-        return {};
+        if (readback) readback += buffer.size();
     };
-    PIC_TRY(get(mCacheY, values.y));
-    PIC_TRY(get(mCacheCo, values.co));
-    return get(mCacheCg, values.cg);
+    get(mCacheY, values.y);
+    get(mCacheCo, values.co);
+    get(mCacheCg, values.cg);
 }
 
 Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, UpdateStats* statsOut) {
@@ -267,9 +284,12 @@ Result<std::vector<glm::vec3>> GpuRuntime::runPull(std::span<const glm::vec3> le
 Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), mBake.nodes.size());
     PIC_TRY(uploadFlux(nodeFlux, mNodeFlux));
-    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mCacheLighting->record(cmd); }));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
+        mCacheLighting->record(cmd);
+        recordCacheReadback(cmd);
+    }));
     CacheValues values = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
-    PIC_TRY(downloadCaches(values));
+    readCaches(values);
     return values;
 }
 

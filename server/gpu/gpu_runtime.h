@@ -82,7 +82,10 @@ private:
     Result<void> uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer);
     Result<std::vector<glm::vec3>> downloadFlux(const gpu::Buffer& buffer, size_t count);
     Result<void> uploadCaches(const CacheValues& values);
-    Result<void> downloadCaches(CacheValues& values);
+    /// Records the copy of the caches into mCacheReadback when the host cannot map them.
+    void recordCacheReadback(VkCommandBuffer cmd);
+    /// The caches as the latest submission that recorded recordCacheReadback left them.
+    void readCaches(CacheValues& values) const;
 
     const Scene& mScene;
     const BakeData& mBake;
@@ -99,6 +102,9 @@ private:
     gpu::Buffer mCacheCo;    ///< half, nC·lC²
     gpu::Buffer mCacheCg;    ///< half, nC·lC²
     gpu::Buffer mShTables;   ///< ShTables
+    /// Host-visible Y, Co, Cg after one another, only when the cache buffers are not mapped
+    /// (a discrete GPU): filled by the submission that wrote them, not by another one.
+    gpu::Buffer mCacheReadback;
     CacheValues mValues;
     CacheTextures mTextures;
     bool mTexturesCurrent = false;
