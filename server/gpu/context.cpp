@@ -246,6 +246,7 @@ Result<std::unique_ptr<Context>> Context::create(const ContextOptions& options) 
 }
 
 Result<void> Context::init(const ContextOptions& options) {
+    mMapDeviceMemory = options.mapDeviceMemory;
     // Instance: no surface extensions; the validation layer and its messenger when wanted.
     const bool validation = wantValidation(options.validation) && layerAvailable(kValidationLayer);
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
@@ -478,7 +479,7 @@ Result<Buffer> Context::createBuffer(VkDeviceSize bytes, VkBufferUsageFlags usag
     // Memory the host sees coherently is mapped once for its whole life.
     const VkMemoryPropertyFlags mappable =
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    if ((flags & mappable) == mappable)
+    if ((flags & mappable) == mappable && (use != MemoryUse::Device || mMapDeviceMemory))
         PIC_VK_TRY(vkMapMemory(mDevice, buffer.mMemory, 0, VK_WHOLE_SIZE, 0, &buffer.mMapped));
     return buffer;
 }

@@ -147,6 +147,9 @@ struct ContextOptions {
     /// Enables VK_LAYER_KHRONOS_validation when it is installed (off when it is not). The
     /// PIC_VK_VALIDATION environment variable (0/1) overrides this.
     bool validation = false;
+    /// False leaves device-local memory unmapped even where the host could map it (a CPU
+    /// device), so that the staging paths a discrete GPU takes run there too (tests).
+    bool mapDeviceMemory = true;
 };
 
 /// Timestamps of named passes inside one command buffer (Vulkan timestamp queries).
@@ -274,6 +277,7 @@ private:
     /// kept and grown rather than allocated per transfer: on a discrete GPU an allocation
     /// costs more than the copy.
     Buffer mStaging;
+    bool mMapDeviceMemory = true;
     bool mLost = false;
     uint32_t mValidationMessages = 0;
 

@@ -43,7 +43,8 @@ GpuRuntime::~GpuRuntime() = default;
 
 Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& options) {
     using namespace gpu;
-    PIC_TRY_ASSIGN(mContext, Context::create({options.deviceName, options.validation}));
+    const ContextOptions contextOptions{options.deviceName, options.validation, options.mapDeviceMemory};
+    PIC_TRY_ASSIGN(mContext, Context::create(contextOptions));
     Context& ctx = *mContext;
     const size_t nC = mBake.caches.size();
     const uint32_t countY = mBake.params.bandsY * mBake.params.bandsY;

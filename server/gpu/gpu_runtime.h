@@ -30,6 +30,9 @@ struct GpuRuntimeOptions {
     /// the surfaces a light reaches (gpu::ShadowMapOptions::equalFootprint): the surfels are
     /// spread over those surfaces by area. Off: every layer shadowMapSize wide.
     bool shadowEqualFootprint = true;
+    /// gpu::ContextOptions::mapDeviceMemory: false runs a discrete GPU's staging and
+    /// read-back paths on a device whose memory the host could map (tests).
+    bool mapDeviceMemory = true;
 };
 
 namespace gpu {

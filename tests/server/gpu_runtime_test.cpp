@@ -21,6 +21,7 @@
 #include "server/cpu/lightmap_copy.h"
 #include "server/cpu/pull.h"
 #include "server/cpu/surfel_lighting.h"
+#include "server/gpu/copy_probe.h"
 #include "server/gpu/gpu_runtime.h"
 
 namespace pic {
@@ -67,8 +68,9 @@ const Baked& baked(const std::string& name, LinkMode mode, uint32_t bandsY = 3, 
 
 /// The GPU runtime, or a skip when the machine has no Vulkan device at all (CI has lavapipe,
 /// so there these tests run).
-std::unique_ptr<GpuRuntime> gpuFor(const Baked& b, BounceParams bounces = {}) {
-    auto runtime = GpuRuntime::create(b.scene, *b.rays, b.bake, bounces);
+std::unique_ptr<GpuRuntime> gpuFor(const Baked& b, BounceParams bounces = {},
+                                   const GpuRuntimeOptions& options = {}) {
+    auto runtime = GpuRuntime::create(b.scene, *b.rays, b.bake, bounces, options);
     if (!runtime) {
         ADD_FAILURE() << runtime.error().message;
         return nullptr;
@@ -394,6 +396,56 @@ TEST(GpuContext, UnknownDeviceNameIsNotFound) {
     ASSERT_FALSE(context);
     EXPECT_EQ(context.error().code, ErrorCode::NotFound);
     EXPECT_NE(context.error().message.find("no-such-device-name"), std::string::npos);
+}
+
+// A discrete GPU's device memory is not mapped: uploads, downloads and the caches' read-back
+// go through host-visible buffers. Lavapipe could map it; left unmapped, it takes those paths
+// and must give the same caches and textures, bit for bit (the same shaders on the same data).
+TEST(GpuRuntime, UnmappedDeviceMemoryGivesTheSameResults) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto mapped = gpuFor(b);
+    auto unmapped = gpuFor(b, {}, {.mapDeviceMemory = false});
+    ASSERT_TRUE(mapped && unmapped);
+    LightSet lights = defaultLightSet(b.scene);
+    for (int update = 0; update < 2; ++update) {
+        auto expected = mapped->setLights(lights, nullptr);
+        auto actual = unmapped->setLights(lights, nullptr);
+        ASSERT_TRUE(expected && actual);
+        EXPECT_EQ((*actual)->y, (*expected)->y);
+        EXPECT_EQ((*actual)->co, (*expected)->co);
+        EXPECT_EQ((*actual)->cg, (*expected)->cg);
+        auto expectedTextures = mapped->textures();
+        auto actualTextures = unmapped->textures();
+        ASSERT_TRUE(expectedTextures && actualTextures);
+        for (int ch = 0; ch < 3; ++ch) {
+            EXPECT_EQ((*actualTextures)->grid[ch], (*expectedTextures)->grid[ch]);
+            EXPECT_EQ((*actualTextures)->lightmap[ch], (*expectedTextures)->lightmap[ch]);
+        }
+        lights.lights[0].intensity *= 0.5f;
+    }
+    // The single-pass path reads the caches back the same way.
+    std::vector<glm::vec3> nodes(b.bake.nodes.size(), glm::vec3(0.25f, 0.5f, 1.0f));
+    auto expected = mapped->runCacheLighting(nodes);
+    auto actual = unmapped->runCacheLighting(nodes);
+    ASSERT_TRUE(expected && actual);
+    EXPECT_EQ(actual->y, expected->y);
+    EXPECT_GT(*std::max_element(actual->y.begin(), actual->y.end()), 0.0f);
+    EXPECT_EQ(unmapped->context().validationMessages(), 0u);
+}
+
+TEST(GpuCopyProbe, CopiesEveryWordAndReportsARate) {
+    auto context = gpu::Context::create({.mapDeviceMemory = false});
+    ASSERT_TRUE(context) << context.error().message;
+    // Fewer workgroups than the data needs: each strides over the rest, past a partial group.
+    auto rate = gpu::computeCopyBandwidth(
+        **context, {.bytes = 16 * 3001, .copiesPerSubmission = 2, .submissions = 3, .maxGroups = 3});
+    ASSERT_TRUE(rate) << rate.error().message;
+    EXPECT_GT(*rate, 0.0);
+    auto bad = gpu::computeCopyBandwidth(**context, {.bytes = 20});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(bad.error().message.find("20"), std::string::npos) << bad.error().message;
 }
 
 TEST(GpuRuntime, RefusesInvalidLights) {
