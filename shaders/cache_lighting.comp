@@ -6,6 +6,8 @@
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_shader_16bit_storage : require
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
 #include "shared/bake_layout.h"
 #include "shared/cache_lighting.h"
 #include "shared/sh_tables.h"
@@ -15,6 +17,7 @@ layout(constant_id = 0) const uint kBandsY = 3u;
 layout(constant_id = 1) const uint kBandsC = 2u;
 layout(constant_id = 2) const uint kLinksPerCache = 128u;
 layout(constant_id = 3) const uint kLinkForm = 1u;
+layout(constant_id = 4) const uint kMapping = 0u;
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 
@@ -30,59 +33,87 @@ layout(push_constant) uniform Push { CacheLightingPush pc; };
 
 #include "lib/sh.glsl"
 
+float y[kCountY];
+float co[kCountC];
+float cg[kCountC];
+
 float16_t toHalf(float value) {
     return float16_t(clamp(value, -kHalfMax, kHalfMax));
 }
 
-void main() {
-    const uint local = gl_GlobalInvocationID.x;  // cache within the chunk
-    if (local >= pc.cacheCount) return;
-    float y[kCountY];
-    float co[kCountC];
-    float cg[kCountC];
-    [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = 0.0;
-    [[unroll]] for (uint i = 0u; i < kCountC; ++i) { co[i] = 0.0; cg[i] = 0.0; }
-
-    for (uint j = 0u; j < kLinksPerCache; ++j) {
-        const uint slot = local * kLinksPerCache + j;
-        if (kLinkForm == kLinkFormRtp) {
-            // §4.6: the node's cone projected at runtime, factor·K_l(α)·y_lm(direction).
-            const RtpLink link = rtpLinks[slot];
-            if (link.factor == 0.0) continue;  // padding
-            const vec3 flux = rgbToYCoCg(nodeFlux[link.node].xyz);
-            float cone[kBandsY];
-            coneZonal(link.oneMinusCosAlpha, cone);
-            float basis[64];
-            shEvaluate(decodeOctahedral(link.directionOct), basis);
-            [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
-                const float w = link.factor * cone[kShBandOf[i]] * basis[i];
-                y[i] += flux.x * w;
-                if (i < kCountC) {
-                    co[i] += flux.y * w;
-                    cg[i] += flux.z * w;
-                }
+/// Adds link `slot` (within the chunk) to y, co, cg.
+void addLink(uint slot) {
+    if (kLinkForm == kLinkFormRtp) {
+        // §4.6: the node's cone projected at runtime, factor·K_l(α)·y_lm(direction).
+        const RtpLink link = rtpLinks[slot];
+        if (link.factor == 0.0) return;  // padding
+        const vec3 flux = rgbToYCoCg(nodeFlux[link.node].xyz);
+        float cone[kBandsY];
+        coneZonal(link.oneMinusCosAlpha, cone);
+        float basis[64];
+        shEvaluate(decodeOctahedral(link.directionOct), basis);
+        [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
+            const float w = link.factor * cone[kShBandOf[i]] * basis[i];
+            y[i] += flux.x * w;
+            if (i < kCountC) {
+                co[i] += flux.y * w;
+                cg[i] += flux.z * w;
             }
-        } else {
-            // SH-projected links: lY² half coefficients; chroma takes the first lC².
-            const uint node = shNodes[slot];
-            if (node == kNoNode) continue;
-            const vec3 flux = rgbToYCoCg(nodeFlux[node].xyz);
-            const uint first = slot * kCountY;
-            [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
-                const float k = float(shCoefficients[first + i]);
-                y[i] += flux.x * k;
-                if (i < kCountC) {
-                    co[i] += flux.y * k;
-                    cg[i] += flux.z * k;
-                }
+        }
+    } else {
+        // SH-projected links: lY² half coefficients; chroma takes the first lC².
+        const uint node = shNodes[slot];
+        if (node == kNoNode) return;
+        const vec3 flux = rgbToYCoCg(nodeFlux[node].xyz);
+        const uint first = slot * kCountY;
+        [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
+            const float k = float(shCoefficients[first + i]);
+            y[i] += flux.x * k;
+            if (i < kCountC) {
+                co[i] += flux.y * k;
+                cg[i] += flux.z * k;
             }
         }
     }
+}
 
+void store(uint local) {
     const uint cache = pc.firstCache + local;
     [[unroll]] for (uint i = 0u; i < kCountY; ++i) cacheY[cache * kCountY + i] = toHalf(y[i]);
     [[unroll]] for (uint i = 0u; i < kCountC; ++i) {
         cacheCo[cache * kCountC + i] = toHalf(co[i]);
         cacheCg[cache * kCountC + i] = toHalf(cg[i]);
+    }
+}
+
+void clear() {
+    [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = 0.0;
+    [[unroll]] for (uint i = 0u; i < kCountC; ++i) { co[i] = 0.0; cg[i] = 0.0; }
+}
+
+void main() {
+    if (kMapping == kCachePerInvocation) {
+        const uint local = gl_GlobalInvocationID.x;  // cache within the chunk
+        if (local >= pc.cacheCount) return;
+        clear();
+        for (uint j = 0u; j < kLinksPerCache; ++j) addLink(local * kLinksPerCache + j);
+        store(local);
+    } else {
+        // Subgroups stride over the chunk's caches, so that however many subgroups the device
+        // launches per workgroup, every cache is lit once. The loop condition is uniform in
+        // a subgroup, as subgroupAdd needs.
+        const uint stride = gl_NumWorkGroups.x * gl_NumSubgroups;
+        for (uint local = gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID; local < pc.cacheCount;
+             local += stride) {
+            clear();
+            for (uint j = gl_SubgroupInvocationID; j < kLinksPerCache; j += gl_SubgroupSize)
+                addLink(local * kLinksPerCache + j);
+            [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = subgroupAdd(y[i]);
+            [[unroll]] for (uint i = 0u; i < kCountC; ++i) {
+                co[i] = subgroupAdd(co[i]);
+                cg[i] = subgroupAdd(cg[i]);
+            }
+            if (subgroupElect()) store(local);
+        }
     }
 }

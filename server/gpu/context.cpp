@@ -337,6 +337,7 @@ Result<void> Context::init(const ContextOptions& options) {
         !(subgroups.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT))
         return fail(ErrorCode::Unsupported,
                     "Vulkan device \"{}\" lacks subgroup arithmetic in compute shaders", mName);
+    mSubgroupSize = std::max(subgroups.subgroupSize, 1u);
 
     // One queue that does graphics and compute and has timestamps.
     uint32_t familyCount = 0;

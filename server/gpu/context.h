@@ -192,6 +192,8 @@ public:
     const std::string& deviceName() const { return mName; }
     /// True for a CPU implementation (lavapipe): memory is the host's.
     bool isCpuDevice() const { return mProperties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+    /// Invocations per subgroup compute shaders get by default (8 on lavapipe, 32 on NVIDIA).
+    uint32_t subgroupSize() const { return mSubgroupSize; }
     /// Errors and warnings the validation layer reported so far (0 when it is off).
     uint32_t validationMessages() const { return mValidationMessages; }
     bool validationEnabled() const { return mMessenger != VK_NULL_HANDLE; }
@@ -278,6 +280,7 @@ private:
     /// costs more than the copy.
     Buffer mStaging;
     bool mMapDeviceMemory = true;
+    uint32_t mSubgroupSize = 1;
     bool mLost = false;
     uint32_t mValidationMessages = 0;
 

@@ -69,7 +69,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                                     .equalFootprint = options.shadowEqualFootprint}));
     PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon()));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
-    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake));
+    const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
+    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup));
     PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
     PIC_TRY(bindShadowConsumers());
     PIC_TRY(mPull->bind(mNodeFlux));

@@ -5,6 +5,7 @@
 /// machine without a GPU that is Mesa's lavapipe.
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -33,6 +34,9 @@ struct GpuRuntimeOptions {
     /// gpu::ContextOptions::mapDeviceMemory: false runs a discrete GPU's staging and
     /// read-back paths on a device whose memory the host could map (tests).
     bool mapDeviceMemory = true;
+    /// Cache lighting gives each cache a subgroup (true) or an invocation (false); unset: a
+    /// subgroup on a GPU, an invocation on a CPU device (gpu::CacheLightingPass::create).
+    std::optional<bool> cachePerSubgroup;
 };
 
 namespace gpu {

@@ -16,8 +16,14 @@ constexpr uint32_t kChunkAlignment = 256;
 }  // namespace
 
 Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
-                                                                     const BakeData& bake) {
+                                                                     const BakeData& bake,
+                                                                     bool cachePerSubgroup) {
     std::unique_ptr<CacheLightingPass> pass(new CacheLightingPass());
+    // Per subgroup: as many caches per workgroup as it has subgroups of the default size (the
+    // shader strides over any the device leaves, should it launch fewer).
+    pass->mCachesPerGroup = cachePerSubgroup
+        ? std::max<uint32_t>(kCacheLightingGroup / context.subgroupSize(), 1)
+        : kCacheLightingGroup;
     const LinkSet& links = bake.links;
     pass->mRtpForm = links.mode == LinkMode::Rtp;
     pass->mCacheCount = uint32_t(bake.caches.size());
@@ -46,7 +52,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     layout.bindings[7] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
     layout.pushBytes = sizeof(CacheLightingPush);
     layout.specialization = {bake.params.bandsY, bake.params.bandsC, links.linksPerCache,
-                             pass->mRtpForm ? kLinkFormRtp : kLinkFormSh};
+                             pass->mRtpForm ? kLinkFormRtp : kLinkFormSh,
+                             cachePerSubgroup ? kCachePerSubgroup : kCachePerInvocation};
     layout.maxSets = std::max<uint32_t>(uint32_t(pass->mChunkFirst.size()), 1);
     PIC_TRY_ASSIGN(pass->mKernel,
                    Kernel::create(context, kSpirvCacheLightingComp, layout, "cache_lighting"));
@@ -101,7 +108,7 @@ void CacheLightingPass::record(VkCommandBuffer cmd) {
     // Chunks write disjoint caches: no barrier between them.
     for (size_t k = 0; k < mSets.size(); ++k) {
         const CacheLightingPush push{mChunkFirst[k], mChunkCount[k], 0, 0};
-        mKernel.dispatch(cmd, mSets[k], &push, groupsFor(push.cacheCount, kCacheLightingGroup));
+        mKernel.dispatch(cmd, mSets[k], &push, groupsFor(push.cacheCount, mCachesPerGroup));
     }
 }
 

@@ -16,7 +16,10 @@ namespace pic::gpu {
 class CacheLightingPass {
 public:
     /// Uploads the links (RTP: 16 bytes each; SH: node index + lY² half coefficients).
-    static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake);
+    /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
+    /// walks them (CPU devices); shaders/shared/cache_lighting.h says why.
+    static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
+                                                             bool cachePerSubgroup);
     /// Binds node flux (vec4 per node), the output caches (half) and the SH tables.
     Result<void> bind(const Buffer& nodeFlux, const Buffer& cacheY, const Buffer& cacheCo,
                       const Buffer& cacheCg, const Buffer& shTables);
@@ -30,6 +33,7 @@ private:
     CacheLightingPass() = default;
     Kernel mKernel;
     bool mRtpForm = true;
+    uint32_t mCachesPerGroup = 1;  ///< caches one workgroup lights
     uint32_t mCacheCount = 0;
     uint32_t mLinksPerCache = 0;
     uint32_t mCountY = 0;

@@ -137,15 +137,17 @@ TEST(GpuPull, NodeFluxIsExact) {
     for (size_t n = 0; n < nodes.size(); ++n) ASSERT_EQ((*pulled)[n], nodes[n]) << "node " << n;
 }
 
-/// Cache lighting for a link form and band split.
+/// Cache lighting for a link form and band split, each cache lit by a subgroup (as on a
+/// GPU) or by an invocation (as on a CPU device).
 class GpuCacheLighting
-    : public testing::TestWithParam<std::tuple<LinkMode, uint32_t, uint32_t>> {};
+    : public testing::TestWithParam<std::tuple<std::tuple<LinkMode, uint32_t, uint32_t>, bool>> {};
 
 TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
-    const auto [mode, bandsY, bandsC] = GetParam();
+    const auto [form, perSubgroup] = GetParam();
+    const auto [mode, bandsY, bandsC] = form;
     const Baked& b = baked("cornell", mode, bandsY, bandsC);
     ASSERT_TRUE(b.ok);
-    auto gpu = gpuFor(b);
+    auto gpu = gpuFor(b, {}, {.cachePerSubgroup = perSubgroup});
     ASSERT_TRUE(gpu);
     const std::vector<glm::vec3> nodes = cpuNodeFlux(b, defaultLightSet(b.scene));
     CacheValues cpu;
@@ -160,9 +162,11 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
 
 INSTANTIATE_TEST_SUITE_P(
     LinkFormsAndBands, GpuCacheLighting,
-    testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u), std::make_tuple(LinkMode::Rtp, 4u, 1u),
-                    std::make_tuple(LinkMode::Rtp, 2u, 2u), std::make_tuple(LinkMode::Sh, 3u, 2u),
-                    std::make_tuple(LinkMode::Sh, 4u, 2u), std::make_tuple(LinkMode::Sh, 1u, 1u)));
+    testing::Combine(
+        testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u), std::make_tuple(LinkMode::Rtp, 4u, 1u),
+                        std::make_tuple(LinkMode::Rtp, 2u, 2u), std::make_tuple(LinkMode::Sh, 3u, 2u),
+                        std::make_tuple(LinkMode::Sh, 4u, 2u), std::make_tuple(LinkMode::Sh, 1u, 1u)),
+        testing::Bool()));
 
 /// Direct surfel flux for a scene and light set.
 void expectDirectMatches(const Baked& b, const LightSet& lights) {
