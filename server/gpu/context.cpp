@@ -405,6 +405,7 @@ Context::~Context() {
     if (mDevice) {
         vkDeviceWaitIdle(mDevice);
         mStaging.reset();
+        mPendingStaging.reset();
         if (mNearestSampler) vkDestroySampler(mDevice, mNearestSampler, nullptr);
         if (mFence) vkDestroyFence(mDevice, mFence, nullptr);
         if (mCommandPool) vkDestroyCommandPool(mDevice, mCommandPool, nullptr);
@@ -513,6 +514,30 @@ Result<void> Context::upload(Buffer& buffer, const void* data, VkDeviceSize byte
         const VkBufferCopy region{0, offset, bytes};
         vkCmdCopyBuffer(cmd, staging->handle(), buffer.handle(), 1, &region);
     });
+}
+
+Result<void> Context::uploadWithNextSubmit(Buffer& buffer, const void* data, VkDeviceSize bytes,
+                                           VkDeviceSize offset) {
+    PIC_CHECK(offset + bytes <= buffer.size());
+    if (buffer.mapped()) {
+        std::memcpy(static_cast<char*>(buffer.mapped()) + offset, data, bytes);
+        return {};
+    }
+    VkDeviceSize start = (mPendingBytes + 15) / 16 * 16;
+    if (start + bytes > mPendingStaging.size()) {
+        // Grow only with nothing pending: an empty submission records what is.
+        if (!mPending.empty()) PIC_TRY(submit([](VkCommandBuffer) {}));
+        if (bytes > mPendingStaging.size()) {
+            mPendingStaging.reset();
+            PIC_TRY_ASSIGN(mPendingStaging, createBuffer(std::bit_ceil(std::max<VkDeviceSize>(bytes, 4096)),
+                                                         0, MemoryUse::Readback, "pending uploads"));
+        }
+        start = 0;
+    }
+    std::memcpy(static_cast<char*>(mPendingStaging.mapped()) + start, data, bytes);
+    mPending.push_back({buffer.handle(), start, offset, bytes});
+    mPendingBytes = start + bytes;
+    return {};
 }
 
 Result<void> Context::download(const Buffer& buffer, void* data, VkDeviceSize bytes,
@@ -815,6 +840,22 @@ Result<void> Context::submit(const std::function<void(VkCommandBuffer)>& record,
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     PIC_VK_TRY(vkBeginCommandBuffer(mCommandBuffer, &begin));
     if (timer) vkCmdResetQueryPool(mCommandBuffer, timer->mPool, 0, 2 * timer->mCapacity);
+    if (!mPending.empty()) {
+        for (const PendingUpload& u : mPending) {
+            const VkBufferCopy region{u.stagingOffset, u.targetOffset, u.bytes};
+            vkCmdCopyBuffer(mCommandBuffer, mPendingStaging.handle(), u.target, 1, &region);
+        }
+        // The uploads land before any later command reads them.
+        VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        barrier.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        vkCmdPipelineBarrier(mCommandBuffer, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &barrier, 0, nullptr, 0,
+                             nullptr);
+        // Recorded: the staging bytes stay untouched until this submission has waited.
+        mPending.clear();
+        mPendingBytes = 0;
+    }
     record(mCommandBuffer);
     if (timer) timer->end(mCommandBuffer);
     PIC_VK_TRY(vkEndCommandBuffer(mCommandBuffer));

@@ -213,6 +213,11 @@ public:
     /// Writes `bytes` of `data` into `buffer` at `offset`.
     Result<void> upload(Buffer& buffer, const void* data, VkDeviceSize bytes,
                         VkDeviceSize offset = 0);
+    /// Writes `bytes` of `data` into `buffer` at `offset` for the next submit(): at once where
+    /// the buffer is mapped, else by a copy recorded at the start of that submission, before
+    /// all it records. Small per-update uploads take no submission of their own this way.
+    Result<void> uploadWithNextSubmit(Buffer& buffer, const void* data, VkDeviceSize bytes,
+                                      VkDeviceSize offset = 0);
     /// Reads `bytes` of `buffer` at `offset` into `data` (waits for nothing: call after the
     /// work that wrote it completed).
     Result<void> download(const Buffer& buffer, void* data, VkDeviceSize bytes,
@@ -279,6 +284,14 @@ private:
     /// kept and grown rather than allocated per transfer: on a discrete GPU an allocation
     /// costs more than the copy.
     Buffer mStaging;
+    /// Uploads waiting for the next submission: their bytes in mPendingStaging.
+    struct PendingUpload {
+        VkBuffer target;
+        VkDeviceSize stagingOffset, targetOffset, bytes;
+    };
+    std::vector<PendingUpload> mPending;
+    Buffer mPendingStaging;
+    VkDeviceSize mPendingBytes = 0;
     bool mMapDeviceMemory = true;
     uint32_t mSubgroupSize = 1;
     bool mLost = false;

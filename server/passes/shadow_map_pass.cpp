@@ -608,9 +608,10 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
 
     const std::vector<GpuLight> records = lightRecords();
     if (!records.empty()) {
-        PIC_TRY(mContext.upload(mLights, records.data(), records.size() * sizeof(GpuLight)));
-        PIC_TRY(mContext.upload(mMatrices, mClipFromWorld.data(),
-                                mClipFromWorld.size() * sizeof(glm::mat4)));
+        PIC_TRY(mContext.uploadWithNextSubmit(mLights, records.data(),
+                                              records.size() * sizeof(GpuLight)));
+        PIC_TRY(mContext.uploadWithNextSubmit(mMatrices, mClipFromWorld.data(),
+                                              mClipFromWorld.size() * sizeof(glm::mat4)));
     }
     return {};
 }

@@ -104,7 +104,7 @@ Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
     std::vector<float> scales(std::max<size_t>(mScene.materials.size(), 1), 1.0f);
     for (size_t m = 0; m < mScene.materials.size(); ++m)
         scales[m] = lights.emissiveScaleOf(mScene.materials[m].name);
-    return mContext.upload(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
+    return mContext.uploadWithNextSubmit(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
 }
 
 void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
