@@ -496,7 +496,8 @@ Result<Buffer> Context::createBufferWith(const void* data, VkDeviceSize bytes,
 Result<Buffer*> Context::staging(VkDeviceSize bytes) {
     if (mStaging.size() < bytes) {
         mStaging.reset();
-        PIC_TRY_ASSIGN(mStaging, createBuffer(std::bit_ceil(bytes), 0, MemoryUse::Readback, "staging"));
+        PIC_TRY_ASSIGN(mStaging,
+                       createBuffer(std::bit_ceil(bytes), 0, MemoryUse::Readback, "staging"));
     }
     return &mStaging;
 }
@@ -529,8 +530,9 @@ Result<void> Context::uploadWithNextSubmit(Buffer& buffer, const void* data, VkD
         if (!mPending.empty()) PIC_TRY(submit([](VkCommandBuffer) {}));
         if (bytes > mPendingStaging.size()) {
             mPendingStaging.reset();
-            PIC_TRY_ASSIGN(mPendingStaging, createBuffer(std::bit_ceil(std::max<VkDeviceSize>(bytes, 4096)),
-                                                         0, MemoryUse::Readback, "pending uploads"));
+            const VkDeviceSize size = std::bit_ceil(std::max<VkDeviceSize>(bytes, 4096));
+            PIC_TRY_ASSIGN(mPendingStaging,
+                           createBuffer(size, 0, MemoryUse::Readback, "pending uploads"));
         }
         start = 0;
     }

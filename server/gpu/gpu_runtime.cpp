@@ -43,7 +43,8 @@ GpuRuntime::~GpuRuntime() = default;
 
 Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& options) {
     using namespace gpu;
-    const ContextOptions contextOptions{options.deviceName, options.validation, options.mapDeviceMemory};
+    const ContextOptions contextOptions{options.deviceName, options.validation,
+                                        options.mapDeviceMemory};
     PIC_TRY_ASSIGN(mContext, Context::create(contextOptions));
     Context& ctx = *mContext;
     const size_t nC = mBake.caches.size();
@@ -57,7 +58,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY_ASSIGN(mCacheCg, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Cg"));
     if (!mCacheY.mapped() || !mCacheCo.mapped() || !mCacheCg.mapped()) {
         const VkDeviceSize bytes = mCacheY.size() + mCacheCo.size() + mCacheCg.size();
-        PIC_TRY_ASSIGN(mCacheReadback, ctx.createBuffer(bytes, 0, MemoryUse::Readback, "cache readback"));
+        PIC_TRY_ASSIGN(mCacheReadback,
+                       ctx.createBuffer(bytes, 0, MemoryUse::Readback, "cache readback"));
     }
     const ShTables tables = makeShTables();
     PIC_TRY_ASSIGN(mShTables, ctx.createBufferWith(&tables, sizeof(tables),
