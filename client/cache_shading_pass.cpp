@@ -9,7 +9,7 @@
 namespace pic::gpu {
 namespace {
 
-/// shaders/cache_shading.comp bindings: four G-buffer samplers, lights, matrices, the shadow
+/// shaders/cache_shading.comp bindings: four G-buffer samplers, lights, shadow layers, the shadow
 /// maps, eight cache-texture buffers, the SH tables and the output.
 constexpr uint32_t kBindingCount = 17;
 constexpr uint32_t kShadowMapBinding = 6;
@@ -94,7 +94,7 @@ Result<void> CacheShadingPass::bind(const CacheShadingResources& r) {
         BindingResource::image(2, r.gbuffer->target(2).view(), sampler),
         BindingResource::image(3, r.gbuffer->target(3).view(), sampler),
         BindingResource::storage(4, r.shadows->lightBuffer()),
-        BindingResource::storage(5, r.shadows->matrixBuffer()),
+        BindingResource::storage(5, r.shadows->layerBuffer()),
         BindingResource::image(kShadowMapBinding, r.shadows->depth().arrayView(), sampler),
         BindingResource::storage(7, mGrid[0]),
         BindingResource::storage(8, mGrid[1]),

@@ -25,7 +25,7 @@ layout(binding = 1) uniform sampler2D gbufferNormalV;
 layout(binding = 2) uniform sampler2D gbufferAlbedo;
 layout(binding = 3) uniform sampler2D gbufferEmission;
 layout(std430, binding = 4) readonly buffer Lights { GpuLight lights[]; };
-layout(std430, binding = 5) readonly buffer LayerMatrices { mat4 clipFromWorld[]; };
+layout(std430, binding = 5) readonly buffer ShadowLayers { GpuShadowLayer shadowLayers[]; };
 layout(binding = 6) uniform sampler2DArray shadowMaps;
 // Cache textures (server/cpu/lightmap_copy.h layout), half floats, coefficient-major layers.
 layout(std430, binding = 7) readonly buffer GridY { float16_t gridY[]; };

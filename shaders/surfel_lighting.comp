@@ -28,7 +28,7 @@ const uint kCountC = kBandsC * kBandsC;
 
 layout(std430, binding = 0) readonly buffer Surfels { Surfel surfels[]; };
 layout(std430, binding = 1) readonly buffer Lights { GpuLight lights[]; };
-layout(std430, binding = 2) readonly buffer LayerMatrices { mat4 clipFromWorld[]; };
+layout(std430, binding = 2) readonly buffer ShadowLayers { GpuShadowLayer shadowLayers[]; };
 layout(std430, binding = 3) readonly buffer EmissiveScale { float emissiveScale[]; };  // per material
 layout(binding = 4) uniform sampler2DArray shadowMaps;
 layout(std430, binding = 5) buffer DirectFlux { vec4 directFlux[]; };   // nS

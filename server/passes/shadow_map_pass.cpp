@@ -26,6 +26,15 @@ uint32_t layersOf(const Light& light) {
     return 1;
 }
 
+/// The cube face (+x, −x, +y, −y, +z, −z: 0–5) that holds the direction `v` from the light:
+/// its major axis, ties to x then y, as shaders/lib/lights.glsl picks it.
+uint32_t cubeFace(const glm::vec3& v) {
+    const glm::vec3 a = glm::abs(v);
+    if (a.x >= a.y && a.x >= a.z) return v.x >= 0.0f ? 0 : 1;
+    if (a.y >= a.z) return v.y >= 0.0f ? 2 : 3;
+    return v.z >= 0.0f ? 4 : 5;
+}
+
 /// `count` points spread over the scene's surfaces by area: stratified along the triangles'
 /// cumulative area, at Halton barycentrics within each triangle.
 std::vector<glm::vec3> surfaceSamples(const Scene& scene, uint32_t count) {
@@ -410,8 +419,8 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
                                             VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "shadow indices"));
     PIC_TRY_ASSIGN(pass->mLights, context.createBuffer(sizeof(GpuLight) * kMaxLights, 0,
                                                        MemoryUse::Device, "lights"));
-    PIC_TRY_ASSIGN(pass->mMatrices, context.createBuffer(sizeof(glm::mat4) * 6 * kMaxLights, 0,
-                                                         MemoryUse::Device, "shadow matrices"));
+    PIC_TRY_ASSIGN(pass->mLayerBuffer, context.createBuffer(sizeof(GpuShadowLayer) * 6 * kMaxLights, 0,
+                                                            MemoryUse::Device, "shadow layers"));
     // A one-layer placeholder keeps descriptor sets valid before the first light arrives.
     PIC_TRY_ASSIGN(pass->mDepth, context.createDepthArray(size, 1));
 
@@ -451,9 +460,9 @@ uint32_t ShadowMapPass::levelFor(const LightSlot& slot, uint32_t layer) const {
     // are one size; a perspective layer's grow with depth from the nearest caster it sees
     // (level 0's clusters, whose bounds are exact).
     const GpuLight& g = slot.gpu;
-    float texel = g.texelSlope;
+    float texel = mLayers[layer].texelSlope;
     if (g.shadowKind != kShadowOrthographic) {
-        const float nearest = nearestClusterDepth(clustersOf(0), mClipFromWorld[layer]);
+        const float nearest = nearestClusterDepth(clustersOf(0), mLayers[layer].clipFromWorld);
         texel *= std::max(nearest, g.depthNear);
     }
     const float allowed = kCasterErrorPerTexel * texel;
@@ -470,11 +479,11 @@ std::vector<GpuLight> ShadowMapPass::lightRecords() const {
 }
 
 VkDeviceSize ShadowMapPass::bytes() const {
-    return mVertices.size() + mIndices.size() + mLights.size() + mMatrices.size() + mDepth.bytes();
+    return mVertices.size() + mIndices.size() + mLights.size() + mLayerBuffer.size() + mDepth.bytes();
 }
 
 ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t firstLayer,
-                                                 std::vector<glm::mat4>& clipFromWorld) const {
+                                                 std::vector<GpuShadowLayer>& layers) const {
     LightSlot slot;
     slot.id = light.id;
     slot.position = light.position;
@@ -497,7 +506,14 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     g.firstLayer = firstLayer;
 
     const float diagonal = std::max(mBounds.diagonal(), 1e-3f);
-    g.side = mSize;
+    const auto addLayer = [&](const glm::mat4& clipFromWorld, float texelSlope, uint32_t side) {
+        slot.sides[layers.size() - firstLayer] = side;
+        GpuShadowLayer record{};
+        record.clipFromWorld = clipFromWorld;
+        record.texelSlope = texelSlope;
+        record.side = side;
+        layers.push_back(record);
+    };
     if (light.type == LightType::Directional) {
         // An orthographic box around the scene's bounding sphere, looking along the light.
         const glm::vec3 centre = mBounds.center();
@@ -507,9 +523,9 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
         g.shadowKind = kShadowOrthographic;
         g.depthNear = 0.0f;
         g.depthFar = 2.02f * radius * 1.01f;
-        g.texelSlope = orthographicTexel();
         slot.eye = ShadowEye{};
-        clipFromWorld.push_back(glm::orthoRH_ZO(-radius, radius, -radius, radius, g.depthNear, g.depthFar) * view);
+        addLayer(glm::orthoRH_ZO(-radius, radius, -radius, radius, g.depthNear, g.depthFar) * view,
+                 orthographicTexel(), mSize);
         return slot;
     }
 
@@ -531,33 +547,34 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
         const float fov = 2.0f * light.outerConeAngle + 0.035f;
         g.shadowKind = kShadowPerspective;
         const float slope = 2.0f * std::tan(0.5f * fov);
-        g.side = perspectiveSide(light, slope);
-        g.texelSlope = slope / float(g.side);
+        const uint32_t side = perspectiveSides(light, slope)[0];
         const glm::mat4 view = glm::lookAtRH(light.position, light.position + light.direction,
                                              upFor(light.direction));
-        clipFromWorld.push_back(glm::perspectiveRH_ZO(fov, 1.0f, g.depthNear, g.depthFar) * view);
+        addLayer(glm::perspectiveRH_ZO(fov, 1.0f, g.depthNear, g.depthFar) * view, slope / float(side), side);
         return slot;
     }
     // Cube faces +x, −x, +y, −y, +z, −z: 90° frusta whose union is every direction; the
     // surfel-lighting pass picks the face by the major axis of (p − light).
     g.shadowKind = kShadowCube;
-    g.side = perspectiveSide(light, 2.0f);
-    g.texelSlope = 2.0f / float(g.side);
+    const std::array<uint32_t, 6> sides = perspectiveSides(light, 2.0f);
     const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     const glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, g.depthNear, g.depthFar);
-    for (const glm::vec3& axis : axes)
-        clipFromWorld.push_back(projection *
-                                glm::lookAtRH(light.position, light.position + axis, upFor(axis)));
+    for (uint32_t face = 0; face < 6; ++face)
+        addLayer(projection * glm::lookAtRH(light.position, light.position + axes[face], upFor(axes[face])),
+                 2.0f / float(sides[face]), sides[face]);
     return slot;
 }
 
-uint32_t ShadowMapPass::perspectiveSide(const Light& light, float slopeAtOneTexel) const {
-    if (mSurfaceSamples.empty()) return mSize;
-    // The samples the light can reach (occlusion aside): within its range and, for spots,
-    // its outer cone.
+std::array<uint32_t, 6> ShadowMapPass::perspectiveSides(const Light& light, float slopeAtOneTexel) const {
+    std::array<uint32_t, 6> sides;
+    sides.fill(mSize);
+    if (mSurfaceSamples.empty()) return sides;
+    // The samples the light can reach (occlusion aside), within its range and, for spots,
+    // its outer cone, each on the layer that holds it: a cube's face by the major axis of
+    // (p − light), as surfel lighting picks it; a narrow spot's only layer.
+    const bool cube = layersOf(light) == 6;
     const float cosOuter = std::cos(light.outerConeAngle);
-    std::vector<float> distances;
-    distances.reserve(mSurfaceSamples.size());
+    std::array<std::vector<float>, 6> distances;
     for (const glm::vec3& p : mSurfaceSamples) {
         const glm::vec3 offset = p - light.position;
         const float distance = glm::length(offset);
@@ -565,21 +582,28 @@ uint32_t ShadowMapPass::perspectiveSide(const Light& light, float slopeAtOneTexe
         if (std::isfinite(light.range) && light.range > 0.0f && distance >= light.range) continue;
         if (light.type == LightType::Spot && glm::dot(offset, light.direction) < cosOuter * distance)
             continue;
-        distances.push_back(distance);
+        distances[cube ? cubeFace(offset) : 0].push_back(distance);
     }
-    if (distances.empty()) return kMinShadowSide;  // the map is never sampled where lit
-    const auto median = distances.begin() + distances.size() / 2;
-    std::nth_element(distances.begin(), median, distances.end());
-    return footprintSide(slopeAtOneTexel, *median, orthographicTexel(), mSize);
+    for (uint32_t layer = 0; layer < (cube ? 6u : 1u); ++layer) {
+        std::vector<float>& d = distances[layer];
+        if (d.empty()) {  // the layer is never sampled where lit
+            sides[layer] = kMinShadowSide;
+            continue;
+        }
+        const auto median = d.begin() + d.size() / 2;
+        std::nth_element(d.begin(), median, d.end());
+        sides[layer] = footprintSide(slopeAtOneTexel, *median, orthographicTexel(), mSize);
+    }
+    return sides;
 }
 
 Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
     reallocated = false;
     std::vector<LightSlot> next;
-    std::vector<glm::mat4> matrices;
+    std::vector<GpuShadowLayer> layerRecords;
     uint32_t layer = 0;
     for (const Light& light : lights.lights) {
-        LightSlot slot = describe(light, layer, matrices);
+        LightSlot slot = describe(light, layer, layerRecords);
         layer += slot.layers;
         next.push_back(std::move(slot));
     }
@@ -598,20 +622,20 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
         const LightSlot& old = mCurrent[i];
         slot.dirty = !(old.id == slot.id && old.type == slot.type &&
                        old.gpu.firstLayer == slot.gpu.firstLayer && old.layers == slot.layers &&
-                       old.gpu.side == slot.gpu.side &&
+                       old.sides == slot.sides &&
                        old.position == slot.position && old.direction == slot.direction &&
                        old.outerConeAngle == slot.outerConeAngle && !old.dirty);
     }
     mCurrent = std::move(next);
-    mClipFromWorld = std::move(matrices);
-    mLayerLevels.resize(mClipFromWorld.size(), 0);
+    mLayers = std::move(layerRecords);
+    mLayerLevels.resize(mLayers.size(), 0);
 
     const std::vector<GpuLight> records = lightRecords();
     if (!records.empty()) {
         PIC_TRY(mContext.uploadWithNextSubmit(mLights, records.data(),
                                               records.size() * sizeof(GpuLight)));
-        PIC_TRY(mContext.uploadWithNextSubmit(mMatrices, mClipFromWorld.data(),
-                                              mClipFromWorld.size() * sizeof(glm::mat4)));
+        PIC_TRY(mContext.uploadWithNextSubmit(mLayerBuffer, mLayers.data(),
+                                              mLayers.size() * sizeof(GpuShadowLayer)));
     }
     return {};
 }
@@ -623,7 +647,7 @@ void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint3
     const VkRect2D scissor{{0, 0}, {side, side}};
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
-    const ShadowMapPush push{mClipFromWorld[layer]};
+    const ShadowMapPush push{mLayers[layer].clipFromWorld};
     vkCmdPushConstants(cmd, mPipelineLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
     const VkBuffer vertices = mVertices.handle();
     const VkDeviceSize zero = 0;
@@ -672,20 +696,21 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
             depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
             depth.clearValue.depthStencil = {1.0f, 0};
             VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-            rendering.renderArea = {{0, 0}, {slot.gpu.side, slot.gpu.side}};
+            const uint32_t side = mLayers[layer].side;
+            rendering.renderArea = {{0, 0}, {side, side}};
             rendering.layerCount = 1;
             rendering.pDepthAttachment = &depth;
             vkCmdBeginRendering(cmd, &rendering);
-            mRenderedTexels += uint64_t(slot.gpu.side) * slot.gpu.side;
+            mRenderedTexels += uint64_t(side) * side;
             const uint32_t level = levelFor(slot, layer);
             mLayerLevels[layer] = level;
-            const auto ranges = visibleTriangleRanges(clustersOf(level), mClipFromWorld[layer], slot.eye);
+            const auto ranges = visibleTriangleRanges(clustersOf(level), mLayers[layer].clipFromWorld, slot.eye);
             for (const bool oneSided : {true, false}) {
                 bool bound = false;
                 for (const TriangleRange& range : ranges) {
                     if (range.oneSided != oneSided) continue;
                     if (!bound) {
-                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer, slot.gpu.side);
+                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer, side);
                         bound = true;
                     }
                     vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);

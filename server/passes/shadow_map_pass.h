@@ -13,6 +13,7 @@
 /// equalFootprint): each light then renders and samples the top-left side × side texels.
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -134,9 +135,10 @@ struct ShadowMapOptions {
     bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
     bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
     bool levelsOfDetail = true;  ///< layers whose texels are coarse draw simplified casters
-    /// Every layer `size` texels wide (false), or perspective layers only as wide as needed
-    /// for texels, at the median distance of the scene's surfaces from the light (within its
-    /// range and cone), as wide as an orthographic layer's over the scene (at most `size`).
+    /// Every layer `size` texels wide (false), or each perspective layer only as wide as
+    /// needed for texels, at the median distance from the light of the scene's surfaces that
+    /// layer holds (within the light's range and cone), as wide as an orthographic layer's
+    /// over the scene (at most `size`).
     /// Off for pixels (a camera may look at the nearest surfaces); on for surfels, which are
     /// spread over the surfaces by area.
     bool equalFootprint = false;
@@ -192,10 +194,12 @@ public:
     std::span<const uint32_t> layerLevels() const { return mLayerLevels; }
     /// The GpuLight records of the lights prepare() laid out, in order.
     std::vector<GpuLight> lightRecords() const;
+    /// The records of the layers prepare() laid out (GpuLight::firstLayer indexes them).
+    std::span<const GpuShadowLayer> layerRecords() const { return mLayers; }
     uint32_t size() const { return mSize; }
     const DepthArray& depth() const { return mDepth; }
     const Buffer& lightBuffer() const { return mLights; }     ///< GpuLight[kMaxLights]
-    const Buffer& matrixBuffer() const { return mMatrices; }  ///< mat4[6·kMaxLights]
+    const Buffer& layerBuffer() const { return mLayerBuffer; }  ///< GpuShadowLayer[6·kMaxLights]
     uint32_t lightCount() const { return uint32_t(mCurrent.size()); }
     /// Bytes of GPU memory held (geometry, depth image, light records).
     VkDeviceSize bytes() const;
@@ -210,6 +214,7 @@ private:
         float outerConeAngle = 0.0f;
         LightType type = LightType::Point;
         uint32_t layers = 0;
+        std::array<uint32_t, 6> sides{};  ///< of its layers, in texels
         ShadowEye eye;
         bool dirty = true;
     };
@@ -217,15 +222,16 @@ private:
     ShadowMapPass(Context& context) : mContext(context) {}
     /// Binds `pipeline` with layer `layer`'s matrix and geometry and a side × side viewport.
     void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer, uint32_t side) const;
-    /// The side of `light`'s perspective layers (slopeAtOneTexel: 2·tan(fov/2)): with
-    /// equalFootprint, the one whose texels at the median distance of the surface samples the
-    /// light reaches are as wide as an orthographic layer's; otherwise mSize.
-    uint32_t perspectiveSide(const Light& light, float slopeAtOneTexel) const;
+    /// The sides of `light`'s perspective layers (a spot's one layer first; slopeAtOneTexel:
+    /// 2·tan(fov/2)): with equalFootprint, each the one whose texels, at the median distance
+    /// of the surface samples the light reaches on that layer, are as wide as an
+    /// orthographic layer's (kMinShadowSide for a layer that holds none); otherwise mSize.
+    std::array<uint32_t, 6> perspectiveSides(const Light& light, float slopeAtOneTexel) const;
     /// Metres per texel of an orthographic layer: its box spans the scene's bounding sphere
     /// with a 1 % margin.
     float orthographicTexel() const { return 1.01f * std::max(mBounds.diagonal(), 1e-3f) / float(mSize); }
     LightSlot describe(const Light& light, uint32_t firstLayer,
-                       std::vector<glm::mat4>& clipFromWorld) const;
+                       std::vector<GpuShadowLayer>& layers) const;
     /// The coarsest level whose error layer `layer` of `slot` allows everywhere it looks.
     uint32_t levelFor(const LightSlot& slot, uint32_t layer) const;
     std::span<const TriangleCluster> clustersOf(uint32_t level) const {
@@ -242,14 +248,14 @@ private:
     Buffer mVertices;
     Buffer mIndices;
     Buffer mLights;
-    Buffer mMatrices;
+    Buffer mLayerBuffer;
     DepthArray mDepth;
     VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
     VkPipeline mPipeline = VK_NULL_HANDLE;         ///< both faces
     VkPipeline mOneSidedPipeline = VK_NULL_HANDLE;  ///< faces looking towards the light
     uint32_t mSolidTriangles = 0;
     std::vector<LightSlot> mCurrent;
-    std::vector<glm::mat4> mClipFromWorld;  ///< per layer
+    std::vector<GpuShadowLayer> mLayers;
     uint32_t mRenderedLights = 0;
     uint64_t mDrawnTriangles = 0;
     uint64_t mRenderedTexels = 0;

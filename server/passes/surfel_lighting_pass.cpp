@@ -81,7 +81,7 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::storage(0, mSurfels),
         BindingResource::storage(1, r.shadows->lightBuffer()),
-        BindingResource::storage(2, r.shadows->matrixBuffer()),
+        BindingResource::storage(2, r.shadows->layerBuffer()),
         BindingResource::storage(3, mEmissiveScale),
         BindingResource::image(4, r.shadows->depth().arrayView(), mContext.nearestSampler()),
         BindingResource::storage(5, mDirectFlux),

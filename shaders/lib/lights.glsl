@@ -1,6 +1,6 @@
 // Punctual lights and their shadow maps (shaders/shared/shadow_map.h) on the GPU, shared by
 // every pass that lights a surface point. The includer declares `GpuLight`'s header, the
-// per-layer matrices as `clipFromWorld[]` and the depth array as `sampler2DArray shadowMaps`.
+// per-layer records as `GpuShadowLayer shadowLayers[]` and the depth array as `sampler2DArray shadowMaps`.
 
 /// core/light_set.h lightIrradiance: irradiance on a surface at p with normal n, the unit
 /// direction to the light and its distance (∞ for directional lights).
@@ -56,17 +56,18 @@ bool shadowVisible(GpuLight light, vec3 p, vec3 n, float cosTheta, float epsilon
         layer += face;
     }
     const bool ortho = light.shadowKind == kShadowOrthographic;
-    const mat4 m = clipFromWorld[layer];
+    const GpuShadowLayer shadowLayer = shadowLayers[layer];
+    const mat4 m = shadowLayer.clipFromWorld;
     const float depthP = ortho ? light.depthNear + (m * vec4(p, 1.0)).z * (light.depthFar - light.depthNear)
                                : (m * vec4(p, 1.0)).w;
-    const float texel = ortho ? light.texelSlope : light.texelSlope * max(depthP, 0.0);
+    const float texel = ortho ? shadowLayer.texelSlope : shadowLayer.texelSlope * max(depthP, 0.0);
     const float tanTheta = sqrt(max(1.0 - cosTheta * cosTheta, 0.0)) / max(cosTheta, 1e-4);
     const vec3 q = p + n * (epsilon + texel);
     const vec4 clip = m * vec4(q, 1.0);
     if (!ortho && clip.w <= 0.0) return true;  // behind the light's near plane
     const vec3 ndc = clip.xyz / clip.w;
     const vec2 uv = ndc.xy * 0.5 + 0.5;
-    const int size = int(light.side);
+    const int size = int(shadowLayer.side);
     const ivec2 xy = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
     const float stored = texelFetch(shadowMaps, ivec3(xy, int(layer)), 0).r;
     if (stored >= 1.0) return true;  // nothing drawn there: the far plane

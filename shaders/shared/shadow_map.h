@@ -27,11 +27,22 @@ struct GpuLight {
     uint firstLayer;     // its first layer in the depth array
     float depthNear;     // metres: perspective near plane, or orthographic depth of z = 0
     float depthFar;      // metres: perspective far plane, or orthographic depth of z = 1
-    float texelSlope;    // perspective: texel width per metre of depth; ortho: texel width (m)
     uint hardCone;       // spot: 1 when inner ≥ outer (hard edge)
-    uint side;           // texels per side of its layers: each uses its top-left side × side
+    uint pad0;
+    uint pad1;
 };
 PIC_STRUCT_CHECK(GpuLight, 80);
+
+// One layer of the depth array as the passes that sample it read it. Layers of one light
+// may differ in side: each is as wide as its own receivers need (footprint sides).
+struct GpuShadowLayer {
+    mat4 clipFromWorld;
+    float texelSlope;  // perspective: texel width per metre of depth; ortho: texel width (m)
+    uint side;         // texels per side: the layer uses its top-left side × side texels
+    uint pad0;
+    uint pad1;
+};
+PIC_STRUCT_CHECK(GpuShadowLayer, 80);
 
 // Push constants of the rasteriser: one layer's clip-from-world matrix.
 struct ShadowMapPush {
