@@ -88,6 +88,11 @@ int picbenchMain(int argc, char** argv) {
                "perspective shadow-map layers: footprint (as wide as gives the orthographic texel at "
                "the median surface distance) or uniform (all --shadow-map-size; default footprint)")
         ->check(CLI::IsMember({"footprint", "uniform"}));
+    runtime
+        ->add_option("--visibility", runtimeParams.visibilities,
+                     "direct visibility of the GPU backend, one runtime each: auto (rays on a "
+                     "CPU device, shadow maps on a GPU), shadow-maps, rays (default: auto)")
+        ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
     runtime->add_option("--changes", runtimeParams.changes,
                         "light changes: move-all, move-one, recolour (default: all three)")
         ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));

@@ -68,6 +68,7 @@ struct BackendFigures {
     int bounces = 0;
     uint64_t shadowTriangles = 0;  ///< GPU: triangles rasterised per update, after culling
     uint64_t shadowTexels = 0;     ///< GPU: texels of the layers rendered per update
+    int lightsTraced = 0;          ///< GPU, rays: lights whose rays each update traced
 };
 
 Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step,
@@ -82,6 +83,7 @@ Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int r
         figures.bounces = stats.bounces;
         figures.shadowTriangles = stats.shadowTriangles;
         figures.shadowTexels = stats.shadowTexels;
+        figures.lightsTraced = stats.lightsTraced;
     }
     return figures;
 }
@@ -114,6 +116,7 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     json["bounces"] = f.bounces;
     json["shadow_triangles"] = f.shadowTriangles;
     json["shadow_texels"] = f.shadowTexels;
+    json["lights_traced"] = f.lightsTraced;
     json["pass_ms_median"] = nlohmann::ordered_json::object();
     for (const auto& [pass, ms] : f.passMs) json["pass_ms_median"][pass] = median(ms);
     return json;
@@ -138,9 +141,9 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
     json["floor"] = floorName;
     json["floor_bytes_per_second"] = bandwidth;
     json["runs"] = nlohmann::ordered_json::array();
-    std::printf("%-9s %-4s %-7s %-8s %6s %9s %9s %6s %9s %8s %8s %9s %9s %9s %8s\n", "setting",
-                "link", "bounces", "change", "nC", "cpu ms", "gpu ms", "ratio", "shadow", "k tris",
-                "M texels", "surfels", "pull", "caches*", "bw ratio");
+    std::printf("%-9s %-4s %-7s %-8s %-5s %6s %9s %9s %6s %9s %8s %8s %9s %9s %9s %8s\n", "setting",
+                "link", "bounces", "change", "vis", "nC", "cpu ms", "gpu ms", "ratio", "vis ms",
+                "k tris", "M texels", "surfels", "pull", "caches*", "bw ratio");
     for (const std::string& setting : params.settings) {
         for (const std::string& linkMode : params.linkModes) {
             BakeReport bakeReport;
@@ -151,74 +154,99 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                 const BounceParams bounceParams{bounces};
                 auto cpu = createCpuRuntime(scene, *inputs->rays, *bake, bounceParams);
                 if (!cpu) return reportError(cpu.error());
-                GpuRuntimeOptions options;
-                options.deviceName = params.device;
-                options.shadowMapSize = params.shadowMapSize;
-                options.shadowEqualFootprint = params.shadowEqualFootprint;
-                auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
-                if (!gpu) return reportError(gpu.error());
-                auto cacheWall = timeCacheLighting(**gpu, scene, *inputs->rays, *bake, inputs->lights,
-                                                   params.repeat);
-                if (!cacheWall) return reportError(cacheWall.error());
-                const double cacheWallMs = median(*cacheWall);
-                const double linkBytes = double((*gpu)->linkBytesPerBounce());
-                for (const std::string& change : params.changes) {
-                    auto cpuFigures = timeBackend(**cpu, inputs->lights, params.repeat, step, change);
-                    if (!cpuFigures) return reportError(cpuFigures.error());
-                    auto gpuFigures = timeBackend(**gpu, inputs->lights, params.repeat, step, change);
-                    if (!gpuFigures) return reportError(gpuFigures.error());
-                    const auto passMedian = [&](const BackendFigures& f, const char* pass) {
-                        auto it = f.passMs.find(pass);
-                        return it == f.passMs.end() ? 0.0 : median(it->second);
-                    };
-                    const double cpuMs = median(cpuFigures->totalMs), gpuMs = median(gpuFigures->totalMs);
-                    // Link bytes per second of one cache-lighting pass: every link is read
-                    // once per bounce. Timestamps where they are honest, else wall clock.
-                    const double cacheMs = floor->deviceCopy
-                        ? passMedian(*gpuFigures, "cache_lighting") / std::max(gpuFigures->bounces, 1)
-                        : cacheWallMs;
-                    const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
-                    std::printf("%-9s %-4s %-7d %-8s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %8.2f %9.1f %9.1f %9.1f %8.2f\n",
-                                setting.c_str(), linkMode.c_str(), gpuFigures->bounces, change.c_str(),
-                                bake->caches.size(), cpuMs, gpuMs, gpuMs / cpuMs,
-                                passMedian(*gpuFigures, "shadow_maps"),
-                                double(gpuFigures->shadowTriangles) * 1e-3,
-                                double(gpuFigures->shadowTexels) * 1e-6,
-                                passMedian(*gpuFigures, "surfel_lighting"),
-                                passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
+                for (const std::string& visibility : params.visibilities) {
+                    GpuRuntimeOptions options;
+                    options.deviceName = params.device;
+                    options.shadowMapSize = params.shadowMapSize;
+                    options.shadowEqualFootprint = params.shadowEqualFootprint;
+                    auto parsed = gpu::parseDirectVisibility(visibility);
+                    if (!parsed) return reportError(parsed.error());
+                    options.directVisibility = *parsed;
+                    auto gpu =
+                        GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
+                    if (!gpu) return reportError(gpu.error());
+                    const bool rays = (*gpu)->directVisibility() == gpu::DirectVisibility::Rays;
+                    auto cacheWall = timeCacheLighting(**gpu, scene, *inputs->rays, *bake,
+                                                       inputs->lights, params.repeat);
+                    if (!cacheWall) return reportError(cacheWall.error());
+                    const double cacheWallMs = median(*cacheWall);
+                    const double linkBytes = double((*gpu)->linkBytesPerBounce());
+                    for (const std::string& change : params.changes) {
+                        auto cpuFigures =
+                            timeBackend(**cpu, inputs->lights, params.repeat, step, change);
+                        if (!cpuFigures) return reportError(cpuFigures.error());
+                        auto gpuFigures =
+                            timeBackend(**gpu, inputs->lights, params.repeat, step, change);
+                        if (!gpuFigures) return reportError(gpuFigures.error());
+                        const auto passMedian = [&](const BackendFigures& f, const char* pass) {
+                            auto it = f.passMs.find(pass);
+                            return it == f.passMs.end() ? 0.0 : median(it->second);
+                        };
+                        const double cpuMs = median(cpuFigures->totalMs),
+                                     gpuMs = median(gpuFigures->totalMs);
+                        // Link bytes per second of one cache-lighting pass: every link is read
+                        // once per bounce. Timestamps where they are honest, else wall clock.
+                        const double cacheMs = floor->deviceCopy
+                                                   ? passMedian(*gpuFigures, "cache_lighting") /
+                                                         std::max(gpuFigures->bounces, 1)
+                                                   : cacheWallMs;
+                        const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
+                        std::printf(
+                            "%-9s %-4s %-7d %-8s %-5s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %8.2f "
+                            "%9.1f %9.1f %9.1f %8.2f\n",
+                            setting.c_str(), linkMode.c_str(), gpuFigures->bounces, change.c_str(),
+                            rays ? "rays" : "maps", bake->caches.size(), cpuMs, gpuMs,
+                            gpuMs / cpuMs,
+                            passMedian(*gpuFigures, rays ? "visibility_rays" : "shadow_maps"),
+                            double(gpuFigures->shadowTriangles) * 1e-3,
+                            double(gpuFigures->shadowTexels) * 1e-6,
+                            passMedian(*gpuFigures, "surfel_lighting"),
+                            passMedian(*gpuFigures, "pull"), cacheMs, linkRate / bandwidth);
 
-                    nlohmann::ordered_json run;
-                    run["setting"] = setting;
-                    run["link_mode"] = linkMode;
-                    run["bounces_requested"] = bounces;
-                    run["change"] = change;
-                    run["surfels"] = bake->surfels.size();
-                    run["caches"] = bake->caches.size();
-                    run["links_per_cache"] = bake->links.linksPerCache;
-                    run["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
-                    run["device"] = (*gpu)->context().deviceName();
-                    run["shadow_map_size"] = params.shadowMapSize;
-                    run["shadow_sides"] = params.shadowEqualFootprint ? "footprint" : "uniform";
-                    run["cpu"] = figuresJson(*cpuFigures);
-                    run["gpu"] = figuresJson(*gpuFigures);
-                    run["gpu_over_cpu"] = gpuMs / cpuMs;
-                    run["cache_lighting_wall_ms_median"] = cacheWallMs;
-                    run["cache_lighting_ms"] = cacheMs;
-                    run["cache_lighting_timing"] = floor->deviceCopy ? "timestamps" : "wall clock";
-                    run["link_bytes_per_bounce"] = linkBytes;
-                    run["cache_lighting_bytes_per_second"] = linkRate;
-                    run["bandwidth_ratio"] = linkRate / bandwidth;
-                    run["gpu_memory_bytes"] = nlohmann::ordered_json::object();
-                    for (const auto& [buffer, bytes] : (*gpu)->memory()) run["gpu_memory_bytes"][buffer] = bytes;
-                    json["runs"].push_back(run);
+                        nlohmann::ordered_json run;
+                        run["setting"] = setting;
+                        run["link_mode"] = linkMode;
+                        run["bounces_requested"] = bounces;
+                        run["change"] = change;
+                        run["surfels"] = bake->surfels.size();
+                        run["caches"] = bake->caches.size();
+                        run["links_per_cache"] = bake->links.linksPerCache;
+                        run["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
+                        run["device"] = (*gpu)->context().deviceName();
+                        run["direct_visibility"] =
+                            gpu::directVisibilityName((*gpu)->directVisibility());
+                        if (!rays) {
+                            run["shadow_map_size"] = params.shadowMapSize;
+                            run["shadow_sides"] =
+                                params.shadowEqualFootprint ? "footprint" : "uniform";
+                        }
+                        run["cpu"] = figuresJson(*cpuFigures);
+                        run["gpu"] = figuresJson(*gpuFigures);
+                        run["gpu_over_cpu"] = gpuMs / cpuMs;
+                        run["cache_lighting_wall_ms_median"] = cacheWallMs;
+                        run["cache_lighting_ms"] = cacheMs;
+                        run["cache_lighting_timing"] =
+                            floor->deviceCopy ? "timestamps" : "wall clock";
+                        run["link_bytes_per_bounce"] = linkBytes;
+                        run["cache_lighting_bytes_per_second"] = linkRate;
+                        run["bandwidth_ratio"] = linkRate / bandwidth;
+                        run["gpu_memory_bytes"] = nlohmann::ordered_json::object();
+                        for (const auto& [buffer, bytes] : (*gpu)->memory())
+                            run["gpu_memory_bytes"][buffer] = bytes;
+                        json["runs"].push_back(run);
+                    }
                 }
             }
         }
     }
-    std::printf("ms: medians per update; shadow, surfels, pull from GPU timestamps; caches* is one\n"
-                "cache-lighting pass, %s; bw ratio: its link bytes per second over %s\n",
-                floor->deviceCopy ? "by timestamps" : "by wall clock (lavapipe's timestamps do not wait for it)",
-                floorName);
+    std::printf(
+        "ms: medians per update; vis: the direct light's visibility, shadow maps (GPU\n"
+        "timestamps) or rays traced on the host (wall clock); surfels, pull from GPU\n"
+        "timestamps; caches* is one cache-lighting pass, %s; bw ratio: its link bytes per\n"
+        "second over %s\n",
+        floor->deviceCopy ? "by timestamps"
+                          : "by wall clock (lavapipe's timestamps do not wait for it)",
+        floorName);
     return writeJson(json, params.jsonPath);
 }
 
@@ -241,6 +269,68 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
     json["runs"] = nlohmann::ordered_json::array();
     std::printf("%-6s %-9s %9s %10s %10s %10s %12s %12s\n", "size", "sides", "M texels", "gpu ms",
                 "cpu ms", "gpu/cpu", "rel L1", "surfels >1%");
+    // Wall-clock ms of the GPU's direct light (every light's visibility and surfel lighting,
+    // read-back included) against the CPU twin's rays, and how far its flux is from theirs.
+    const auto measure = [&](const GpuRuntimeOptions& options) -> Result<nlohmann::ordered_json> {
+        PIC_TRY_ASSIGN(auto gpu,
+                       GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options));
+        std::vector<double> gpuMs, cpuMs;
+        double l1 = 0.0, norm = 0.0;
+        size_t differing = 0, compared = 0;
+        uint64_t texels = 0;
+        for (int k = 0; k <= params.repeat; ++k) {  // k = 0 warms up
+            // Every light moves, so every shadow map is rendered (every light traced) each time.
+            const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
+            UpdateStats stats;
+            Clock::time_point start = Clock::now();
+            PIC_TRY_ASSIGN(std::vector<glm::vec3> direct, gpu->runDirect(lights, &stats));
+            const double g =
+                std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+            texels = stats.shadowTexels;
+            std::vector<glm::vec3> rays(nS);
+            start = Clock::now();
+            directSurfelFlux(scene, *inputs->rays, *bake, lights, rays);
+            const double c =
+                std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+            if (k == 0) continue;
+            gpuMs.push_back(g);
+            cpuMs.push_back(c);
+            float brightest = 0.0f;
+            for (const glm::vec3& f : rays) brightest = std::max({brightest, f.r, f.g, f.b});
+            for (size_t i = 0; i < nS; ++i) {
+                bool differs = false;
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double d = std::abs(double(direct[i][ch]) - double(rays[i][ch]));
+                    l1 += d;
+                    norm += std::abs(double(rays[i][ch]));
+                    differs |=
+                        d > 0.01 * std::max(std::abs(rays[i][ch]), std::abs(direct[i][ch])) &&
+                        d > 1e-6 * brightest;
+                }
+                differing += differs;
+            }
+            compared += nS;
+        }
+        nlohmann::ordered_json row;
+        row["direct_visibility"] = gpu::directVisibilityName(gpu->directVisibility());
+        row["texels"] = texels;
+        row["device"] = gpu->context().deviceName();
+        row["gpu_direct_ms_median"] = median(gpuMs);
+        row["cpu_direct_ms_median"] = median(cpuMs);
+        row["gpu_direct_ms"] = gpuMs;
+        row["relative_l1"] = norm > 0.0 ? l1 / norm : 0.0;
+        row["fraction_surfels_differing"] = compared ? double(differing) / double(compared) : 0.0;
+        return row;
+    };
+    const auto printRow = [](const nlohmann::ordered_json& row, const std::string& size,
+                             const std::string& sides) {
+        const double gpuMs = row["gpu_direct_ms_median"], cpuMs = row["cpu_direct_ms_median"];
+        std::printf("%-6s %-9s %9.2f %10.1f %10.1f %10.2f %11.2f%% %11.2f%%\n", size.c_str(),
+                    sides.c_str(), double(row["texels"].get<uint64_t>()) * 1e-6, gpuMs, cpuMs,
+                    gpuMs / cpuMs, 100.0 * row["relative_l1"].get<double>(),
+                    100.0 * row["fraction_surfels_differing"].get<double>());
+    };
+
     std::vector<ChartSeries> series;
     for (const std::string& sides : params.sides) {
         const bool footprint = sides == "footprint";
@@ -254,75 +344,48 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
             options.deviceName = params.device;
             options.shadowMapSize = size;
             options.shadowEqualFootprint = footprint;
-            auto gpu = GpuRuntime::create(scene, *inputs->rays, *bake, BounceParams{1}, options);
-            if (!gpu) return reportError(gpu.error());
-            std::vector<double> gpuMs, cpuMs;
-            double l1 = 0.0, norm = 0.0;
-            size_t differing = 0, compared = 0;
-            uint64_t texels = 0;
-            for (int k = 0; k <= params.repeat; ++k) {  // k = 0 warms up
-                // Every light moves, so every shadow map is rendered in each timed call.
-                const LightSet lights = changedLights(inputs->lights, k, step, "move-all");
-                UpdateStats stats;
-                Clock::time_point start = Clock::now();
-                auto direct = (*gpu)->runDirect(lights, &stats);
-                if (!direct) return reportError(direct.error());
-                const double g = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-                texels = stats.shadowTexels;
-                std::vector<glm::vec3> rays(nS);
-                start = Clock::now();
-                directSurfelFlux(scene, *inputs->rays, *bake, lights, rays);
-                const double c = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-                if (k == 0) continue;
-                gpuMs.push_back(g);
-                cpuMs.push_back(c);
-                float brightest = 0.0f;
-                for (const glm::vec3& f : rays) brightest = std::max({brightest, f.r, f.g, f.b});
-                for (size_t i = 0; i < nS; ++i) {
-                    bool differs = false;
-                    for (int ch = 0; ch < 3; ++ch) {
-                        const double d = std::abs(double((*direct)[i][ch]) - double(rays[i][ch]));
-                        l1 += d;
-                        norm += std::abs(double(rays[i][ch]));
-                        differs |= d > 0.01 * std::max(std::abs(rays[i][ch]), std::abs((*direct)[i][ch])) &&
-                                   d > 1e-6 * brightest;
-                    }
-                    differing += differs;
-                }
-                compared += nS;
-            }
-            const double relL1 = norm > 0.0 ? l1 / norm : 0.0;
-            const double fraction = compared ? double(differing) / double(compared) : 0.0;
-            std::printf("%-6u %-9s %9.2f %10.1f %10.1f %10.2f %11.2f%% %11.2f%%\n", size, sides.c_str(),
-                        double(texels) * 1e-6, median(gpuMs), median(cpuMs),
-                        median(gpuMs) / median(cpuMs), 100.0 * relL1, 100.0 * fraction);
-            nlohmann::ordered_json row;
-            row["size"] = size;
-            row["sides"] = sides;
-            row["texels"] = texels;
-            row["device"] = (*gpu)->context().deviceName();
-            row["gpu_direct_ms_median"] = median(gpuMs);
-            row["cpu_direct_ms_median"] = median(cpuMs);
-            row["gpu_direct_ms"] = gpuMs;
-            row["relative_l1"] = relL1;
-            row["fraction_surfels_differing"] = fraction;
-            json["runs"].push_back(row);
-            tradeoff.points.push_back({median(gpuMs), 100.0 * relL1});
+            options.directVisibility = gpu::DirectVisibility::ShadowMaps;
+            auto row = measure(options);
+            if (!row) return reportError(row.error());
+            printRow(*row, std::to_string(size), sides);
+            (*row)["size"] = size;
+            (*row)["sides"] = sides;
+            tradeoff.points.push_back({(*row)["gpu_direct_ms_median"].get<double>(),
+                                       100.0 * (*row)["relative_l1"].get<double>()});
             tradeoff.labels.push_back(fmt::format("{0}x{0}", size));
-            differingSeries.points.push_back({median(gpuMs), 100.0 * fraction});
+            differingSeries.points.push_back(
+                {(*row)["gpu_direct_ms_median"].get<double>(),
+                 100.0 * (*row)["fraction_surfels_differing"].get<double>()});
+            json["runs"].push_back(std::move(*row));
         }
         series.push_back(tradeoff);
         series.push_back(differingSeries);
     }
-    std::printf("gpu: shadow maps of every light + direct surfel lighting (wall clock, read-back\n"
-                "included); cpu: the twin's rays; errors: GPU direct surfel flux against the rays;\n"
-                "sides: uniform, every layer size²; footprint, perspective layers only as wide as\n"
-                "give an orthographic layer's texel at the median distance of the lit surfaces\n");
+    // The other end of the trade-off: the CPU twin's own rays, traced for the GPU's surfel
+    // lighting (DirectVisibility::Rays), exact by construction.
+    GpuRuntimeOptions rayOptions;
+    rayOptions.deviceName = params.device;
+    rayOptions.directVisibility = gpu::DirectVisibility::Rays;
+    auto rayRow = measure(rayOptions);
+    if (!rayRow) return reportError(rayRow.error());
+    printRow(*rayRow, "-", "rays");
+    series.push_back(ChartSeries{"host rays (exact)",
+                                 glm::vec3(0.2f, 0.6f, 0.3f),
+                                 {{(*rayRow)["gpu_direct_ms_median"].get<double>(),
+                                   100.0 * (*rayRow)["relative_l1"].get<double>()}},
+                                 {"rays"}});
+    json["runs"].push_back(std::move(*rayRow));
+    std::printf(
+        "gpu: shadow maps of every light (rays: every light's rays, traced on the host) +\n"
+        "direct surfel lighting (wall clock, read-back included); cpu: the twin's rays;\n"
+        "errors: GPU direct surfel flux against the rays;\n"
+        "sides: uniform, every layer size²; footprint, perspective layers only as wide as\n"
+        "give an orthographic layer's texel at the median distance of the lit surfaces\n");
     Chart chart;
     chart.title = fmt::format("Shadow-map size: time against error ({} rtp, {})", params.setting,
                               json["runs"].empty() ? std::string("no device")
                                                    : json["runs"][0]["device"].get<std::string>());
-    chart.xLabel = "GPU shadow maps + direct surfel lighting, ms (median)";
+    chart.xLabel = "GPU visibility + direct surfel lighting, ms (median)";
     chart.yLabel = "% of the direct surfel flux against the CPU twin's rays";
     chart.series = std::move(series);
     if (int exit = writeChartFile(chart, chartPathFor(params.jsonPath)); exit != 0) return exit;

@@ -92,6 +92,11 @@ int picserverMain(int argc, char** argv) {
            "directional layer's texel at the median distance of the surfaces they light) or "
            "uniform (every layer --shadow-map-size wide)")
         ->check(CLI::IsMember({"footprint", "uniform"}));
+    app.add_option("--direct-visibility", serve.directVisibility,
+                   "gpu backend: where direct light's visibility comes from: shadow-maps, rays "
+                   "(one ray per surfel and light, traced on the host with Embree: exact) or auto "
+                   "(default: rays on a CPU device such as lavapipe, shadow maps on a GPU)")
+        ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
     app.add_option("--bounces", serve.bounces.bounces,
                    "cache passes per update: 0 = direct light only, B = up to B reflections "
                    "(default: until a bounce adds < 0.5 % of the flux, at most 8)")
@@ -164,11 +169,13 @@ int picserverMain(int argc, char** argv) {
         const v1::BakeSummary& summary = (*bake)->summary();
         std::fprintf(stderr,
                      "picserver: bake %s: %s, %u triangles, %u surfels, %u caches × %u %s links, "
-                     "%s backend%s%s, loaded in %.1f s\n",
+                     "%s backend%s%s%s%s, loaded in %.1f s\n",
                      summary.bake_id().c_str(), summary.scene_name().c_str(), summary.triangles(),
                      summary.surfels(), summary.caches(), summary.links_per_cache(),
                      summary.link_mode().c_str(), serve.backend.c_str(),
                      (*bake)->device().empty() ? "" : " on ", (*bake)->device().c_str(),
+                     (*bake)->directVisibility().empty() ? "" : ", direct visibility by ",
+                     (*bake)->directVisibility().c_str(),
                      std::chrono::duration<double>(Clock::now() - start).count());
         bakes.push_back(std::move(*bake));
     }

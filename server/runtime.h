@@ -31,6 +31,7 @@ struct UpdateStats {
     int shadowMapsRendered = 0;               ///< lights whose shadow maps were re-rendered (GPU)
     uint64_t shadowTriangles = 0;             ///< triangles rasterised into them, after culling (GPU)
     uint64_t shadowTexels = 0;                ///< texels of the layers rendered (GPU)
+    int lightsTraced = 0;  ///< lights whose visibility rays were traced (GPU, rays)
 };
 
 /// A runtime backend over one bake of one scene.

@@ -62,9 +62,12 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
         gpuOptions.deviceName = options.device;
         gpuOptions.shadowMapSize = options.shadowMapSize;
         gpuOptions.shadowEqualFootprint = options.shadowEqualFootprint;
+        PIC_TRY_ASSIGN(gpuOptions.directVisibility,
+                       gpu::parseDirectVisibility(options.directVisibility));
         PIC_TRY_ASSIGN(auto gpu, GpuRuntime::create(served->mScene, *served->mRays, served->mBake,
                                                     options.bounces, gpuOptions));
         served->mDevice = gpu->context().deviceName();
+        served->mDirectVisibility = gpu::directVisibilityName(gpu->directVisibility());
         served->mRuntime = std::move(gpu);
     } else if (options.backend == "cpu") {
         PIC_TRY_ASSIGN(served->mRuntime, createCpuRuntime(served->mScene, *served->mRays,

@@ -24,6 +24,8 @@ struct ServeOptions {
     std::string device;             ///< gpu: substring of the Vulkan device name; empty = best
     uint32_t shadowMapSize = 1024;  ///< gpu: texels per side of each shadow-map layer
     bool shadowEqualFootprint = true;  ///< gpu: GpuRuntimeOptions::shadowEqualFootprint
+    /// gpu: GpuRuntimeOptions::directVisibility as "auto", "shadow-maps" or "rays".
+    std::string directVisibility = "auto";
     BounceParams bounces;           ///< progressive by default, as everywhere
 };
 
@@ -49,6 +51,9 @@ public:
     const std::vector<std::string>& assetBytes() const { return mAssetBytes; }
     /// The Vulkan device of the GPU backend, empty for the CPU twin.
     const std::string& device() const { return mDevice; }
+    /// Where the GPU backend's direct visibility comes from ("shadow-maps", "rays"), empty
+    /// for the CPU twin (which traces rays).
+    const std::string& directVisibility() const { return mDirectVisibility; }
 
     /// Relights the scene with `lights` and copies the resulting textures as half floats, one
     /// session at a time (the runtime keeps per-light state such as shadow maps).
@@ -65,6 +70,7 @@ private:
     std::unique_ptr<Runtime> mRuntime;
     std::mutex mRuntimeMutex;
     std::string mDevice;
+    std::string mDirectVisibility;
     v1::BakeSummary mSummary;
     v1::SceneHeader mHeader;
     std::vector<std::string> mAssetBytes;

@@ -1,6 +1,7 @@
 #version 460
 // Surfel lighting (paper 000 Figure 2 step 2): each leaf surfel's outgoing flux in W per RGB
-// channel. Direct mode: Φ = ρ·A·Σ E_light·V + π·L_e·A·emissiveScale, V from the shadow maps;
+// channel. Direct mode: Φ = ρ·A·Σ E_light·V + π·L_e·A·emissiveScale, V from the shadow maps
+// or, in the rays mode, one bit per surfel and light traced on the host (RayVisibilityPass);
 // bounce mode: Φ = Φ_direct + ρ·A·max(0, E) with E the irradiance the previous bounce's caches
 // deliver at the surfel (its precomputed interpolation stencil). Each workgroup also writes
 // its summed flux for the progressive stop, in one of two slots so that consecutive passes
@@ -39,6 +40,8 @@ layout(std430, binding = 9) readonly buffer CacheCo { float16_t cacheCo[]; };
 layout(std430, binding = 10) readonly buffer CacheCg { float16_t cacheCg[]; };
 layout(std140, binding = 11) uniform Sh { ShTables sh; };
 layout(std430, binding = 12) writeonly buffer GroupFlux { vec4 groupFlux[]; };
+// Rays mode: bit i % 32 of word light·⌈nS/32⌉ + i/32 is set where light reaches surfel i.
+layout(std430, binding = 13) readonly buffer Visibility { uint visibility[]; };
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
@@ -51,7 +54,8 @@ void main() {
     vec3 flux = vec3(0.0);
     if (i < pc.surfelCount) {
         const Surfel surfel = surfels[i];
-        if (kMode == kSurfelModeDirect) {
+        if (kMode != kSurfelModeBounce) {
+            const uint words = (pc.surfelCount + 31u) / 32u;
             vec3 irradiance = vec3(0.0);
             for (uint k = 0u; k < pc.lightCount; ++k) {
                 const GpuLight light = lights[k];
@@ -60,9 +64,12 @@ void main() {
                 const vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
                 // Surfels facing away, outside the cone or past the range need no shadow test.
                 if (!(e.r > 0.0 || e.g > 0.0 || e.b > 0.0)) continue;
-                if (shadowVisible(light, surfel.position, surfel.normal, dot(surfel.normal, toLight),
-                                  pc.epsilon))
-                    irradiance += e;
+                const bool visible =
+                    kMode == kSurfelModeDirectRays
+                        ? (visibility[k * words + (i >> 5u)] & (1u << (i & 31u))) != 0u
+                        : shadowVisible(light, surfel.position, surfel.normal,
+                                        dot(surfel.normal, toLight), pc.epsilon);
+                if (visible) irradiance += e;
             }
             flux = surfel.albedo * (surfel.area * irradiance) +
                    (kPi * surfel.area * emissiveScale[surfel.material]) * surfel.emission;

@@ -42,6 +42,7 @@ struct ShadeCommand {
     std::string backend = "cpu";
     std::string device;              ///< --device: Vulkan device name substring (gpu backend)
     uint32_t shadowMapSize = 1024;   ///< --shadow-map-size (gpu backend)
+    std::string directVisibility = "auto";  ///< --direct-visibility (gpu backend)
     std::string lightsPath;
     std::string cameraText;
     int sceneCameraIndex = -1;  ///< used when --camera is not given
@@ -122,10 +123,14 @@ int runShade(const ShadeCommand& command) {
         GpuRuntimeOptions options;
         options.deviceName = command.device;
         options.shadowMapSize = command.shadowMapSize;
+        auto visibility = gpu::parseDirectVisibility(command.directVisibility);
+        if (!visibility) return reportError(visibility.error());
+        options.directVisibility = *visibility;
         auto gpu = GpuRuntime::create(*scene, **rays, *bake, BounceParams{command.bounces}, options);
         if (!gpu) return reportError(gpu.error());
-        std::fprintf(stderr, "picref shade: GPU backend on \"%s\"\n",
-                     (*gpu)->context().deviceName().c_str());
+        std::fprintf(stderr, "picref shade: GPU backend on \"%s\", direct visibility by %s\n",
+                     (*gpu)->context().deviceName().c_str(),
+                     gpu::directVisibilityName((*gpu)->directVisibility()));
         runtime = std::unique_ptr<Runtime>(std::move(*gpu));
     } else {
         runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{command.bounces});
@@ -180,6 +185,10 @@ int picrefShadeMain(int argc, char** argv) {
                    "GPU, else integrated, else lavapipe)");
     app.add_option("--shadow-map-size", command.shadowMapSize,
                    "gpu backend: texels per side of each shadow-map layer (default 1024)");
+    app.add_option("--direct-visibility", command.directVisibility,
+                   "gpu backend: shadow-maps, rays (traced on the host) or auto (default: rays on "
+                   "a CPU device, shadow maps on a GPU)")
+        ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
     app.add_option("--lights", command.lightsPath, "light set JSON (default: the scene's lights)");
     auto* cameraOption = app.add_option("--camera", command.cameraText,
                                         "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");

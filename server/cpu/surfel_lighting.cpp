@@ -16,6 +16,19 @@ constexpr float kPi = std::numbers::pi_v<float>;
 /// Surfels per task: a surfel costs one shadow ray per light or one cache lookup.
 constexpr size_t kSurfelGrain = 256;
 
+/// E_light·V at `surfel`: the light's irradiance there, or zero where the surfel faces away,
+/// lies outside the cone or range (no ray is cast) or the ray to the light is occluded. Rays
+/// start just above the surface so that they do not hit the surfel's own triangle.
+glm::vec3 visibleIrradiance(const EmbreeScene& rays, const Surfel& surfel, const Light& light) {
+    glm::vec3 toLight;
+    float distance = 0.0f;
+    const glm::vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
+    if (!(e.r > 0.0f || e.g > 0.0f || e.b > 0.0f)) return glm::vec3(0.0f);
+    const float epsilon = rays.epsilon();
+    const glm::vec3 origin = surfel.position + epsilon * surfel.normal;
+    return rays.occluded(origin, toLight, 0.0f, distance - epsilon) ? glm::vec3(0.0f) : e;
+}
+
 }  // namespace
 
 void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
@@ -25,30 +38,42 @@ void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeDat
     std::vector<float> emissiveScale(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m)
         emissiveScale[m] = lights.emissiveScaleOf(scene.materials[m].name);
-    const float epsilon = rays.epsilon();
 
     parallelFor(0, bake.surfels.size(), [&](size_t i) {
         const Surfel& surfel = bake.surfels[i];
         PIC_DCHECK(surfel.material < emissiveScale.size());
-        // Rays start just above the surface so that they do not hit the surfel's own triangle.
-        const glm::vec3 origin = surfel.position + epsilon * surfel.normal;
         glm::vec3 irradiance(0.0f);
-        for (const Light& light : lights.lights) {
-            glm::vec3 toLight;
-            float distance = 0.0f;
-            const glm::vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight,
-                                                distance);
-            // Surfels facing away from the light or outside its cone or range cast no ray.
-            if (!(e.r > 0.0f || e.g > 0.0f || e.b > 0.0f)) continue;
-            if (rays.occluded(origin, toLight, 0.0f, distance - epsilon)) continue;
-            irradiance += e;
-        }
+        for (const Light& light : lights.lights)
+            irradiance += visibleIrradiance(rays, surfel, light);
         // Lambertian reflection of the direct light plus the material's own emission, both as
         // flux leaving the disc: B·A with B = ρ·E and B = π·L_e.
         glm::vec3 flux = surfel.albedo * (surfel.area * irradiance);
         flux += (kPi * surfel.area * emissiveScale[surfel.material]) * surfel.emission;
         directFlux[i] = flux;
     }, kSurfelGrain);
+}
+
+void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
+                      std::span<uint32_t> bits) {
+    const size_t nS = bake.surfels.size();
+    PIC_CHECK_EQ(bits.size(), visibilityWords(nS));
+    // White and of unit strength: where E > 0 for it, E > 0 for any colour and intensity.
+    Light unit = light;
+    unit.color = glm::vec3(1.0f);
+    unit.intensity = 1.0f;
+    // A task per word, so that no two tasks write one word.
+    parallelFor(
+        0, bits.size(),
+        [&](size_t word) {
+            uint32_t mask = 0;
+            const size_t end = std::min(nS, 32 * word + 32);
+            for (size_t i = 32 * word; i < end; ++i) {
+                const glm::vec3 e = visibleIrradiance(rays, bake.surfels[i], unit);
+                if (e.r > 0.0f) mask |= 1u << (i - 32 * word);
+            }
+            bits[word] = mask;
+        },
+        kSurfelGrain / 32);
 }
 
 void bounceSurfelFlux(const Scene& scene, const BakeData& bake,

@@ -25,6 +25,17 @@ namespace pic {
 void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
                       const LightSet& lights, std::span<glm::vec3> directFlux);
 
+/// Words of a visibility mask over nS surfels (surfelVisibility): one bit per surfel.
+inline size_t visibilityWords(size_t surfels) {
+    return (surfels + 31) / 32;
+}
+
+/// The V of directSurfelFlux for one light, as bits: bit i % 32 of `bits[i / 32]` is set where
+/// the surfel faces the light within its cone and range and the ray to it is unoccluded. The
+/// light's colour and intensity do not matter. `bits` must hold visibilityWords(nS) words.
+void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
+                      std::span<uint32_t> bits);
+
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
 /// irradiance that the interpolated caches of `previousBounce` deliver at the surfel
 /// (lookupSurfaceRadiance at its barycentrics, clamped-cosine about its normal), per channel

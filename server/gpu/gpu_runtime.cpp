@@ -7,6 +7,7 @@
 #include "server/passes/cache_lighting_pass.h"
 #include "server/passes/lightmap_copy_pass.h"
 #include "server/passes/pull_pass.h"
+#include "server/passes/ray_visibility_pass.h"
 #include "server/passes/shadow_map_pass.h"
 #include "server/passes/surfel_lighting_pass.h"
 
@@ -66,15 +67,23 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                                      VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
     PIC_TRY_ASSIGN(mTimer, ctx.createPassTimer(kTimedPasses));
 
-    PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(ctx, mScene, options.shadowMapSize,
-                                                   {.levelsOfDetail = options.casterLevelsOfDetail,
-                                                    .equalFootprint = options.shadowEqualFootprint}));
-    PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon()));
+    mVisibility = options.directVisibility.value_or(
+        ctx.isCpuDevice() ? DirectVisibility::Rays : DirectVisibility::ShadowMaps);
+    if (mVisibility == DirectVisibility::Rays) {
+        PIC_TRY_ASSIGN(mRayVisibility, RayVisibilityPass::create(ctx, rays, mBake));
+    } else {
+        PIC_TRY_ASSIGN(mShadows,
+                       ShadowMapPass::create(ctx, mScene, options.shadowMapSize,
+                                             {.levelsOfDetail = options.casterLevelsOfDetail,
+                                              .equalFootprint = options.shadowEqualFootprint}));
+    }
+    PIC_TRY_ASSIGN(mSurfels,
+                   SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon(), mVisibility));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
     const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup));
     PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
-    PIC_TRY(bindShadowConsumers());
+    PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(mNodeFlux));
     PIC_TRY(mCacheLighting->bind(mNodeFlux, mCacheY, mCacheCo, mCacheCg, mShTables));
     PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
@@ -84,17 +93,38 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     return {};
 }
 
-Result<void> GpuRuntime::bindShadowConsumers() {
-    return mSurfels->bind({mShadows.get(), &mNodeFlux, &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
+Result<void> GpuRuntime::bindVisibility() {
+    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mCacheY, &mCacheCo,
+                           &mCacheCg, &mShTables});
 }
 
 Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
     PIC_TRY(checkRuntimeLights(lights, mScene));
     bool reallocated = false;
-    PIC_TRY(mShadows->prepare(lights, reallocated));
-    // A new depth image invalidates the set that samples the old one.
-    if (reallocated) PIC_TRY(bindShadowConsumers());
+    if (mShadows)
+        PIC_TRY(mShadows->prepare(lights, reallocated));
+    else
+        PIC_TRY(mRayVisibility->prepare(lights, reallocated));
+    // A new depth image or visibility buffer invalidates the set that reads the old one.
+    if (reallocated) PIC_TRY(bindVisibility());
     return mSurfels->setEmissiveScales(lights);
+}
+
+void GpuRuntime::recordShadowMaps(VkCommandBuffer cmd) {
+    if (!mShadows) return;
+    mTimer.begin(cmd, "shadow_maps");
+    mShadows->record(cmd);
+}
+
+void GpuRuntime::addVisibilityStats(UpdateStats& stats) const {
+    if (mRayVisibility) {
+        stats.lightsTraced = int(mRayVisibility->tracedLights());
+        stats.passMs["visibility_rays"] += mRayVisibility->traceMs();
+        return;
+    }
+    stats.shadowMapsRendered = int(mShadows->renderedLights());
+    stats.shadowTriangles = mShadows->drawnTriangles();
+    stats.shadowTexels = mShadows->renderedTexels();
 }
 
 Result<void> GpuRuntime::submitTimed(const std::function<void(VkCommandBuffer)>& record,
@@ -143,18 +173,17 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         gpu::computeBarrier(cmd);
     };
 
-    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
-        mTimer.begin(cmd, "shadow_maps");
-        mShadows->record(cmd);
-        mTimer.begin(cmd, "surfel_lighting");
-        mSurfels->record(cmd, false, lightCount, 0);
-        // The leaves are written before the pull reads them.
-        gpu::computeBarrier(cmd);
-        cacheBounce(cmd, passes > 1, 1);
-    }, stats));
-    stats.shadowMapsRendered = int(mShadows->renderedLights());
-    stats.shadowTriangles = mShadows->drawnTriangles();
-    stats.shadowTexels = mShadows->renderedTexels();
+    PIC_TRY(submitTimed(
+        [&](VkCommandBuffer cmd) {
+            recordShadowMaps(cmd);
+            mTimer.begin(cmd, "surfel_lighting");
+            mSurfels->record(cmd, false, lightCount, 0);
+            // The leaves are written before the pull reads them.
+            gpu::computeBarrier(cmd);
+            cacheBounce(cmd, passes > 1, 1);
+        },
+        stats));
+    addVisibilityStats(stats);
     PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
     double total = luminance(glm::vec3(sum));
     stats.bounces = 1;
@@ -255,15 +284,14 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, Upd
     UpdateStats& stats = statsOut ? *statsOut : local;
     stats = UpdateStats{};
     PIC_TRY(prepareLights(lights));
-    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
-        mTimer.begin(cmd, "shadow_maps");
-        mShadows->record(cmd);
-        mTimer.begin(cmd, "surfel_lighting");
-        mSurfels->record(cmd, false, uint32_t(lights.lights.size()), 0);
-    }, stats));
-    stats.shadowMapsRendered = int(mShadows->renderedLights());
-    stats.shadowTriangles = mShadows->drawnTriangles();
-    stats.shadowTexels = mShadows->renderedTexels();
+    PIC_TRY(submitTimed(
+        [&](VkCommandBuffer cmd) {
+            recordShadowMaps(cmd);
+            mTimer.begin(cmd, "surfel_lighting");
+            mSurfels->record(cmd, false, uint32_t(lights.lights.size()), 0);
+        },
+        stats));
+    addVisibilityStats(stats);
     return downloadFlux(mSurfels->directFlux(), mBake.surfels.size());
 }
 
@@ -314,7 +342,8 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
         {"node_flux", mNodeFlux.size()},
         {"caches", mCacheY.size() + mCacheCo.size() + mCacheCg.size()},
         {"textures", mLightmapCopy->bytes()},
-        {"shadow_maps", mShadows->bytes()},
+        mShadows ? std::pair<std::string, uint64_t>{"shadow_maps", mShadows->bytes()}
+                 : std::pair<std::string, uint64_t>{"visibility", mRayVisibility->bytes()},
     };
 }
 

@@ -15,6 +15,7 @@
 
 #include "bake/embree_scene.h"
 #include "server/gpu/context.h"
+#include "server/passes/surfel_lighting_pass.h"
 #include "server/runtime.h"
 
 namespace pic {
@@ -31,6 +32,11 @@ struct GpuRuntimeOptions {
     /// the surfaces a light reaches (gpu::ShadowMapOptions::equalFootprint): the surfels are
     /// spread over those surfaces by area. Off: every layer shadowMapSize wide.
     bool shadowEqualFootprint = true;
+    /// Where the direct light's visibility comes from; unset: host-traced rays on a CPU
+    /// device (lavapipe, where rasterising shadow maps costs several times more than tracing
+    /// a ray per surfel and light), shadow maps on a GPU. The shadow-map options above apply
+    /// to DirectVisibility::ShadowMaps only.
+    std::optional<gpu::DirectVisibility> directVisibility;
     /// gpu::ContextOptions::mapDeviceMemory: false runs a discrete GPU's staging and
     /// read-back paths on a device whose memory the host could map (tests).
     bool mapDeviceMemory = true;
@@ -41,6 +47,7 @@ struct GpuRuntimeOptions {
 
 namespace gpu {
 class ShadowMapPass;
+class RayVisibilityPass;
 class SurfelLightingPass;
 class PullPass;
 class CacheLightingPass;
@@ -62,7 +69,10 @@ public:
     Result<const CacheTextures*> textures() override;
     const char* name() const override { return "gpu"; }
 
-    /// Shadow maps and the direct part of surfel lighting for `lights`: nS direct fluxes.
+    /// The direct light's visibility in use (GpuRuntimeOptions::directVisibility resolved).
+    gpu::DirectVisibility directVisibility() const { return mVisibility; }
+    /// Visibility (shadow maps or rays) and the direct part of surfel lighting for `lights`:
+    /// nS direct fluxes.
     Result<std::vector<glm::vec3>> runDirect(const LightSet& lights, UpdateStats* stats = nullptr);
     /// One bounce of surfel lighting from `direct` (nS) and the caches `previous`: the leaves.
     Result<std::vector<glm::vec3>> runBounce(std::span<const glm::vec3> direct,
@@ -83,7 +93,12 @@ public:
 private:
     GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces);
     Result<void> init(const EmbreeScene& rays, const GpuRuntimeOptions& options);
-    Result<void> bindShadowConsumers();
+    /// (Re)binds surfel lighting to the current shadow-map image or visibility buffer.
+    Result<void> bindVisibility();
+    /// Records the shadow maps of the lights that changed (nothing with rays).
+    void recordShadowMaps(VkCommandBuffer cmd);
+    /// The counts and host time of the visibility the latest update prepared and recorded.
+    void addVisibilityStats(UpdateStats& stats) const;
     Result<void> prepareLights(const LightSet& lights);
     Result<void> submitTimed(const std::function<void(VkCommandBuffer)>& record, UpdateStats& stats);
     Result<void> uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer);
@@ -98,7 +113,9 @@ private:
     const BakeData& mBake;
     BounceParams mBounces;
     std::unique_ptr<gpu::Context> mContext;
-    std::unique_ptr<gpu::ShadowMapPass> mShadows;
+    gpu::DirectVisibility mVisibility = gpu::DirectVisibility::ShadowMaps;
+    std::unique_ptr<gpu::ShadowMapPass> mShadows;            ///< DirectVisibility::ShadowMaps
+    std::unique_ptr<gpu::RayVisibilityPass> mRayVisibility;  ///< DirectVisibility::Rays
     std::unique_ptr<gpu::SurfelLightingPass> mSurfels;
     std::unique_ptr<gpu::PullPass> mPull;
     std::unique_ptr<gpu::CacheLightingPass> mCacheLighting;

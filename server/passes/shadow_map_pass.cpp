@@ -482,6 +482,21 @@ VkDeviceSize ShadowMapPass::bytes() const {
     return mVertices.size() + mIndices.size() + mLights.size() + mLayerBuffer.size() + mDepth.bytes();
 }
 
+GpuLight gpuLightRecord(const Light& light) {
+    GpuLight g{};
+    g.position = light.position;
+    g.type = light.type == LightType::Point  ? kLightPoint
+             : light.type == LightType::Spot ? kLightSpot
+                                             : kLightDirectional;
+    g.direction = light.direction;
+    g.range = std::isfinite(light.range) ? light.range : 0.0f;
+    g.radiant = light.intensity * light.color;
+    g.cosOuter = std::cos(light.outerConeAngle);
+    g.cosInner = std::cos(light.innerConeAngle);
+    g.hardCone = light.innerConeAngle >= light.outerConeAngle ? 1u : 0u;
+    return g;
+}
+
 ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t firstLayer,
                                                  std::vector<GpuShadowLayer>& layers) const {
     LightSlot slot;
@@ -492,17 +507,8 @@ ShadowMapPass::LightSlot ShadowMapPass::describe(const Light& light, uint32_t fi
     slot.type = light.type;
     slot.layers = layersOf(light);
 
+    slot.gpu = gpuLightRecord(light);
     GpuLight& g = slot.gpu;
-    g.position = light.position;
-    g.type = light.type == LightType::Point ? kLightPoint
-             : light.type == LightType::Spot ? kLightSpot
-                                             : kLightDirectional;
-    g.direction = light.direction;
-    g.range = std::isfinite(light.range) ? light.range : 0.0f;
-    g.radiant = light.intensity * light.color;
-    g.cosOuter = std::cos(light.outerConeAngle);
-    g.cosInner = std::cos(light.innerConeAngle);
-    g.hardCone = light.innerConeAngle >= light.outerConeAngle ? 1u : 0u;
     g.firstLayer = firstLayer;
 
     const float diagonal = std::max(mBounds.diagonal(), 1e-3f);

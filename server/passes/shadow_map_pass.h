@@ -88,6 +88,10 @@ inline constexpr uint32_t kFootprintSamples = 4096;
 /// Smallest side of a layer, and the step sides are rounded up to (texels).
 inline constexpr uint32_t kMinShadowSide = 16;
 
+/// The GpuLight record of `light` as lightIrradiance (shaders/lib/lights.glsl) reads it:
+/// type, position, direction, range, radiant intensity and cone; the shadow fields zero.
+GpuLight gpuLightRecord(const Light& light);
+
 /// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
 /// (median splits of their centroids); `order` receives the triangle indices in cluster order.
 /// With `solids`, the triangles of solids come first and share no cluster with open ones.

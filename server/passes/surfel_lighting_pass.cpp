@@ -11,26 +11,40 @@
 namespace pic::gpu {
 namespace {
 
-constexpr uint32_t kBindingCount = 13;
+constexpr uint32_t kBindingCount = 14;
 constexpr uint32_t kSamplerBinding = 4;
 constexpr uint32_t kShTablesBinding = 11;
 
 }  // namespace
 
-Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(Context& context,
-                                                                       const Scene& scene,
-                                                                       const BakeData& bake,
-                                                                       float epsilon) {
+const char* directVisibilityName(DirectVisibility visibility) {
+    return visibility == DirectVisibility::Rays ? "rays" : "shadow-maps";
+}
+
+Result<std::optional<DirectVisibility>> parseDirectVisibility(std::string_view text) {
+    if (text == "auto") return std::nullopt;
+    if (text == "shadow-maps") return DirectVisibility::ShadowMaps;
+    if (text == "rays") return DirectVisibility::Rays;
+    return fail(ErrorCode::InvalidInput,
+                "direct visibility \"{}\" is none of auto, shadow-maps, rays", text);
+}
+
+Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
+    Context& context, const Scene& scene, const BakeData& bake, float epsilon,
+    DirectVisibility visibility) {
     std::unique_ptr<SurfelLightingPass> pass(new SurfelLightingPass(context, scene));
     pass->mSurfelCount = uint32_t(bake.surfels.size());
     pass->mEpsilon = epsilon;
+    pass->mVisibility = visibility;
+    const bool rays = visibility == DirectVisibility::Rays;
 
     KernelLayout layout;
     layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     layout.bindings[kSamplerBinding] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     layout.bindings[kShTablesBinding] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     layout.pushBytes = sizeof(SurfelLightingPush);
-    layout.specialization = {bake.params.bandsY, bake.params.bandsC, kSurfelModeDirect};
+    layout.specialization = {bake.params.bandsY, bake.params.bandsC,
+                             rays ? kSurfelModeDirectRays : kSurfelModeDirect};
     PIC_TRY_ASSIGN(pass->mDirect, Kernel::create(context, kSpirvSurfelLightingComp, layout,
                                                  "surfel_lighting (direct)"));
     layout.specialization.back() = kSurfelModeBounce;
@@ -73,17 +87,30 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(Context& 
     PIC_TRY_ASSIGN(pass->mGroupFlux,
                    context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
                                         MemoryUse::Readback, "surfel flux sums"));
+    // Both modes share one shader, which declares both sources: the one not in use is bound to
+    // a placeholder.
+    if (rays) {
+        PIC_TRY_ASSIGN(pass->mUnusedLayers, context.createBuffer(sizeof(GpuShadowLayer), 0,
+                                                                 MemoryUse::Device, "unused"));
+        PIC_TRY_ASSIGN(pass->mUnusedDepth, context.createDepthArray(kMinShadowSide, 1));
+    } else {
+        PIC_TRY_ASSIGN(pass->mUnusedVisibility,
+                       context.createBuffer(sizeof(uint32_t), 0, MemoryUse::Device, "unused"));
+    }
     return pass;
 }
 
 Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
-    PIC_CHECK(r.shadows && r.nodeFlux && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    const bool rays = mVisibility == DirectVisibility::Rays;
+    PIC_CHECK(rays ? r.rays != nullptr : r.shadows != nullptr);
+    PIC_CHECK(r.nodeFlux && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::storage(0, mSurfels),
-        BindingResource::storage(1, r.shadows->lightBuffer()),
-        BindingResource::storage(2, r.shadows->layerBuffer()),
+        BindingResource::storage(1, rays ? r.rays->lightBuffer() : r.shadows->lightBuffer()),
+        BindingResource::storage(2, rays ? mUnusedLayers : r.shadows->layerBuffer()),
         BindingResource::storage(3, mEmissiveScale),
-        BindingResource::image(4, r.shadows->depth().arrayView(), mContext.nearestSampler()),
+        BindingResource::image(4, (rays ? mUnusedDepth : r.shadows->depth()).arrayView(),
+                               mContext.nearestSampler()),
         BindingResource::storage(5, mDirectFlux),
         BindingResource::storage(6, *r.nodeFlux),
         BindingResource::storage(7, mStencils),
@@ -92,6 +119,7 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         BindingResource::storage(10, *r.cacheCg),
         BindingResource::storage(11, *r.shTables),
         BindingResource::storage(12, mGroupFlux),
+        BindingResource::storage(13, rays ? r.rays->visibilityBuffer() : mUnusedVisibility),
     };
     PIC_TRY(mDirect.resetSets());
     PIC_TRY(mBounce.resetSets());
@@ -134,7 +162,7 @@ Result<glm::dvec3> SurfelLightingPass::totalFlux(uint32_t sumSlot) {
 
 VkDeviceSize SurfelLightingPass::bytes() const {
     return mSurfels.size() + mStencils.size() + mEmissiveScale.size() + mDirectFlux.size() +
-           mGroupFlux.size();
+           mGroupFlux.size() + mUnusedLayers.size() + mUnusedVisibility.size();
 }
 
 }  // namespace pic::gpu

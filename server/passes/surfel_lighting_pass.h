@@ -2,8 +2,11 @@
 /// Surfel lighting on the GPU (paper 000 Figure 2 step 2): the direct flux of every surfel
 /// from the shadow-mapped lights and its emission, then, per further bounce, that plus the
 /// light the previous bounce's caches deliver to it. CPU twin: server/cpu/surfel_lighting.h.
+/// The direct light's visibility comes from shadow maps or from host-traced rays.
 
 #include <memory>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -12,13 +15,28 @@
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "server/gpu/kernel.h"
+#include "server/passes/ray_visibility_pass.h"
 #include "server/passes/shadow_map_pass.h"
 
 namespace pic::gpu {
 
+/// Where the direct light's visibility at each surfel comes from.
+enum class DirectVisibility {
+    ShadowMaps,  ///< rasterised shadow maps (ShadowMapPass), sampled at the surfel
+    Rays,        ///< one ray per surfel and light, traced on the host (RayVisibilityPass)
+};
+
+/// "shadow-maps" or "rays".
+const char* directVisibilityName(DirectVisibility visibility);
+/// Parses "shadow-maps", "rays" or "auto" (nullopt: the runtime picks); InvalidInput otherwise.
+Result<std::optional<DirectVisibility>> parseDirectVisibility(std::string_view text);
+
 /// The runtime's buffers this pass reads and writes.
 struct SurfelLightingResources {
+    /// The lights' records and visibility: shadows with DirectVisibility::ShadowMaps, rays
+    /// with DirectVisibility::Rays.
     const ShadowMapPass* shadows = nullptr;
+    const RayVisibilityPass* rays = nullptr;
     const Buffer* nodeFlux = nullptr;    ///< vec4 per node; the pass writes the leaves
     const Buffer* cacheY = nullptr;      ///< half, nC·lY²: the previous bounce
     const Buffer* cacheCo = nullptr;     ///< half, nC·lC²
@@ -31,9 +49,11 @@ public:
     /// Uploads the surfels and their cache stencils (core/cache_values.h surfaceStencil at
     /// each surfel's barycentrics: the same lookup as the CPU twin's bounce).
     static Result<std::unique_ptr<SurfelLightingPass>> create(Context& context, const Scene& scene,
-                                                              const BakeData& bake, float epsilon);
+                                                              const BakeData& bake, float epsilon,
+                                                              DirectVisibility visibility);
 
-    /// (Re)binds the pass to the runtime's buffers and the shadow maps' current image.
+    /// (Re)binds the pass to the runtime's buffers and the current shadow-map image or
+    /// visibility buffer.
     Result<void> bind(const SurfelLightingResources& resources);
     /// Writes the per-material emission scales of `lights`.
     Result<void> setEmissiveScales(const LightSet& lights);
@@ -51,7 +71,8 @@ private:
     SurfelLightingPass(Context& context, const Scene& scene) : mContext(context), mScene(scene) {}
     Context& mContext;
     const Scene& mScene;
-    Kernel mDirect;  ///< the shader specialised to kSurfelModeDirect
+    DirectVisibility mVisibility = DirectVisibility::ShadowMaps;
+    Kernel mDirect;  ///< the shader specialised to kSurfelModeDirect or kSurfelModeDirectRays
     Kernel mBounce;  ///< and to kSurfelModeBounce
     VkDescriptorSet mDirectSet = VK_NULL_HANDLE;
     VkDescriptorSet mBounceSet = VK_NULL_HANDLE;
@@ -62,6 +83,11 @@ private:
     Buffer mStencils;
     Buffer mDirectFlux;
     Buffer mGroupFlux;
+    /// What the shader declares and the mode in use does not read: shadow-map layer records
+    /// and a 16² depth layer (rays), or a visibility word (shadow maps).
+    Buffer mUnusedLayers;
+    DepthArray mUnusedDepth;
+    Buffer mUnusedVisibility;
 };
 
 }  // namespace pic::gpu

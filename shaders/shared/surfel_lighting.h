@@ -10,6 +10,7 @@ PIC_CONST(uint, kSurfelLightingGroup, 64u);
 // The pass's mode (specialization constant 2):
 PIC_CONST(uint, kSurfelModeDirect, 0u);  // directFlux = lights + emission; leaves = directFlux
 PIC_CONST(uint, kSurfelModeBounce, 1u);  // leaves = directFlux + ρ·A·E(previous caches)
+PIC_CONST(uint, kSurfelModeDirectRays, 2u);  // as Direct, V from host-traced rays, not shadow maps
 
 // Up to 8 caches and weights; unused slots have weight 0 (and cache 0).
 struct SurfelStencil {

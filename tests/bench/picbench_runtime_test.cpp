@@ -49,24 +49,37 @@ TEST_F(PicbenchRuntime, ReportsEveryKindOfLightChange) {
     std::string err;
     ASSERT_EQ(run(std::string("runtime --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf "
                   "--settings moderate --link-modes rtp --bounces 1 --repeat 1 --shadow-map-size 256 "
-                  "--json " + json.string(), err), 0) << err;
+                  "--visibility shadow-maps rays --json " + json.string(), err), 0) << err;
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);
-    ASSERT_EQ(report.at("runs").size(), 3u);
-    for (const nlohmann::json& run : report.at("runs")) {
+    ASSERT_EQ(report.at("runs").size(), 6u);
+    for (size_t r = 0; r < 6; ++r) {
+        const nlohmann::json& run = report.at("runs")[r];
         const std::string change = run.at("change");
-        SCOPED_TRACE(change);
+        const std::string visibility = run.at("direct_visibility");
+        SCOPED_TRACE(change + ", " + visibility);
+        EXPECT_EQ(visibility, r < 3 ? "shadow-maps" : "rays");
         EXPECT_GT(run.at("cpu").at("update_ms_median").get<double>(), 0.0);
         EXPECT_GT(run.at("gpu").at("update_ms_median").get<double>(), 0.0);
+        EXPECT_GT(run.at("bandwidth_ratio").get<double>(), 0.0);
+        const uint64_t drawn = run.at("gpu").at("shadow_triangles").get<uint64_t>();
+        const int traced = run.at("gpu").at("lights_traced").get<int>();
+        if (visibility == "rays") {
+            // Cornell's one point light is traced whenever it moves, never for a recolour.
+            EXPECT_FALSE(run.contains("shadow_map_size"));
+            EXPECT_EQ(drawn, 0u);
+            EXPECT_EQ(traced, change == "recolour" ? 0 : 1);
+            EXPECT_TRUE(run.at("gpu").at("pass_ms_median").contains("visibility_rays"));
+            continue;
+        }
         EXPECT_EQ(run.at("shadow_map_size").get<int>(), 256);
+        EXPECT_EQ(traced, 0);
         // Cornell's one point light: a cube, every triangle in some face, none drawn when only
         // the intensity changes.
-        const uint64_t drawn = run.at("gpu").at("shadow_triangles").get<uint64_t>();
         if (change == "recolour")
             EXPECT_EQ(drawn, 0u);
         else
             EXPECT_GE(drawn, report.at("triangles").get<uint64_t>());
-        EXPECT_GT(run.at("bandwidth_ratio").get<double>(), 0.0);
     }
 }
 
@@ -79,7 +92,7 @@ TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);
     const nlohmann::json& runs = report.at("runs");
-    ASSERT_EQ(runs.size(), 4u);
+    ASSERT_EQ(runs.size(), 5u);
     for (const nlohmann::json& row : runs) {
         EXPECT_GE(row.at("relative_l1").get<double>(), 0.0);
         EXPECT_LE(row.at("fraction_surfels_differing").get<double>(), 1.0);
@@ -96,6 +109,11 @@ TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {
     // Cornell's one point light: six uniform layers; footprint sides are never wider.
     EXPECT_EQ(runs[1].at("texels").get<uint64_t>(), 6u * 512u * 512u);
     EXPECT_LE(runs[3].at("texels").get<uint64_t>(), runs[1].at("texels").get<uint64_t>());
+    // Last, the host rays: the CPU twin's own visibility, so no error but float rounding.
+    EXPECT_EQ(runs[4].at("direct_visibility").get<std::string>(), "rays");
+    EXPECT_EQ(runs[4].at("texels").get<uint64_t>(), 0u);
+    EXPECT_LT(runs[4].at("relative_l1").get<double>(), 1e-5);
+    EXPECT_EQ(runs[4].at("fraction_surfels_differing").get<double>(), 0.0);
 }
 
 TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {

@@ -143,6 +143,55 @@ TEST(SurfelLighting, OccludedLightGivesNothing) {
     EXPECT_GT(flux[0].x, 0.0f);
 }
 
+TEST(SurfelLighting, VisibilityBitsAreWhereTheDirectFluxIsLit) {
+    // 70 surfels along x (three words, the last one partly used), the middle ones under a
+    // blocker; a spot whose cone leaves out the far end. Bit i is set exactly where the
+    // direct flux of that light is positive, whatever its colour and intensity.
+    Scene scene = floorScene();
+    addQuad(scene, {-0.2f, 1, -0.5f}, {0.2f, 1, -0.5f}, {0.2f, 1, 0.5f}, {-0.2f, 1, 0.5f}, 0);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    BakeData bake = oneSurfelBake({0.0f, 0.0f, 0.0f});
+    const Surfel first = bake.surfels[0];
+    bake.surfels.clear();
+    for (int i = 0; i < 70; ++i) {
+        Surfel s = first;
+        s.position = {-0.95f + 0.0275f * float(i), 0.0f, 0.0f};
+        bake.surfels.push_back(s);
+    }
+    Light spot = pointLight({0.0f, 2.0f, 0.0f}, 4.0f, {1.0f, 0.0f, 0.5f});
+    spot.type = LightType::Spot;
+    spot.direction = glm::normalize(glm::vec3(-0.3f, -1.0f, 0.0f));
+    spot.outerConeAngle = 0.45f;
+    spot.innerConeAngle = 0.3f;
+    LightSet lights;
+    lights.lights = {spot};
+    std::vector<glm::vec3> flux(bake.surfels.size());
+    directSurfelFlux(scene, **rays, bake, lights, flux);
+    std::vector<uint32_t> bits(visibilityWords(bake.surfels.size()), ~0u);
+    ASSERT_EQ(bits.size(), 3u);
+    surfelVisibility(**rays, bake, spot, bits);
+    int lit = 0, blocked = 0;
+    for (size_t i = 0; i < bake.surfels.size(); ++i) {
+        const bool bit = (bits[i / 32] >> (i % 32)) & 1u;
+        EXPECT_EQ(bit, flux[i].r > 0.0f) << "surfel " << i;
+        lit += bit;
+        blocked += std::abs(bake.surfels[i].position.x) < 0.15f && !bit;
+    }
+    EXPECT_GT(lit, 10);
+    EXPECT_GT(blocked, 5);
+    EXPECT_LT(lit + blocked, 70);  // the cone leaves some out
+    EXPECT_EQ(bits[2] >> 6, 0u);   // bits past the last surfel stay clear
+
+    // Colour and intensity do not change what the light reaches.
+    Light dim = spot;
+    dim.intensity = 0.0f;
+    dim.color = {0.0f, 1.0f, 0.0f};
+    std::vector<uint32_t> dimBits(bits.size());
+    surfelVisibility(**rays, bake, dim, dimBits);
+    EXPECT_EQ(dimBits, bits);
+}
+
 TEST(SurfelLighting, EmissiveSurfelGivesPiRadianceAreaScale) {
     Scene scene = floorScene();
     auto rays = EmbreeScene::create(scene);

@@ -168,12 +168,34 @@ INSTANTIATE_TEST_SUITE_P(
                         std::make_tuple(LinkMode::Sh, 4u, 2u), std::make_tuple(LinkMode::Sh, 1u, 1u)),
         testing::Bool()));
 
-/// Direct surfel flux for a scene and light set.
+/// Largest relative difference of a GPU flux from the CPU's over surfels and channels
+/// (differences below 1e−6 of the brightest surfel ignored).
+double largestDifference(const std::vector<glm::vec3>& gpu, const std::vector<glm::vec3>& cpu) {
+    float brightest = 0.0f;
+    for (const glm::vec3& f : cpu) brightest = std::max({brightest, f.r, f.g, f.b});
+    double largest = 0.0;
+    for (size_t i = 0; i < cpu.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double d = std::abs(double(gpu[i][c]) - double(cpu[i][c]));
+            if (d > 1e-6 * brightest)
+                largest = std::max(largest, d / std::max(std::abs(double(cpu[i][c])), 1e-30));
+        }
+    return largest;
+}
+
+/// Direct surfel flux for a scene and light set, with the visibility of shadow maps (within
+/// the bound) and of rays (the CPU twin's own rays: equal to float rounding).
 void expectDirectMatches(const Baked& b, const LightSet& lights) {
-    auto gpu = gpuFor(b);
-    ASSERT_TRUE(gpu);
     std::vector<glm::vec3> cpu(b.bake.surfels.size());
     directSurfelFlux(b.scene, *b.rays, b.bake, lights, cpu);
+    auto rays = gpuFor(b, {}, {.directVisibility = gpu::DirectVisibility::Rays});
+    ASSERT_TRUE(rays);
+    auto traced = rays->runDirect(lights);
+    ASSERT_TRUE(traced) << traced.error().message;
+    EXPECT_LE(largestDifference(*traced, cpu), 1e-4);
+
+    auto gpu = gpuFor(b, {}, {.directVisibility = gpu::DirectVisibility::ShadowMaps});
+    ASSERT_TRUE(gpu);
     auto direct = gpu->runDirect(lights);
     ASSERT_TRUE(direct) << direct.error().message;
     // Shadow maps and exact rays disagree only where a shadow edge crosses a surfel.
@@ -213,7 +235,8 @@ TEST(GpuSurfelLighting, SimplifiedCastersKeepTheDirectFlux) {
     std::vector<glm::vec3> direct[2];
     for (const bool levels : {false, true}) {
         auto runtime = GpuRuntime::create(b.scene, *b.rays, b.bake, {},
-                                          {.casterLevelsOfDetail = levels});
+                                          {.casterLevelsOfDetail = levels,
+                                           .directVisibility = gpu::DirectVisibility::ShadowMaps});
         ASSERT_TRUE(runtime) << runtime.error().message;
         auto flux = (*runtime)->runDirect(lights);
         ASSERT_TRUE(flux) << flux.error().message;
@@ -302,12 +325,14 @@ TEST(GpuLightmapCopy, TexturesMatchTheCpuTwin) {
     EXPECT_EQ(textures->lightmapCoverage, cpu.lightmapCoverage);
 }
 
-class GpuRuntimeForms : public testing::TestWithParam<LinkMode> {};
+class GpuRuntimeForms : public testing::TestWithParam<std::tuple<LinkMode, gpu::DirectVisibility>> {
+};
 
 TEST_P(GpuRuntimeForms, ProgressiveUpdateMatchesTheCpuRuntime) {
-    const Baked& b = baked("cornell", GetParam());
+    const auto [mode, visibility] = GetParam();
+    const Baked& b = baked("cornell", mode);
     ASSERT_TRUE(b.ok);
-    auto gpu = gpuFor(b);
+    auto gpu = gpuFor(b, {}, {.directVisibility = visibility});
     ASSERT_TRUE(gpu);
     auto cpu = createCpuRuntime(b.scene, *b.rays, b.bake, BounceParams{});
     ASSERT_TRUE(cpu);
@@ -330,12 +355,25 @@ TEST_P(GpuRuntimeForms, ProgressiveUpdateMatchesTheCpuRuntime) {
     EXPECT_EQ(gpu->context().validationMessages(), 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(LinkForms, GpuRuntimeForms, testing::Values(LinkMode::Rtp, LinkMode::Sh));
+/// "ShadowMaps" or "Rays", for test names.
+std::string visibilityName(gpu::DirectVisibility visibility) {
+    return visibility == gpu::DirectVisibility::Rays ? "Rays" : "ShadowMaps";
+}
+
+INSTANTIATE_TEST_SUITE_P(LinkFormsAndVisibility, GpuRuntimeForms,
+                         testing::Combine(testing::Values(LinkMode::Rtp, LinkMode::Sh),
+                                          testing::Values(gpu::DirectVisibility::ShadowMaps,
+                                                          gpu::DirectVisibility::Rays)),
+                         [](const auto& info) {
+                             return std::string(std::get<0>(info.param) == LinkMode::Rtp ? "Rtp"
+                                                                                         : "Sh") +
+                                    visibilityName(std::get<1>(info.param));
+                         });
 
 TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
     const Baked& b = baked("cornell", LinkMode::Rtp);
     ASSERT_TRUE(b.ok);
-    auto gpu = gpuFor(b, BounceParams{1});
+    auto gpu = gpuFor(b, BounceParams{1}, {.directVisibility = gpu::DirectVisibility::ShadowMaps});
     ASSERT_TRUE(gpu);
     LightSet lights = defaultLightSet(b.scene);
     ASSERT_FALSE(lights.lights.empty());
@@ -357,6 +395,72 @@ TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
     lights.lights[1].position.x += 0.05f;
     ASSERT_TRUE(gpu->setLights(lights, &stats));
     EXPECT_EQ(stats.shadowMapsRendered, 1);
+}
+
+TEST(GpuRayVisibility, OnlyLightsThatChangedAreRetracedAndMoreLightsKeepTheirBits) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    const GpuRuntimeOptions options{.directVisibility = gpu::DirectVisibility::Rays};
+    auto gpu = gpuFor(b, BounceParams{1}, options);
+    ASSERT_TRUE(gpu);
+    LightSet lights = defaultLightSet(b.scene);
+    ASSERT_FALSE(lights.lights.empty());
+    Light second = lights.lights[0];
+    second.id = "second";
+    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
+    lights.lights.push_back(second);
+    UpdateStats stats;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.lightsTraced, 2);
+    EXPECT_EQ(stats.shadowMapsRendered, 0);
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.lightsTraced, 0);
+    // Colour and intensity do not change what a light reaches.
+    lights.lights[1].intensity *= 2.0f;
+    lights.lights[1].color = {1.0f, 0.5f, 0.25f};
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.lightsTraced, 0);
+    // Moving one light retraces that light only; so does a new cone.
+    lights.lights[1].position.x += 0.05f;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.lightsTraced, 1);
+    // A third light outgrows the visibility buffer: every light is traced into the new one.
+    Light third = second;
+    third.id = "third";
+    third.position.z -= 0.1f;
+    lights.lights.push_back(third);
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.lightsTraced, 3);
+    // Dropping the first light shifts the others onto its slot: both are traced again.
+    lights.lights.erase(lights.lights.begin());
+    auto updated = gpu->setLights(lights, &stats);
+    ASSERT_TRUE(updated) << updated.error().message;
+    EXPECT_EQ(stats.lightsTraced, 2);
+    // After all that, the same caches as a runtime that saw only this light set.
+    auto fresh = gpuFor(b, BounceParams{1}, options);
+    ASSERT_TRUE(fresh);
+    auto expected = fresh->setLights(lights, nullptr);
+    ASSERT_TRUE(expected) << expected.error().message;
+    EXPECT_EQ((*updated)->y, (*expected)->y);
+    EXPECT_EQ((*updated)->co, (*expected)->co);
+    EXPECT_EQ(gpu->context().validationMessages(), 0u);
+}
+
+TEST(GpuRuntime, DirectVisibilityIsRaysOnACpuDeviceAndShadowMapsOnAGpu) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    EXPECT_EQ(gpu->directVisibility(), gpu->context().isCpuDevice()
+                                           ? gpu::DirectVisibility::Rays
+                                           : gpu::DirectVisibility::ShadowMaps);
+    EXPECT_EQ(*gpu::parseDirectVisibility("rays"), gpu::DirectVisibility::Rays);
+    EXPECT_EQ(*gpu::parseDirectVisibility("shadow-maps"), gpu::DirectVisibility::ShadowMaps);
+    EXPECT_EQ(*gpu::parseDirectVisibility("auto"), std::nullopt);
+    auto bad = gpu::parseDirectVisibility("raytraced");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(bad.error().message.find("raytraced"), std::string::npos);
 }
 
 TEST(GpuRuntime, ZeroBouncesLeaveCachesAndTexturesDark) {
@@ -405,14 +509,16 @@ TEST(GpuContext, UnknownDeviceNameIsNotFound) {
 // A discrete GPU's device memory is not mapped: uploads, downloads and the caches' read-back
 // go through host-visible buffers. Lavapipe could map it; left unmapped, it takes those paths
 // and must give the same caches and textures, bit for bit (the same shaders on the same data).
-TEST(GpuRuntime, UnmappedDeviceMemoryGivesTheSameResults) {
+class GpuRuntimeMemory : public testing::TestWithParam<gpu::DirectVisibility> {};
+
+TEST_P(GpuRuntimeMemory, UnmappedDeviceMemoryGivesTheSameResults) {
     const Baked& b = baked("cornell", LinkMode::Rtp);
     ASSERT_TRUE(b.ok);
-    auto mapped = gpuFor(b);
-    auto unmapped = gpuFor(b, {}, {.mapDeviceMemory = false});
+    auto mapped = gpuFor(b, {}, {.directVisibility = GetParam()});
+    auto unmapped = gpuFor(b, {}, {.directVisibility = GetParam(), .mapDeviceMemory = false});
     ASSERT_TRUE(mapped && unmapped);
     LightSet lights = defaultLightSet(b.scene);
-    for (int update = 0; update < 2; ++update) {
+    for (int update = 0; update < 3; ++update) {
         auto expected = mapped->setLights(lights, nullptr);
         auto actual = unmapped->setLights(lights, nullptr);
         ASSERT_TRUE(expected && actual);
@@ -426,7 +532,9 @@ TEST(GpuRuntime, UnmappedDeviceMemoryGivesTheSameResults) {
             EXPECT_EQ((*actualTextures)->grid[ch], (*expectedTextures)->grid[ch]);
             EXPECT_EQ((*actualTextures)->lightmap[ch], (*expectedTextures)->lightmap[ch]);
         }
-        lights.lights[0].intensity *= 0.5f;
+        // A recolour, then a move.
+        if (update == 0) lights.lights[0].intensity *= 0.5f;
+        if (update == 1) lights.lights[0].position.y -= 0.1f;
     }
     // The single-pass path reads the caches back the same way.
     std::vector<glm::vec3> nodes(b.bake.nodes.size(), glm::vec3(0.25f, 0.5f, 1.0f));
@@ -437,6 +545,11 @@ TEST(GpuRuntime, UnmappedDeviceMemoryGivesTheSameResults) {
     EXPECT_GT(*std::max_element(actual->y.begin(), actual->y.end()), 0.0f);
     EXPECT_EQ(unmapped->context().validationMessages(), 0u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Visibility, GpuRuntimeMemory,
+                         testing::Values(gpu::DirectVisibility::ShadowMaps,
+                                         gpu::DirectVisibility::Rays),
+                         [](const auto& info) { return visibilityName(info.param); });
 
 TEST(GpuCopyProbe, CopiesEveryWordAndReportsARate) {
     auto context = gpu::Context::create({.mapDeviceMemory = false});
