@@ -1,6 +1,6 @@
 #version 460
 // Cache lighting (paper 000 Figure 2 step 4, eq. 3): per cache, L = Σ over its nL links of
-// Φ_node·transport in YCoCg, Y with lY bands and Co, Cg with lC bands, stored as half floats.
+// the node's radiance Φ / (π·A) (RGB9E5, §4.7) times its transport, in YCoCg, Y with lY bands and Co, Cg with lC bands, stored as half floats.
 // CPU twin: server/cpu/cache_lighting.cpp.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -21,8 +21,8 @@ layout(constant_id = 4) const uint kMapping = 0u;
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 
-layout(std430, binding = 0) readonly buffer NodeFlux { vec4 nodeFlux[]; };          // W, RGB
-layout(std430, binding = 1) readonly buffer RtpLinks { RtpLink rtpLinks[]; };       // chunk
+layout(std430, binding = 0) readonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGB9E5
+layout(std430, binding = 1) readonly buffer RtpLinks { GpuRtpLink rtpLinks[]; };    // chunk
 layout(std430, binding = 2) readonly buffer ShNodes { uint shNodes[]; };            // chunk
 layout(std430, binding = 3) readonly buffer ShCoefficients { float16_t shCoefficients[]; };
 layout(std430, binding = 4) writeonly buffer CacheY { float16_t cacheY[]; };
@@ -31,6 +31,7 @@ layout(std430, binding = 6) writeonly buffer CacheCg { float16_t cacheCg[]; };
 layout(std140, binding = 7) uniform Sh { ShTables sh; };
 layout(push_constant) uniform Push { CacheLightingPush pc; };
 
+#include "lib/rgb9e5.glsl"
 #include "lib/sh.glsl"
 
 float y[kCountY];
@@ -44,34 +45,36 @@ float16_t toHalf(float value) {
 /// Adds link `slot` (within the chunk) to y, co, cg.
 void addLink(uint slot) {
     if (kLinkForm == kLinkFormRtp) {
-        // §4.6: the node's cone projected at runtime, factor·K_l(α)·y_lm(direction).
-        const RtpLink link = rtpLinks[slot];
-        if (link.factor == 0.0) return;  // padding
-        const vec3 flux = rgbToYCoCg(nodeFlux[link.node].xyz);
+        // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
+        const GpuRtpLink link = rtpLinks[slot];
+        const float visible = float(link.visibleAndCone & 0xFFFFu) * (1.0 / 65535.0);
+        if (visible == 0.0) return;  // padding
+        const vec3 radiance = rgbToYCoCg(unpackRgb9e5(nodeRadiance[link.node]));
         float cone[kBandsY];
-        coneZonal(link.oneMinusCosAlpha, cone);
+        coneZonal(unpackHalf2x16(link.visibleAndCone >> 16u).x, cone);
         float basis[64];
         shEvaluate(decodeOctahedral(link.directionOct), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
-            const float w = link.factor * cone[kShBandOf[i]] * basis[i];
-            y[i] += flux.x * w;
+            const float w = visible * cone[kShBandOf[i]] * basis[i];
+            y[i] += radiance.x * w;
             if (i < kCountC) {
-                co[i] += flux.y * w;
-                cg[i] += flux.z * w;
+                co[i] += radiance.y * w;
+                cg[i] += radiance.z * w;
             }
         }
     } else {
-        // SH-projected links: lY² half coefficients; chroma takes the first lC².
+        // SH-projected links: lY² half coefficients, scaled by π·A at upload to take the
+        // node's radiance; chroma takes the first lC².
         const uint node = shNodes[slot];
         if (node == kNoNode) return;
-        const vec3 flux = rgbToYCoCg(nodeFlux[node].xyz);
+        const vec3 radiance = rgbToYCoCg(unpackRgb9e5(nodeRadiance[node]));
         const uint first = slot * kCountY;
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float k = float(shCoefficients[first + i]);
-            y[i] += flux.x * k;
+            y[i] += radiance.x * k;
             if (i < kCountC) {
-                co[i] += flux.y * k;
-                cg[i] += flux.z * k;
+                co[i] += radiance.y * k;
+                cg[i] += radiance.z * k;
             }
         }
     }

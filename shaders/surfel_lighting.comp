@@ -42,10 +42,12 @@ layout(std140, binding = 11) uniform Sh { ShTables sh; };
 layout(std430, binding = 12) writeonly buffer GroupFlux { vec4 groupFlux[]; };
 // Rays mode: bit i % 32 of word light·⌈nS/32⌉ + i/32 is set where light reaches surfel i.
 layout(std430, binding = 13) readonly buffer Visibility { uint visibility[]; };
+layout(std430, binding = 14) writeonly buffer NodeRadiance { uint nodeRadiance[]; };  // leaves
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
 #include "lib/lights.glsl"
+#include "lib/rgb9e5.glsl"
 
 shared vec3 partial[kSurfelLightingGroup];  // per subgroup
 
@@ -109,6 +111,8 @@ void main() {
             flux = directFlux[i].xyz + surfel.albedo * (surfel.area * irradiance);
         }
         nodeFlux[i] = vec4(flux, 0.0);
+        // Cache lighting reads the leaf's radiance Φ / (π·A) (paper 000 §4.7).
+        nodeRadiance[i] = packRgb9e5(flux / (kPi * surfel.area));
     }
 
     // Workgroup sum of the flux for the progressive stop (the host adds the groups in double):

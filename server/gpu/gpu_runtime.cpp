@@ -54,6 +54,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
 
     PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), 0,
                                                MemoryUse::Device, "node flux"));
+    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t), 0,
+                                                   MemoryUse::Device, "node radiance"));
     PIC_TRY_ASSIGN(mCacheY, ctx.createBuffer(2 * nC * countY, 0, MemoryUse::Device, "caches Y"));
     PIC_TRY_ASSIGN(mCacheCo, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Co"));
     PIC_TRY_ASSIGN(mCacheCg, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Cg"));
@@ -84,8 +86,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup));
     PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
     PIC_TRY(bindVisibility());
-    PIC_TRY(mPull->bind(mNodeFlux));
-    PIC_TRY(mCacheLighting->bind(mNodeFlux, mCacheY, mCacheCo, mCacheCg, mShTables));
+    PIC_TRY(mPull->bind(mNodeFlux, mNodeRadiance));
+    PIC_TRY(mCacheLighting->bind(mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
     PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
@@ -94,8 +96,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
 }
 
 Result<void> GpuRuntime::bindVisibility() {
-    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mCacheY, &mCacheCo,
-                           &mCacheCg, &mShTables});
+    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeRadiance,
+                           &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
 }
 
 Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
@@ -313,9 +315,19 @@ Result<std::vector<glm::vec3>> GpuRuntime::runPull(std::span<const glm::vec3> le
     return downloadFlux(mNodeFlux, mBake.nodes.size());
 }
 
+Result<std::vector<uint32_t>> GpuRuntime::nodeRadiance() {
+    std::vector<uint32_t> packed(mBake.nodes.size());
+    PIC_TRY(mContext->download(mNodeRadiance, packed.data(), packed.size() * sizeof(uint32_t)));
+    return packed;
+}
+
 Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), mBake.nodes.size());
-    PIC_TRY(uploadFlux(nodeFlux, mNodeFlux));
+    // What surfel lighting and the pull would have written: each node's radiance as RGB9E5.
+    std::vector<uint32_t> radiance(nodeFlux.size());
+    for (size_t n = 0; n < nodeFlux.size(); ++n)
+        radiance[n] = packRgb9e5(nodeFlux[n] * gpu::radianceScale(mBake.nodes[n].area));
+    PIC_TRY(mContext->upload(mNodeRadiance, radiance.data(), radiance.size() * sizeof(uint32_t)));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
         mCacheLighting->record(cmd);
         recordCacheReadback(cmd);
@@ -338,8 +350,9 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
     return {
         {"links", mCacheLighting->bytes()},
         {"surfels", mSurfels->bytes()},
-        {"node_children", mPull->bytes()},
+        {"pull_nodes", mPull->bytes()},
         {"node_flux", mNodeFlux.size()},
+        {"node_radiance", mNodeRadiance.size()},
         {"caches", mCacheY.size() + mCacheCo.size() + mCacheCg.size()},
         {"textures", mLightmapCopy->bytes()},
         mShadows ? std::pair<std::string, uint64_t>{"shadow_maps", mShadows->bytes()}

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <numbers>
 
+#include "core/color.h"
+#include "core/parallel.h"
 #include "shaders/shared/cache_lighting.h"
 #include "spirv/cache_lighting_comp.h"
 
@@ -14,6 +18,22 @@ namespace {
 constexpr uint32_t kChunkAlignment = 256;
 
 }  // namespace
+
+GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea) {
+    // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
+    const double visible =
+        std::clamp(double(link.factor) * std::numbers::pi * double(nodeArea), 0.0, 1.0);
+    auto unorm = uint32_t(std::lround(visible * 65535.0));
+    // A real link too faint for unorm16 would read as padding; it keeps the smallest step.
+    if (unorm == 0 && link.factor > 0.0f) unorm = 1;
+    const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
+    return {link.node, link.directionOct, unorm | (cone << 16)};
+}
+
+uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
+    return floatToHalfClamped(
+        float(double(halfToFloat(coefficient)) * std::numbers::pi * double(nodeArea)));
+}
 
 Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
                                                                      const BakeData& bake,
@@ -32,8 +52,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     const VkDeviceSize nLinks = VkDeviceSize{pass->mCacheCount} * links.linksPerCache;
 
     // The widest per-link binding decides how many caches a chunk may hold.
-    const VkDeviceSize widest = pass->mRtpForm ? sizeof(RtpLink)
-                                               : std::max<VkDeviceSize>(4, 2 * pass->mCountY);
+    const VkDeviceSize widest =
+        pass->mRtpForm ? sizeof(GpuRtpLink) : std::max<VkDeviceSize>(4, 2 * pass->mCountY);
     const VkDeviceSize perCache = std::max<VkDeviceSize>(widest * links.linksPerCache, 1);
     const VkDeviceSize maxRange = context.properties().limits.maxStorageBufferRange;
     VkDeviceSize chunk = (maxRange / perCache) / kChunkAlignment * kChunkAlignment;
@@ -59,22 +79,44 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                    Kernel::create(context, kSpirvCacheLightingComp, layout, "cache_lighting"));
 
     PIC_TRY_ASSIGN(pass->mUnused, context.createBuffer(16, 0, MemoryUse::Device, "unused links"));
+    // The links take the node's radiance Φ / (π·A) rather than its flux (§4.7).
     if (pass->mRtpForm) {
-        PIC_TRY_ASSIGN(pass->mRtp, context.createBufferWith(std::span<const RtpLink>(links.rtp), 0,
-                                                            "RTP links"));
-        pass->mLinkBytes = nLinks * sizeof(RtpLink);
+        std::vector<GpuRtpLink> rtp(links.rtp.size());
+        parallelFor(
+            0, rtp.size(),
+            [&](size_t i) {
+                const RtpLink& link = links.rtp[i];
+                // Padding (factor 0) may name any node; V = 0 marks it.
+                rtp[i] = link.factor > 0.0f ? packRtpLink(link, bake.nodes[link.node].area)
+                                            : GpuRtpLink{0, 0, 0};
+            },
+            4096);
+        PIC_TRY_ASSIGN(pass->mRtp,
+                       context.createBufferWith(std::span<const GpuRtpLink>(rtp), 0, "RTP links"));
+        pass->mLinkBytes = nLinks * sizeof(GpuRtpLink);
     } else {
+        std::vector<uint16_t> coefficients(links.shCoefficients.size());
+        const uint32_t countY = pass->mCountY;
+        parallelFor(
+            0, links.shNodes.size(),
+            [&](size_t slot) {
+                const uint32_t node = links.shNodes[slot];
+                const float area = node == kNoNode ? 0.0f : bake.nodes[node].area;
+                for (size_t i = slot * countY; i < (slot + 1) * countY; ++i)
+                    coefficients[i] = radianceShCoefficient(links.shCoefficients[i], area);
+            },
+            4096);
         PIC_TRY_ASSIGN(pass->mShNodes, context.createBufferWith(
                                            std::span<const uint32_t>(links.shNodes), 0, "SH link nodes"));
         PIC_TRY_ASSIGN(pass->mShCoefficients,
-                       context.createBufferWith(std::span<const uint16_t>(links.shCoefficients), 0,
+                       context.createBufferWith(std::span<const uint16_t>(coefficients), 0,
                                                 "SH link coefficients"));
         pass->mLinkBytes = nLinks * (4 + 2 * pass->mCountY);
     }
     return pass;
 }
 
-Result<void> CacheLightingPass::bind(const Buffer& nodeFlux, const Buffer& cacheY,
+Result<void> CacheLightingPass::bind(const Buffer& nodeRadiance, const Buffer& cacheY,
                                      const Buffer& cacheCo, const Buffer& cacheCg,
                                      const Buffer& shTables) {
     mSets.clear();
@@ -88,8 +130,8 @@ Result<void> CacheLightingPass::bind(const Buffer& nodeFlux, const Buffer& cache
         };
         // The other link form's bindings hold a small placeholder.
         const std::array<BindingResource, 8> resources = {
-            BindingResource::storage(0, nodeFlux),
-            mRtpForm ? chunkOf(1, mRtp, sizeof(RtpLink)) : BindingResource::storage(1, mUnused),
+            BindingResource::storage(0, nodeRadiance),
+            mRtpForm ? chunkOf(1, mRtp, sizeof(GpuRtpLink)) : BindingResource::storage(1, mUnused),
             mRtpForm ? BindingResource::storage(2, mUnused) : chunkOf(2, mShNodes, 4),
             mRtpForm ? BindingResource::storage(3, mUnused)
                      : chunkOf(3, mShCoefficients, 2 * VkDeviceSize{mCountY}),

@@ -10,18 +10,28 @@
 
 #include "core/bake_data.h"
 #include "server/gpu/kernel.h"
+#include "shaders/shared/cache_lighting.h"
 
 namespace pic::gpu {
 
+/// The GPU's 12-byte form of a runtime-projected link whose node has area `nodeArea`:
+/// V = factor·π·A as unorm16 (at least one step for a link with factor > 0) and 1 − cos α as
+/// binary16 (shaders/shared/cache_lighting.h).
+GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea);
+/// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
+/// c·π·A, clamped to ±65504.
+uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
+
 class CacheLightingPass {
 public:
-    /// Uploads the links (RTP: 16 bytes each; SH: node index + lY² half coefficients).
+    /// Uploads the links (RTP: 12 bytes each, packRtpLink; SH: node index + lY² half
+    /// coefficients, radianceShCoefficient).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
                                                              bool cachePerSubgroup);
-    /// Binds node flux (vec4 per node), the output caches (half) and the SH tables.
-    Result<void> bind(const Buffer& nodeFlux, const Buffer& cacheY, const Buffer& cacheCo,
+    /// Binds the node radiance (RGB9E5 per node), the output caches (half) and the SH tables.
+    Result<void> bind(const Buffer& nodeRadiance, const Buffer& cacheY, const Buffer& cacheCo,
                       const Buffer& cacheCg, const Buffer& shTables);
     void record(VkCommandBuffer cmd);
     /// Link bytes read per update.
@@ -38,7 +48,7 @@ private:
     uint32_t mLinksPerCache = 0;
     uint32_t mCountY = 0;
     VkDeviceSize mLinkBytes = 0;
-    Buffer mRtp;             ///< RtpLink per link (RTP)
+    Buffer mRtp;             ///< GpuRtpLink per link (RTP)
     Buffer mShNodes;         ///< uint per link (SH)
     Buffer mShCoefficients;  ///< lY² halves per link (SH)
     Buffer mUnused;          ///< bound where the other link form's buffers go

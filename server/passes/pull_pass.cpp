@@ -1,6 +1,7 @@
 #include "server/passes/pull_pass.h"
 
 #include <array>
+#include <numbers>
 
 #include <glm/glm.hpp>
 
@@ -9,27 +10,35 @@
 
 namespace pic::gpu {
 
+float radianceScale(float area) {
+    return float(1.0 / (std::numbers::pi * double(area)));
+}
+
 Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake) {
     std::unique_ptr<PullPass> pass(new PullPass());
     const size_t nS = bake.surfels.size();
     pass->mSurfelCount = uint32_t(nS);
     pass->mLevelOffsets = bake.levelOffsets;
     KernelLayout layout;
-    layout.bindings.assign(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings.assign(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     layout.pushBytes = sizeof(PullPush);
     PIC_TRY_ASSIGN(pass->mKernel, Kernel::create(context, kSpirvPullComp, layout, "pull"));
-    // Only the children matter to the pull: 8 bytes per inner node instead of the 64-byte Node.
-    std::vector<glm::uvec2> children(bake.nodes.size() - nS);
-    for (size_t n = nS; n < bake.nodes.size(); ++n)
-        children[n - nS] = {bake.nodes[n].left, bake.nodes[n].right};
-    PIC_TRY_ASSIGN(pass->mChildren, context.createBufferWith(std::span<const glm::uvec2>(children),
-                                                             0, "node children"));
+    // Only the children and the area matter to the pull: 12 bytes per inner node instead of
+    // the 64-byte Node.
+    std::vector<PullNode> inner(bake.nodes.size() - nS);
+    for (size_t n = nS; n < bake.nodes.size(); ++n) {
+        const Node& node = bake.nodes[n];
+        inner[n - nS] = {node.left, node.right, radianceScale(node.area)};
+    }
+    PIC_TRY_ASSIGN(pass->mInnerNodes,
+                   context.createBufferWith(std::span<const PullNode>(inner), 0, "pull nodes"));
     return pass;
 }
 
-Result<void> PullPass::bind(const Buffer& nodeFlux) {
-    const std::array<BindingResource, 2> resources = {BindingResource::storage(0, nodeFlux),
-                                                      BindingResource::storage(1, mChildren)};
+Result<void> PullPass::bind(const Buffer& nodeFlux, const Buffer& nodeRadiance) {
+    const std::array<BindingResource, 3> resources = {BindingResource::storage(0, nodeFlux),
+                                                      BindingResource::storage(1, mInnerNodes),
+                                                      BindingResource::storage(2, nodeRadiance)};
     PIC_TRY(mKernel.resetSets());
     PIC_TRY_ASSIGN(mSet, mKernel.makeSet(resources));
     return {};

@@ -1,6 +1,7 @@
 #pragma once
 /// Pull on the GPU (paper 000 Figure 2 step 3, §4.1): node flux = sum of its children's, one
-/// dispatch per hierarchy level, lowest first. CPU twin: server/cpu/pull.h.
+/// dispatch per hierarchy level, lowest first; each inner node's radiance Φ / (π·A) is also
+/// written as RGB9E5 for cache lighting (§4.7). CPU twin: server/cpu/pull.h.
 
 #include <memory>
 #include <vector>
@@ -10,21 +11,26 @@
 
 namespace pic::gpu {
 
+/// 1 / (π·area): the radiance W/(m²·sr) of a Lambertian node per watt of its flux (paper 000
+/// §4.1), as the pull scales it.
+float radianceScale(float area);
+
 class PullPass {
 public:
-    /// Uploads each inner node's two children.
+    /// Uploads each inner node's two children and 1 / (π·area).
     static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake);
-    /// Binds the node flux buffer (vec4 per node, leaves written by surfel lighting).
-    Result<void> bind(const Buffer& nodeFlux);
+    /// Binds the node flux (vec4 per node) and node radiance (RGB9E5 per node) buffers, whose
+    /// leaves surfel lighting writes.
+    Result<void> bind(const Buffer& nodeFlux, const Buffer& nodeRadiance);
     /// Records every level with a barrier after each, so a level reads finished children.
     void record(VkCommandBuffer cmd);
-    VkDeviceSize bytes() const { return mChildren.size(); }
+    VkDeviceSize bytes() const { return mInnerNodes.size(); }
 
 private:
     PullPass() = default;
     Kernel mKernel;
     VkDescriptorSet mSet = VK_NULL_HANDLE;
-    Buffer mChildren;
+    Buffer mInnerNodes;  ///< PullNode per inner node
     uint32_t mSurfelCount = 0;
     std::vector<uint32_t> mLevelOffsets;
 };

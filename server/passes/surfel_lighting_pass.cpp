@@ -11,7 +11,7 @@
 namespace pic::gpu {
 namespace {
 
-constexpr uint32_t kBindingCount = 14;
+constexpr uint32_t kBindingCount = 15;
 constexpr uint32_t kSamplerBinding = 4;
 constexpr uint32_t kShTablesBinding = 11;
 
@@ -103,7 +103,7 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
 Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     const bool rays = mVisibility == DirectVisibility::Rays;
     PIC_CHECK(rays ? r.rays != nullptr : r.shadows != nullptr);
-    PIC_CHECK(r.nodeFlux && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    PIC_CHECK(r.nodeFlux && r.nodeRadiance && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::storage(0, mSurfels),
         BindingResource::storage(1, rays ? r.rays->lightBuffer() : r.shadows->lightBuffer()),
@@ -120,6 +120,7 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         BindingResource::storage(11, *r.shTables),
         BindingResource::storage(12, mGroupFlux),
         BindingResource::storage(13, rays ? r.rays->visibilityBuffer() : mUnusedVisibility),
+        BindingResource::storage(14, *r.nodeRadiance),
     };
     PIC_TRY(mDirect.resetSets());
     PIC_TRY(mBounce.resetSets());

@@ -19,6 +19,17 @@ PIC_CONST(uint, kCachePerSubgroup, 1u);
 // Largest |radiance| a half-float cache coefficient holds; larger values are clamped.
 PIC_CONST(float, kHalfMax, 65504.0f);
 
+// A runtime-projected link as the GPU reads it: 12 bytes, paper 000 Table 4 (the bake's
+// RtpLink is 16). Its node's flux comes as radiance Φ / (π·A) (RGB9E5, written by surfel
+// lighting and the pull), so the link keeps the visible fraction V = factor·π·A ∈ [0, 1]
+// instead of the factor: Φ·factor = (Φ / (π·A))·V.
+struct GpuRtpLink {
+    uint node;            // index into the node array
+    uint directionOct;    // unit direction cache → node, octahedral 2 × snorm16
+    uint visibleAndCone;  // unorm16 V (0 marks padding) | binary16 (1 − cos α) << 16
+};
+PIC_STRUCT_CHECK(GpuRtpLink, 12);
+
 struct CacheLightingPush {
     uint firstCache;  // the chunk is caches [firstCache, firstCache + cacheCount)
     uint cacheCount;

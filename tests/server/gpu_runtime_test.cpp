@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <string>
 #include <tuple>
@@ -14,6 +15,7 @@
 
 #include "bake/bake.h"
 #include "bake/embree_scene.h"
+#include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/light_set.h"
 #include "server/cpu/cache_lighting.h"
@@ -23,9 +25,13 @@
 #include "server/cpu/surfel_lighting.h"
 #include "server/gpu/copy_probe.h"
 #include "server/gpu/gpu_runtime.h"
+#include "server/passes/cache_lighting_pass.h"
+#include "server/passes/pull_pass.h"
 
 namespace pic {
 namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
 
 /// A test scene, its rays and a small bake per (scene, link form, lY, lC), shared.
 struct Baked {
@@ -135,6 +141,82 @@ TEST(GpuPull, NodeFluxIsExact) {
     pullFlux(b.bake, nodes);
     // Each inner node is one float addition of the same two children: bit-exact.
     for (size_t n = 0; n < nodes.size(); ++n) ASSERT_EQ((*pulled)[n], nodes[n]) << "node " << n;
+}
+
+TEST(GpuPull, NodeRadianceIsFluxOverPiAreaAsRgb9e5) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b, {}, {.directVisibility = gpu::DirectVisibility::Rays});
+    ASSERT_TRUE(gpu);
+    const size_t nS = b.bake.surfels.size();
+    // Leaves: surfel lighting packs flux / (π·A), its division rounded by the device, so the
+    // code may differ from the host's by one mantissa step.
+    auto direct = gpu->runDirect(defaultLightSet(b.scene));
+    ASSERT_TRUE(direct) << direct.error().message;
+    auto leaves = gpu->nodeRadiance();
+    ASSERT_TRUE(leaves) << leaves.error().message;
+    size_t lit = 0;
+    for (size_t i = 0; i < nS; ++i) {
+        const glm::vec3 expected = (*direct)[i] / (kPi * b.bake.surfels[i].area);
+        const glm::vec3 got = unpackRgb9e5((*leaves)[i]);
+        const float largest = std::max({expected.r, expected.g, expected.b});
+        if (largest > 0.0f) ++lit;
+        for (int c = 0; c < 3; ++c)
+            ASSERT_LE(std::abs(got[c] - expected[c]), largest / 256.0f) << "surfel " << i;
+    }
+    EXPECT_GT(lit, nS / 4);
+
+    // Inner nodes: the pull's float sum times the uploaded 1 / (π·A), packed with the same
+    // exact operations as packRgb9e5: bit for bit.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 3.0f);
+    std::vector<glm::vec3> flux(nS);
+    for (glm::vec3& f : flux) f = {u(rng), u(rng), u(rng)};
+    auto pulled = gpu->runPull(flux);
+    ASSERT_TRUE(pulled) << pulled.error().message;
+    auto radiance = gpu->nodeRadiance();
+    ASSERT_TRUE(radiance) << radiance.error().message;
+    for (size_t n = nS; n < b.bake.nodes.size(); ++n)
+        ASSERT_EQ((*radiance)[n],
+                  packRgb9e5((*pulled)[n] * gpu::radianceScale(b.bake.nodes[n].area)))
+            << "node " << n;
+}
+
+TEST(GpuCacheLighting, RtpLinksPackIntoTwelveBytes) {
+    // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as unorm16.
+    const float area = 0.37f;
+    const auto pack = [&](float visible, float oneMinusCos) {
+        const gpu::RtpLink link{42, visible / (kPi * area), encodeOctahedral({0, 0, 1}),
+                                oneMinusCos};
+        return gpu::packRtpLink(link, area);
+    };
+    const auto visibleOf = [](const gpu::GpuRtpLink& l) {
+        return float(l.visibleAndCone & 0xFFFFu) / 65535.0f;
+    };
+    const auto coneOf = [](const gpu::GpuRtpLink& l) {
+        return halfToFloat(uint16_t(l.visibleAndCone >> 16));
+    };
+    for (const float visible : {1.0f, 0.75f, 0.3f, 1e-3f}) {
+        for (const float oneMinusCos : {2.0f, 0.5f, 1e-2f, 3e-5f, 1e-7f}) {
+            const gpu::GpuRtpLink l = pack(visible, oneMinusCos);
+            EXPECT_EQ(l.node, 42u);
+            EXPECT_EQ(l.directionOct, encodeOctahedral({0, 0, 1}));
+            EXPECT_NEAR(visibleOf(l), visible, 0.5f / 65535.0f + 1e-6f * visible);
+            // binary16: relative 2^-11 for normal values, 2^-25 absolute below 2^-14.
+            EXPECT_NEAR(coneOf(l), oneMinusCos, std::max(oneMinusCos / 2048.0f, 3e-8f));
+        }
+    }
+    // A link too faint for unorm16 keeps one step instead of reading as padding; padding
+    // (factor 0) stays 0; rounding never takes V past 1.
+    EXPECT_EQ(pack(1e-7f, 0.1f).visibleAndCone & 0xFFFFu, 1u);
+    EXPECT_EQ(pack(0.0f, 0.1f).visibleAndCone & 0xFFFFu, 0u);
+    EXPECT_EQ(pack(1.0001f, 0.1f).visibleAndCone & 0xFFFFu, 65535u);
+
+    // SH links: c·π·A in binary16, saturating.
+    const float c = 123.5f / (kPi * area);
+    EXPECT_NEAR(halfToFloat(gpu::radianceShCoefficient(floatToHalf(c), area)), 123.5f, 0.1f);
+    EXPECT_EQ(gpu::radianceShCoefficient(floatToHalf(-60000.0f), 10.0f), floatToHalf(-65504.0f));
+    EXPECT_EQ(gpu::radianceShCoefficient(floatToHalf(5.0f), 0.0f), floatToHalf(0.0f));
 }
 
 /// Cache lighting for a link form and band split, each cache lit by a subgroup (as on a
