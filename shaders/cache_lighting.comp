@@ -20,15 +20,15 @@ layout(constant_id = 3) const uint kLinkForm = 1u;
 layout(constant_id = 4) const uint kMapping = 0u;
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
+const uint kShPairs = (kCountY + 1u) / 2u;  // shared/cache_lighting.h shLinkWords − 1
 
 layout(std430, binding = 0) readonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGB9E5
 layout(std430, binding = 1) readonly buffer RtpLinks { GpuRtpLink rtpLinks[]; };    // chunk
-layout(std430, binding = 2) readonly buffer ShNodes { uint shNodes[]; };            // chunk
-layout(std430, binding = 3) readonly buffer ShCoefficients { float16_t shCoefficients[]; };
-layout(std430, binding = 4) writeonly buffer CacheY { float16_t cacheY[]; };
-layout(std430, binding = 5) writeonly buffer CacheCo { float16_t cacheCo[]; };
-layout(std430, binding = 6) writeonly buffer CacheCg { float16_t cacheCg[]; };
-layout(std140, binding = 7) uniform Sh { ShTables sh; };
+layout(std430, binding = 2) readonly buffer ShLinks { uint shLinks[]; };            // chunk
+layout(std430, binding = 3) writeonly buffer CacheY { float16_t cacheY[]; };
+layout(std430, binding = 4) writeonly buffer CacheCo { float16_t cacheCo[]; };
+layout(std430, binding = 5) writeonly buffer CacheCg { float16_t cacheCg[]; };
+layout(std140, binding = 6) uniform Sh { ShTables sh; };
 layout(push_constant) uniform Push { CacheLightingPush pc; };
 
 #include "lib/rgb9e5.glsl"
@@ -63,18 +63,23 @@ void addLink(uint slot) {
             }
         }
     } else {
-        // SH-projected links: lY² half coefficients, scaled by π·A at upload to take the
-        // node's radiance; chroma takes the first lC².
-        const uint node = shNodes[slot];
+        // SH-projected links: the node, then lY² half coefficients two per word, scaled by
+        // π·A at upload to take the node's radiance; chroma takes the first lC².
+        const uint first = slot * (1u + kShPairs);
+        const uint node = shLinks[first];
         if (node == kNoNode) return;
         const vec3 radiance = rgbToYCoCg(unpackRgb9e5(nodeRadiance[node]));
-        const uint first = slot * kCountY;
-        [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
-            const float k = float(shCoefficients[first + i]);
-            y[i] += radiance.x * k;
-            if (i < kCountC) {
-                co[i] += radiance.y * k;
-                cg[i] += radiance.z * k;
+        [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
+            const vec2 pair = unpackHalf2x16(shLinks[first + 1u + p]);
+            [[unroll]] for (uint h = 0u; h < 2u; ++h) {
+                const uint i = 2u * p + h;
+                if (i >= kCountY) break;
+                const float k = pair[h];
+                y[i] += radiance.x * k;
+                if (i < kCountC) {
+                    co[i] += radiance.y * k;
+                    cg[i] += radiance.z * k;
+                }
             }
         }
     }

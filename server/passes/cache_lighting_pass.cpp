@@ -17,6 +17,9 @@ namespace {
 /// buffers is a multiple of 256 bytes (the largest minStorageBufferOffsetAlignment in use).
 constexpr uint32_t kChunkAlignment = 256;
 
+/// Node radiance, RTP links, SH links, caches Y, Co, Cg, SH tables.
+constexpr uint32_t kBindingCount = 7;
+
 }  // namespace
 
 GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea) {
@@ -53,7 +56,7 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
 
     // The widest per-link binding decides how many caches a chunk may hold.
     const VkDeviceSize widest =
-        pass->mRtpForm ? sizeof(GpuRtpLink) : std::max<VkDeviceSize>(4, 2 * pass->mCountY);
+        pass->mRtpForm ? sizeof(GpuRtpLink) : sizeof(uint32_t) * shLinkWords(pass->mCountY);
     const VkDeviceSize perCache = std::max<VkDeviceSize>(widest * links.linksPerCache, 1);
     const VkDeviceSize maxRange = context.properties().limits.maxStorageBufferRange;
     VkDeviceSize chunk = (maxRange / perCache) / kChunkAlignment * kChunkAlignment;
@@ -68,8 +71,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     }
 
     KernelLayout layout;
-    layout.bindings.assign(8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-    layout.bindings[7] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
+    layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings[kBindingCount - 1] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
     layout.pushBytes = sizeof(CacheLightingPush);
     layout.specialization = {bake.params.bandsY, bake.params.bandsC, links.linksPerCache,
                              pass->mRtpForm ? kLinkFormRtp : kLinkFormSh,
@@ -95,23 +98,25 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                        context.createBufferWith(std::span<const GpuRtpLink>(rtp), 0, "RTP links"));
         pass->mLinkBytes = nLinks * sizeof(GpuRtpLink);
     } else {
-        std::vector<uint16_t> coefficients(links.shCoefficients.size());
         const uint32_t countY = pass->mCountY;
+        const size_t words = shLinkWords(countY);
+        std::vector<uint32_t> sh(links.shNodes.size() * words, 0u);
         parallelFor(
             0, links.shNodes.size(),
             [&](size_t slot) {
                 const uint32_t node = links.shNodes[slot];
                 const float area = node == kNoNode ? 0.0f : bake.nodes[node].area;
-                for (size_t i = slot * countY; i < (slot + 1) * countY; ++i)
-                    coefficients[i] = radianceShCoefficient(links.shCoefficients[i], area);
+                uint32_t* record = sh.data() + slot * words;
+                record[0] = node;
+                const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
+                for (uint32_t i = 0; i < countY; ++i)
+                    record[1 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
+                                         << (16 * (i % 2));
             },
             4096);
-        PIC_TRY_ASSIGN(pass->mShNodes, context.createBufferWith(
-                                           std::span<const uint32_t>(links.shNodes), 0, "SH link nodes"));
-        PIC_TRY_ASSIGN(pass->mShCoefficients,
-                       context.createBufferWith(std::span<const uint16_t>(coefficients), 0,
-                                                "SH link coefficients"));
-        pass->mLinkBytes = nLinks * (4 + 2 * pass->mCountY);
+        PIC_TRY_ASSIGN(pass->mSh,
+                       context.createBufferWith(std::span<const uint32_t>(sh), 0, "SH links"));
+        pass->mLinkBytes = nLinks * words * sizeof(uint32_t);
     }
     return pass;
 }
@@ -129,16 +134,15 @@ Result<void> CacheLightingPass::bind(const Buffer& nodeRadiance, const Buffer& c
             return BindingResource::storage(binding, b, links * stride, count * stride);
         };
         // The other link form's bindings hold a small placeholder.
-        const std::array<BindingResource, 8> resources = {
+        const std::array<BindingResource, kBindingCount> resources = {
             BindingResource::storage(0, nodeRadiance),
             mRtpForm ? chunkOf(1, mRtp, sizeof(GpuRtpLink)) : BindingResource::storage(1, mUnused),
-            mRtpForm ? BindingResource::storage(2, mUnused) : chunkOf(2, mShNodes, 4),
-            mRtpForm ? BindingResource::storage(3, mUnused)
-                     : chunkOf(3, mShCoefficients, 2 * VkDeviceSize{mCountY}),
-            BindingResource::storage(4, cacheY),
-            BindingResource::storage(5, cacheCo),
-            BindingResource::storage(6, cacheCg),
-            BindingResource::storage(7, shTables),
+            mRtpForm ? BindingResource::storage(2, mUnused)
+                     : chunkOf(2, mSh, sizeof(uint32_t) * shLinkWords(mCountY)),
+            BindingResource::storage(3, cacheY),
+            BindingResource::storage(4, cacheCo),
+            BindingResource::storage(5, cacheCg),
+            BindingResource::storage(6, shTables),
         };
         PIC_TRY_ASSIGN(VkDescriptorSet set, mKernel.makeSet(resources));
         mSets.push_back(set);

@@ -25,7 +25,7 @@ uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 class CacheLightingPass {
 public:
     /// Uploads the links (RTP: 12 bytes each, packRtpLink; SH: node index + lY² half
-    /// coefficients, radianceShCoefficient).
+    /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
@@ -36,7 +36,7 @@ public:
     void record(VkCommandBuffer cmd);
     /// Link bytes read per update.
     VkDeviceSize linkBytes() const { return mLinkBytes; }
-    VkDeviceSize bytes() const { return mRtp.size() + mShNodes.size() + mShCoefficients.size(); }
+    VkDeviceSize bytes() const { return mRtp.size() + mSh.size(); }
     uint32_t chunks() const { return uint32_t(mChunkFirst.size()); }
 
 private:
@@ -49,8 +49,7 @@ private:
     uint32_t mCountY = 0;
     VkDeviceSize mLinkBytes = 0;
     Buffer mRtp;             ///< GpuRtpLink per link (RTP)
-    Buffer mShNodes;         ///< uint per link (SH)
-    Buffer mShCoefficients;  ///< lY² halves per link (SH)
+    Buffer mSh;              ///< shLinkWords(lY²) words per link (SH)
     Buffer mUnused;          ///< bound where the other link form's buffers go
     std::vector<uint32_t> mChunkFirst;
     std::vector<uint32_t> mChunkCount;

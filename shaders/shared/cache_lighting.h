@@ -30,6 +30,15 @@ struct GpuRtpLink {
 };
 PIC_STRUCT_CHECK(GpuRtpLink, 12);
 
+// An SH-projected link as the GPU reads it: the node index, then its lY² binary16
+// coefficients (rescaled by π·A to take the node's radiance) two per 32-bit word, the last
+// word's high half zero when lY² is odd. Whole words keep each lane's loads few: 1 + ⌈lY²/2⌉.
+#ifdef __cplusplus
+inline constexpr uint shLinkWords(uint countY) {
+    return 1u + (countY + 1u) / 2u;
+}
+#endif
+
 struct CacheLightingPush {
     uint firstCache;  // the chunk is caches [firstCache, firstCache + cacheCount)
     uint cacheCount;
