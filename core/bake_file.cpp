@@ -180,6 +180,10 @@ Result<void> checkNodes(const BakeView& v, ErrorCode code, const std::string& wh
             if (index != kNoNode && index >= nNodes)
                 return fail(code, "{}: node {} has {} {} but there are {} nodes", what, i, relation,
                             index, nNodes);
+        // The runtime turns a node's flux into radiance Φ / (π·A).
+        if (!(std::isfinite(node.area) && node.area > 0.0f))
+            return fail(code, "{}: node {} has area {} m², expected a finite positive area", what,
+                        i, node.area);
         if (uint64_t{node.firstSurfel} + node.surfelCount > nS)
             return fail(code, "{}: node {} covers surfels [{}, {}) but there are {}", what, i,
                         node.firstSurfel, uint64_t{node.firstSurfel} + node.surfelCount, nS);

@@ -545,6 +545,8 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     badSurfelRange.nodes[6].surfelCount = 5;
     BakeData badLevels = makeBake(LinkMode::Rtp);
     badLevels.levelOffsets = {4, 7, 6};
+    BakeData zeroArea = makeBake(LinkMode::Rtp);
+    zeroArea.nodes[5].area = 0.0f;
     BakeData badCacheKind = makeBake(LinkMode::Rtp);
     badCacheKind.caches[1].kind = 2;
     BakeData badUvs = makeBake(LinkMode::Rtp);
@@ -558,6 +560,7 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
         {&badNodeChild, "node 5 has right child 7"},
         {&badSurfelRange, "node 6 covers surfels [0, 5) but there are 4"},
         {&badLevels, "level offset 2 is 6"},
+        {&zeroArea, "node 5 has area 0 m²"},
         {&badCacheKind, "cache 1 has kind 2"},
         {&badUvs, "5 light-map UVs"},
         {&badRtpNode, "RTP link 1 refers to node 9"},
