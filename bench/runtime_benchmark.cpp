@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include <nlohmann/json.hpp>
@@ -120,6 +121,51 @@ nlohmann::ordered_json figuresJson(const BackendFigures& f) {
     json["pass_ms_median"] = nlohmann::ordered_json::object();
     for (const auto& [pass, ms] : f.passMs) json["pass_ms_median"][pass] = median(ms);
     return json;
+}
+
+/// GPU/CPU ratio of every run against the CPU twin's update time: a scatter per visibility
+/// source and link form, and the goal (ratio 1) dashed.
+Chart ratioChart(const nlohmann::ordered_json& json) {
+    struct Kind {
+        const char* visibility;
+        const char* linkMode;
+        const char* name;
+        glm::vec3 color;
+    };
+    const Kind kinds[] = {
+        {"rays", "rtp", "host rays, RTP links", {0.15f, 0.55f, 0.25f}},
+        {"rays", "sh", "host rays, SH links", {0.55f, 0.8f, 0.3f}},
+        {"shadow-maps", "rtp", "shadow maps, RTP links", {0.85f, 0.4f, 0.1f}},
+        {"shadow-maps", "sh", "shadow maps, SH links", {0.95f, 0.7f, 0.2f}},
+    };
+    Chart chart;
+    chart.title = fmt::format("GPU backend against the CPU twin ({})",
+                              json["runs"].empty() ? std::string("no runs")
+                                                   : json["runs"][0]["device"].get<std::string>());
+    chart.xLabel = "CPU twin ms per update (median)";
+    chart.yLabel = "GPU ms / CPU twin ms";
+    chart.logX = true;
+    double lowest = std::numeric_limits<double>::max(), highest = 0.0;
+    for (const Kind& kind : kinds) {
+        ChartSeries series{kind.name, kind.color};
+        series.connected = false;
+        for (const auto& run : json["runs"]) {
+            if (run["direct_visibility"] != kind.visibility || run["link_mode"] != kind.linkMode)
+                continue;
+            const double cpuMs = run["cpu"]["update_ms_median"].get<double>();
+            series.points.push_back({cpuMs, run["gpu_over_cpu"].get<double>()});
+            lowest = std::min(lowest, cpuMs);
+            highest = std::max(highest, cpuMs);
+        }
+        if (!series.points.empty()) chart.series.push_back(std::move(series));
+    }
+    if (highest > 0.0) {
+        ChartSeries goal{"goal: GPU/CPU <= 1", glm::vec3(0.3f)};
+        goal.dashed = true;
+        goal.points = {{lowest, 1.0}, {highest, 1.0}};
+        chart.series.push_back(std::move(goal));
+    }
+    return chart;
 }
 
 }  // namespace
@@ -247,6 +293,8 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
         floor->deviceCopy ? "by timestamps"
                           : "by wall clock (lavapipe's timestamps do not wait for it)",
         floorName);
+    if (int exit = writeChartFile(ratioChart(json), chartPathFor(params.jsonPath)); exit != 0)
+        return exit;
     return writeJson(json, params.jsonPath);
 }
 

@@ -139,10 +139,10 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
     }
     OIIO::ImageBufAlgo::render_box(image, left, top, left + plotW, top + plotH, OIIO::cspan<float>(black, 3));
 
-    // Series: polylines (dashed ones in segments), markers, point labels.
+    // Series: polylines (dashed ones in segments; none for a scatter), markers, point labels.
     for (const ChartSeries& series : chart.series) {
         const float color[] = {series.color.r, series.color.g, series.color.b};
-        for (size_t i = 0; i + 1 < series.points.size(); ++i) {
+        for (size_t i = 0; series.connected && i + 1 < series.points.size(); ++i) {
             const glm::ivec2 a = toPixel(series.points[i]), b = toPixel(series.points[i + 1]);
             if (!series.dashed) {
                 for (int d = -1; d <= 1; ++d)

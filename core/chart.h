@@ -19,6 +19,7 @@ struct ChartSeries {
     std::vector<glm::dvec2> points;   ///< in data units, drawn in order
     std::vector<std::string> labels;  ///< empty, or one per point, written beside it
     bool dashed = false;              ///< for goals and references
+    bool connected = true;            ///< false: markers only, a scatter of unordered points
 };
 
 struct Chart {

@@ -81,6 +81,11 @@ TEST_F(PicbenchRuntime, ReportsEveryKindOfLightChange) {
         else
             EXPECT_GE(drawn, report.at("triangles").get<uint64_t>());
     }
+    // The ratio chart beside the JSON: a PNG.
+    std::ifstream png(mDir / "runtime.png", std::ios::binary);
+    std::string signature(8, '\0');
+    ASSERT_TRUE(png.read(signature.data(), 8)) << "no runtime.png beside the JSON";
+    EXPECT_EQ(signature, std::string("\x89PNG\r\n\x1a\n", 8));
 }
 
 TEST_F(PicbenchRuntime, ShadowErrorFallsWithSize) {

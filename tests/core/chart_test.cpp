@@ -42,6 +42,26 @@ TEST(Chart, WritesAPngOfTheAskedSizeWithTheSeriesDrawn) {
     fs::remove(path);
 }
 
+TEST(Chart, AScatterDrawsMarkersWithoutLines) {
+    const fs::path path = fs::temp_directory_path() / fmt::format("pic_scatter_{}.png", getpid());
+    const auto redPixels = [&](bool connected) -> size_t {
+        Chart chart = sample();
+        chart.series[0].connected = connected;
+        chart.series[0].labels.clear();
+        if (!writeChart(chart, path.string(), 640, 400)) return 0;
+        auto image = readImage(path.string());
+        if (!image) return 0;
+        size_t red = 0;
+        for (const glm::vec3& p : image->pixels) red += p.r > 0.8f && p.g < 0.2f && p.b < 0.2f;
+        return red;
+    };
+    const size_t line = redPixels(true), scatter = redPixels(false);
+    // Three 7 × 7 markers, and the legend's swatch.
+    EXPECT_GE(scatter, 3u * 49u);
+    EXPECT_LT(scatter, line / 2) << "lines between the points were drawn";
+    fs::remove(path);
+}
+
 TEST(Chart, RefusesBadData) {
     const std::string path = (fs::temp_directory_path() / "pic_chart_refused.png").string();
     Chart empty;
