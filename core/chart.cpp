@@ -128,6 +128,16 @@ Result<void> writeChart(const Chart& chart, const std::string& path, int width, 
             for (const glm::dvec2& p : series.points) xTicks.push_back(p.x);
         std::sort(xTicks.begin(), xTicks.end());
         xTicks.erase(std::unique(xTicks.begin(), xTicks.end()), xTicks.end());
+        // A few distinct x (subscriber counts) are ticks themselves; many (scattered
+        // timings) would overprint, so those get 1-2-5 ticks per decade.
+        if (xTicks.size() > 8) {
+            xTicks.clear();
+            const double from = std::exp2(x0), to = std::exp2(x1);
+            for (double decade = std::pow(10.0, std::floor(std::log10(from))); decade <= to;
+                 decade *= 10.0)
+                for (const double m : {1.0, 2.0, 5.0})
+                    if (m * decade >= from && m * decade <= to) xTicks.push_back(m * decade);
+        }
     } else {
         xTicks = linearTicks(x0, x1, 7);
     }
