@@ -9,8 +9,10 @@
 namespace pic {
 namespace {
 
-constexpr int kRgb9e5MantissaBits = 9;
-constexpr int kRgb9e5Bias = 15;
+constexpr int kRgbe8MantissaBits = 8;
+constexpr int kRgbe8Bias = 128;
+/// Largest channels below this store 0 (it keeps every scale below a normal float).
+constexpr float kRgbe8Min = 0x1p-100f;
 
 /// 2^exponent as a float, built from its bits; exponent in [-126, 127].
 float exp2i(int exponent) {
@@ -130,33 +132,34 @@ glm::vec3 decodeOctahedral(uint32_t code) {
     return glm::normalize(dir);
 }
 
-uint32_t packRgb9e5(const glm::vec3& rgb) {
+uint32_t packRgbe8(const glm::vec3& rgb) {
     // Negative and NaN channels fail `c > 0` and store 0.
-    const auto clampChannel = [](float c) { return c > 0.0f ? std::min(c, kRgb9e5Max) : 0.0f; };
+    const auto clampChannel = [](float c) { return c > 0.0f ? std::min(c, kRgbe8Max) : 0.0f; };
     const float r = clampChannel(rgb.r);
     const float g = clampChannel(rgb.g);
     const float b = clampChannel(rgb.b);
     const float maxChannel = std::max({r, g, b});
-    // Shared exponent from floor(log2(max)), read from the float's exponent bits; values
-    // below 2^-16 all use the smallest exponent.
-    int floorLog2 = -kRgb9e5Bias - 1;
-    if (maxChannel >= exp2i(-kRgb9e5Bias - 1))
-        floorLog2 = int(std::bit_cast<uint32_t>(maxChannel) >> 23) - 127;
-    int shared = floorLog2 + 1 + kRgb9e5Bias;
-    float scale = exp2i(kRgb9e5MantissaBits + kRgb9e5Bias - shared);  // 1 / mantissa step
-    // Rounding the largest channel up to 2^9 needs the next exponent.
-    if (std::floor(maxChannel * scale + 0.5f) >= float(1 << kRgb9e5MantissaBits)) {
-        ++shared;
+    if (maxChannel < kRgbe8Min) return 0;
+    // The exponent e with max / 2^e in [1/2, 1): floor(log2(max)) + 1 from the float's exponent
+    // bits, in [-99, 127].
+    int exponent = int(std::bit_cast<uint32_t>(maxChannel) >> 23) - 127 + 1;
+    float scale = exp2i(kRgbe8MantissaBits - exponent);  // 1 / mantissa step
+    // Rounding the largest channel up to 2^8 needs the next exponent (never past 127: the
+    // clamp keeps max · 2^-119 <= 255).
+    if (std::floor(maxChannel * scale + 0.5f) >= float(1 << kRgbe8MantissaBits)) {
+        ++exponent;
         scale *= 0.5f;
     }
     const auto mantissa = [scale](float c) { return uint32_t(std::floor(c * scale + 0.5f)); };
-    return mantissa(r) | (mantissa(g) << 9) | (mantissa(b) << 18) | (uint32_t(shared) << 27);
+    return mantissa(r) | (mantissa(g) << 8) | (mantissa(b) << 16) |
+           (uint32_t(exponent + kRgbe8Bias) << 24);
 }
 
-glm::vec3 unpackRgb9e5(uint32_t packed) {
-    const float step = exp2i(int(packed >> 27) - kRgb9e5Bias - kRgb9e5MantissaBits);
-    return {float(packed & 0x1ffu) * step, float((packed >> 9) & 0x1ffu) * step,
-            float((packed >> 18) & 0x1ffu) * step};
+glm::vec3 unpackRgbe8(uint32_t packed) {
+    // ldexp: exact, and defined for the exponent bytes packRgbe8 never writes (below 29).
+    const float step = std::ldexp(1.0f, int(packed >> 24) - kRgbe8Bias - kRgbe8MantissaBits);
+    return {float(packed & 0xffu) * step, float((packed >> 8) & 0xffu) * step,
+            float((packed >> 16) & 0xffu) * step};
 }
 
 float luminance(const glm::vec3& linearRgb) {

@@ -1,6 +1,7 @@
 #pragma once
 /// Colour and storage encodings: YCoCg (paper 000 eq. 7), IEEE half floats, octahedral unit
-/// vectors in 32 bits and the shared-exponent RGB9E5 HDR format (paper 000 §4.7).
+/// vectors in 32 bits and the shared-exponent RGBE8 HDR format (paper 000 §4.7 uses a shared
+/// exponent too).
 
 #include <cstdint>
 
@@ -32,16 +33,18 @@ uint32_t encodeOctahedral(const glm::vec3& unitDir);
 /// Unit direction of an octahedral code from encodeOctahedral.
 glm::vec3 decodeOctahedral(uint32_t code);
 
-/// Shared-exponent RGB9E5: 9-bit mantissas R, G, B in bits 0-8, 9-17, 18-26 and a 5-bit
-/// exponent (bias 15) in bits 27-31. Negative and NaN channels store 0; values above
-/// kRgb9e5Max clamp to it. The largest channel keeps a relative error <= 2^-9.
-uint32_t packRgb9e5(const glm::vec3& rgb);
+/// Shared-exponent RGBE8 (Ward's RGBE, as in the Radiance format): 8-bit mantissas R, G, B in
+/// bits 0-7, 8-15, 16-23 and an 8-bit exponent byte x in bits 24-31, each channel being
+/// mantissa · 2^(x − 136). Every channel keeps an error <= 2^-8 of the largest one. The range is
+/// a float's: a largest channel below 2^-100 stores 0, channels above kRgbe8Max clamp to it,
+/// negative and NaN channels store 0.
+uint32_t packRgbe8(const glm::vec3& rgb);
 
-/// Linear RGB of an RGB9E5 code.
-glm::vec3 unpackRgb9e5(uint32_t packed);
+/// Linear RGB of an RGBE8 code.
+glm::vec3 unpackRgbe8(uint32_t packed);
 
-/// Largest value an RGB9E5 channel holds: 511/512 · 2^16.
-constexpr float kRgb9e5Max = 65408.0f;
+/// Largest value an RGBE8 channel holds: 255/256 · 2^127.
+constexpr float kRgbe8Max = 255.0f * 0x1p119f;
 
 /// Relative luminance of linear Rec. 709 RGB: 0.2126 R + 0.7152 G + 0.0722 B.
 float luminance(const glm::vec3& linearRgb);

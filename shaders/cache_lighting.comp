@@ -1,6 +1,6 @@
 #version 460
 // Cache lighting (paper 000 Figure 2 step 4, eq. 3): per cache, L = Σ over its nL links of
-// the node's radiance Φ / (π·A) (RGB9E5, §4.7) times its transport, in YCoCg, Y with lY bands
+// the node's radiance Φ / (π·A) (RGBE8, §4.7) times its transport, in YCoCg, Y with lY bands
 // and Co, Cg with lC bands, stored as half floats. The CPU twin (server/cpu/cache_lighting.cpp)
 // takes Φ times the bake's factor V / (π·A): the same product.
 #extension GL_GOOGLE_include_directive : require
@@ -23,7 +23,7 @@ const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 const uint kShPairs = (kCountY + 1u) / 2u;  // shared/cache_lighting.h shLinkWords − 1
 
-layout(std430, binding = 0) readonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGB9E5
+layout(std430, binding = 0) readonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGBE8
 layout(std430, binding = 1) readonly buffer RtpLinks { GpuRtpLink rtpLinks[]; };    // chunk
 layout(std430, binding = 2) readonly buffer ShLinks { uint shLinks[]; };            // chunk
 layout(std430, binding = 3) writeonly buffer CacheY { float16_t cacheY[]; };
@@ -32,7 +32,7 @@ layout(std430, binding = 5) writeonly buffer CacheCg { float16_t cacheCg[]; };
 layout(std140, binding = 6) uniform Sh { ShTables sh; };
 layout(push_constant) uniform Push { CacheLightingPush pc; };
 
-#include "lib/rgb9e5.glsl"
+#include "lib/rgbe8.glsl"
 #include "lib/sh.glsl"
 
 float y[kCountY];
@@ -50,7 +50,7 @@ void addLink(uint slot) {
         const GpuRtpLink link = rtpLinks[slot];
         const float visible = float(link.visibleAndCone & 0xFFFFu) * (1.0 / 65535.0);
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = rgbToYCoCg(unpackRgb9e5(nodeRadiance[link.node]));
+        const vec3 radiance = rgbToYCoCg(unpackRgbe8(nodeRadiance[link.node]));
         float cone[kBandsY];
         coneZonal(unpackHalf2x16(link.visibleAndCone >> 16u).x, cone);
         float basis[64];
@@ -69,7 +69,7 @@ void addLink(uint slot) {
         const uint first = slot * (1u + kShPairs);
         const uint node = shLinks[first];
         if (node == kNoNode) return;
-        const vec3 radiance = rgbToYCoCg(unpackRgb9e5(nodeRadiance[node]));
+        const vec3 radiance = rgbToYCoCg(unpackRgbe8(nodeRadiance[node]));
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
             const vec2 pair = unpackHalf2x16(shLinks[first + 1u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {

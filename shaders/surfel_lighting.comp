@@ -47,7 +47,7 @@ layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
 #include "lib/lights.glsl"
-#include "lib/rgb9e5.glsl"
+#include "lib/rgbe8.glsl"
 
 shared vec3 partial[kSurfelLightingGroup];  // per subgroup
 
@@ -112,7 +112,7 @@ void main() {
         }
         nodeFlux[i] = vec4(flux, 0.0);
         // Cache lighting reads the leaf's radiance Φ / (π·A) (paper 000 §4.7).
-        nodeRadiance[i] = packRgb9e5(flux / (kPi * surfel.area));
+        nodeRadiance[i] = packRgbe8(flux / (kPi * surfel.area));
     }
 
     // Workgroup sum of the flux for the progressive stop (the host adds the groups in double):

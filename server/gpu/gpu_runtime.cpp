@@ -323,10 +323,10 @@ Result<std::vector<uint32_t>> GpuRuntime::nodeRadiance() {
 
 Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), mBake.nodes.size());
-    // What surfel lighting and the pull would have written: each node's radiance as RGB9E5.
+    // What surfel lighting and the pull would have written: each node's radiance as RGBE8.
     std::vector<uint32_t> radiance(nodeFlux.size());
     for (size_t n = 0; n < nodeFlux.size(); ++n)
-        radiance[n] = packRgb9e5(nodeFlux[n] * gpu::radianceScale(mBake.nodes[n].area));
+        radiance[n] = packRgbe8(nodeFlux[n] * gpu::radianceScale(mBake.nodes[n].area));
     PIC_TRY(mContext->upload(mNodeRadiance, radiance.data(), radiance.size() * sizeof(uint32_t)));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
         mCacheLighting->record(cmd);

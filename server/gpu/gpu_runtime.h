@@ -79,10 +79,10 @@ public:
                                              const CacheValues& previous);
     /// Pull from the leaves `leaves` (nS): all 2nS − 1 node fluxes.
     Result<std::vector<glm::vec3>> runPull(std::span<const glm::vec3> leaves);
-    /// Cache lighting from `nodeFlux` (2nS − 1 nodes), uploaded as the radiance RGB9E5 that
+    /// Cache lighting from `nodeFlux` (2nS − 1 nodes), uploaded as the radiance RGBE8 that
     /// surfel lighting and the pull write.
     Result<CacheValues> runCacheLighting(std::span<const glm::vec3> nodeFlux);
-    /// Every node's radiance Φ / (π·A) as RGB9E5, as the last update's surfel lighting
+    /// Every node's radiance Φ / (π·A) as RGBE8, as the last update's surfel lighting
     /// (leaves) and pull (inner nodes) wrote it.
     Result<std::vector<uint32_t>> nodeRadiance();
     /// Light-map copy of `values` into the textures.
@@ -126,7 +126,7 @@ private:
     std::unique_ptr<gpu::LightmapCopyPass> mLightmapCopy;
     gpu::PassTimer mTimer;
     gpu::Buffer mNodeFlux;   ///< vec4 per node, W RGB
-    gpu::Buffer mNodeRadiance;  ///< RGB9E5 per node, Φ / (π·A) in W/(m²·sr), cache lighting's input
+    gpu::Buffer mNodeRadiance;  ///< RGBE8 per node, Φ / (π·A) in W/(m²·sr), cache lighting's input
     gpu::Buffer mCacheY;     ///< half, nC·lY²
     gpu::Buffer mCacheCo;    ///< half, nC·lC²
     gpu::Buffer mCacheCg;    ///< half, nC·lC²

@@ -30,7 +30,7 @@ public:
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
                                                              bool cachePerSubgroup);
-    /// Binds the node radiance (RGB9E5 per node), the output caches (half) and the SH tables.
+    /// Binds the node radiance (RGBE8 per node), the output caches (half) and the SH tables.
     Result<void> bind(const Buffer& nodeRadiance, const Buffer& cacheY, const Buffer& cacheCo,
                       const Buffer& cacheCg, const Buffer& shTables);
     void record(VkCommandBuffer cmd);

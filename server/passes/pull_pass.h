@@ -1,7 +1,7 @@
 #pragma once
 /// Pull on the GPU (paper 000 Figure 2 step 3, §4.1): node flux = sum of its children's, one
 /// dispatch per hierarchy level, lowest first; each inner node's radiance Φ / (π·A) is also
-/// written as RGB9E5 for cache lighting (§4.7). CPU twin: server/cpu/pull.h.
+/// written as RGBE8 for cache lighting (§4.7). CPU twin: server/cpu/pull.h.
 
 #include <memory>
 #include <vector>
@@ -19,7 +19,7 @@ class PullPass {
 public:
     /// Uploads each inner node's two children and 1 / (π·area).
     static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake);
-    /// Binds the node flux (vec4 per node) and node radiance (RGB9E5 per node) buffers, whose
+    /// Binds the node flux (vec4 per node) and node radiance (RGBE8 per node) buffers, whose
     /// leaves surfel lighting writes.
     Result<void> bind(const Buffer& nodeFlux, const Buffer& nodeRadiance);
     /// Records every level with a barrier after each, so a level reads finished children.

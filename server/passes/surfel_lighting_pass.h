@@ -38,7 +38,7 @@ struct SurfelLightingResources {
     const ShadowMapPass* shadows = nullptr;
     const RayVisibilityPass* rays = nullptr;
     const Buffer* nodeFlux = nullptr;    ///< vec4 per node; the pass writes the leaves
-    const Buffer* nodeRadiance = nullptr;  ///< RGB9E5 per node; the pass writes the leaves
+    const Buffer* nodeRadiance = nullptr;  ///< RGBE8 per node; the pass writes the leaves
     const Buffer* cacheY = nullptr;      ///< half, nC·lY²: the previous bounce
     const Buffer* cacheCo = nullptr;     ///< half, nC·lC²
     const Buffer* cacheCg = nullptr;     ///< half, nC·lC²

@@ -20,7 +20,7 @@ PIC_CONST(uint, kCachePerSubgroup, 1u);
 PIC_CONST(float, kHalfMax, 65504.0f);
 
 // A runtime-projected link as the GPU reads it: 12 bytes, paper 000 Table 4 (the bake's
-// RtpLink is 16). Its node's flux comes as radiance Φ / (π·A) (RGB9E5, written by surfel
+// RtpLink is 16). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written by surfel
 // lighting and the pull), so the link keeps the visible fraction V = factor·π·A ∈ [0, 1]
 // instead of the factor: Φ·factor = (Φ / (π·A))·V.
 struct GpuRtpLink {

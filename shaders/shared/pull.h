@@ -1,7 +1,7 @@
 #ifndef PIC_SHADERS_SHARED_PULL_H
 #define PIC_SHADERS_SHARED_PULL_H
 // Pull (paper 000 Figure 2 step 3): one dispatch per hierarchy level. Besides the float flux
-// it writes each inner node's radiance Φ / (π·A) as RGB9E5 (paper 000 §4.7), which cache
+// it writes each inner node's radiance Φ / (π·A) as RGBE8 (paper 000 §4.7), which cache
 // lighting reads.
 #include "glue.h"
 

@@ -214,41 +214,49 @@ TEST(Octahedral, LayoutAndDegenerateInputs) {
         EXPECT_NEAR(glm::length(decodeOctahedral(code)), 1.0f, 1e-6f);
 }
 
-TEST(Rgb9e5, RelativeErrorIsBounded) {
+TEST(Rgbe8, ErrorIsBoundedOverAFloatsRange) {
     Lcg rng;
     double maxRelative = 0.0;
     for (int i = 0; i < 100000; ++i) {
-        // Log-uniform magnitudes over the whole range, then independent channel ratios.
-        const float magnitude = std::exp2(-15.0f + 30.9f * rng.next());
+        // Log-uniform magnitudes from 2^-99 to 2^126, then independent channel ratios.
+        const float magnitude = std::exp2(-99.0f + 225.0f * rng.next());
         const glm::vec3 rgb = magnitude * glm::vec3(rng.next(), rng.next(), rng.next());
-        const glm::vec3 back = unpackRgb9e5(packRgb9e5(rgb));
+        const glm::vec3 back = unpackRgbe8(packRgbe8(rgb));
         const float maxChannel = std::max({rgb.r, rgb.g, rgb.b});
-        if (maxChannel < 0x1p-15f) continue;  // below the smallest exponent's resolution
+        if (maxChannel < 0x1p-100f) continue;  // stored as 0
         const double relative =
             std::abs(std::max({back.r, back.g, back.b}) - maxChannel) / maxChannel;
         maxRelative = std::max(maxRelative, relative);
-        // Every channel shares the largest one's step: its error is at most half a step.
+        // The largest channel's mantissa is at least 128, so a step is at most 2^-7 of it and
+        // every channel, rounded to the nearest step, is within 2^-8 of it.
         for (int c = 0; c < 3; ++c)
-            ASSERT_LE(std::abs(back[c] - rgb[c]), maxChannel * 0x1p-9f) << i << " " << c;
+            ASSERT_LE(std::abs(back[c] - rgb[c]), maxChannel * 0x1p-8f) << i << " " << c;
     }
-    EXPECT_LE(maxRelative, 0x1p-9 * 1.0001);
-    EXPECT_GT(maxRelative, 0x1p-11);
+    EXPECT_LE(maxRelative, 0x1p-8 * 1.0001);
+    EXPECT_GT(maxRelative, 0x1p-10);
 }
 
-TEST(Rgb9e5, LayoutExactValuesAndClamping) {
-    // 1.0 has floor(log2) = 0: shared exponent 16 and mantissa 256.
-    EXPECT_EQ(packRgb9e5({1, 0, 0}), (16u << 27) | 256u);
-    EXPECT_EQ(packRgb9e5({0, 0.5f, 0}), (15u << 27) | (256u << 9));
-    EXPECT_EQ(packRgb9e5({0, 0, 0}), 0u);
-    for (const glm::vec3 exact : {glm::vec3(1, 0.5f, 0.25f), glm::vec3(3, 96, 0.75f),
-                                  glm::vec3(kRgb9e5Max, 0, 1024), glm::vec3(0x1p-16f, 0, 0)})
-        EXPECT_EQ(unpackRgb9e5(packRgb9e5(exact)), exact);
-    // Rounding 511.9 up needs the next exponent.
-    EXPECT_EQ(unpackRgb9e5(packRgb9e5({511.9f, 0, 0})), glm::vec3(512, 0, 0));
+TEST(Rgbe8, LayoutExactValuesAndClamping) {
+    // 1.0 = 128 · 2^-7: exponent byte 1 + 128 = 129, mantissa 128.
+    EXPECT_EQ(packRgbe8({1, 0, 0}), (129u << 24) | 128u);
+    EXPECT_EQ(packRgbe8({0, 0.5f, 0}), (128u << 24) | (128u << 8));
+    EXPECT_EQ(packRgbe8({0, 0, 0}), 0u);
+    EXPECT_EQ(unpackRgbe8(0u), glm::vec3(0));
+    for (const glm::vec3 exact : {glm::vec3(1, 0.5f, 0.25f), glm::vec3(3, 96, 1),
+                                  glm::vec3(kRgbe8Max, 0, 0x1p119f), glm::vec3(0x1p-100f, 0, 0)})
+        EXPECT_EQ(unpackRgbe8(packRgbe8(exact)), exact);
+    // Rounding 255.9 up needs the next exponent.
+    EXPECT_EQ(unpackRgbe8(packRgbe8({255.9f, 0, 0})), glm::vec3(256, 0, 0));
     const float inf = std::numeric_limits<float>::infinity();
-    EXPECT_EQ(unpackRgb9e5(packRgb9e5({-1.0f, std::nanf(""), 2.0f})), glm::vec3(0, 0, 2));
-    EXPECT_EQ(unpackRgb9e5(packRgb9e5({1e9f, inf, -inf})), glm::vec3(kRgb9e5Max, kRgb9e5Max, 0));
-    EXPECT_EQ(unpackRgb9e5(0xffffffffu), glm::vec3(kRgb9e5Max));
+    EXPECT_EQ(unpackRgbe8(packRgbe8({-1.0f, std::nanf(""), 2.0f})), glm::vec3(0, 0, 2));
+    EXPECT_EQ(unpackRgbe8(packRgbe8({0, inf, -inf})), glm::vec3(0, kRgbe8Max, 0));
+    EXPECT_EQ(packRgbe8({1e-31f, 5e-32f, 0}), 0u);
+    EXPECT_EQ(unpackRgbe8(0xffffffffu), glm::vec3(kRgbe8Max));
+    // Radiance far past a half float's range (a 50,000 cd lamp 0.4 m from a wall) keeps its
+    // value instead of clamping.
+    const glm::vec3 bright(2e5f, 1e5f, 5e4f);
+    const glm::vec3 back = unpackRgbe8(packRgbe8(bright));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(back[c], bright[c], 2e5f * 0x1p-8f);
 }
 
 TEST(Luminance, Rec709Weights) {
