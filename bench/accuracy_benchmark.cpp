@@ -1,5 +1,6 @@
 #include "bench/accuracy_benchmark.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "bake/embree_scene.h"
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
+#include "bench/bench_common.h"
 #include "core/camera.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
@@ -69,6 +71,118 @@ Json errorJson(const ImageError& e) {
     return {{"relative_rmse", e.relativeRmse}, {"rmse", e.rmse}, {"mean_ratio", e.meanRatio}};
 }
 
+/// The speed/accuracy trade-off over nL: one reference and one set of ideal caches, one bake
+/// per nL, each with its CPU twin's update time (median of three) and its indirect error.
+int runLinksSweep(const AccuracyParams& params, const Scene& scene, const EmbreeScene& rays,
+                  const Camera& camera, const LightSet& lights, glm::uvec2 size) {
+    auto failWith = [](const Error& error) {
+        std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
+        return exitCode(error);
+    };
+    PathTraceParams trace;
+    trace.width = size.x;
+    trace.height = size.y;
+    trace.spp = params.spp;
+    trace.bounces = params.bounces;
+    trace.seed = params.seed;
+    trace.component = PathTraceParams::Component::Indirect;
+    auto reference = pathTrace(scene, rays, lights, camera, trace);
+    if (!reference) return failWith(reference.error());
+
+    ShadeParams shade;
+    shade.width = size.x;
+    shade.height = size.y;
+    shade.samplesPerPixel = params.shadeSpp;
+    shade.component = ShadeComponent::Indirect;
+    std::vector<uint32_t> sweep = params.linksSweep;
+    std::sort(sweep.begin(), sweep.end());
+    sweep.erase(std::unique(sweep.begin(), sweep.end()), sweep.end());
+
+    Json json;
+    json["scene"] = params.scenePath;
+    json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
+    json["size"] = params.size;
+    json["reference_spp"] = params.spp;
+    json["probe_samples"] = params.probeSamples;
+    json["runs"] = Json::array();
+    std::optional<double> idealError;
+    ChartSeries linked{"linked caches", glm::vec3(0.15f, 0.4f, 0.8f)};
+    std::printf("%6s %9s %12s %14s %12s\n", "nL", "caches", "update ms", "indirect RMSE",
+                "mean ratio");
+    for (const uint32_t links : sweep) {
+        BakeOptions options = params.bake;
+        options.links = links;
+        BakeReport report;
+        std::fprintf(stderr, "picbench: baking nL %u …\n", links);
+        auto bake = runBake(scene, options, report);
+        if (!bake) return failWith(bake.error());
+        auto runtime = createCpuRuntime(scene, rays, *bake, BounceParams{params.bounces});
+        if (!runtime) return failWith(runtime.error());
+        std::vector<double> updateMs;
+        const CacheValues* values = nullptr;
+        for (int k = 0; k < 3; ++k) {
+            const Clock::time_point start = Clock::now();
+            auto updated = (*runtime)->setLights(lights, nullptr);
+            if (!updated) return failWith(updated.error());
+            updateMs.push_back(1e3 * secondsSince(start));
+            values = *updated;
+        }
+        std::sort(updateMs.begin(), updateMs.end());
+        auto image = shadeFromCaches(scene, rays, *bake, *values, lights, camera, shade);
+        if (!image) return failWith(image.error());
+        auto error = compareImages(*image, *reference);
+        if (!error) return failWith(error.error());
+        if (!idealError) {
+            // The ideal caches sit where every bake of this scene puts them (nL changes only
+            // the links): their error is the floor that more links approach.
+            ProbeParams probe;
+            probe.samples = params.probeSamples;
+            probe.bounces = params.bounces;
+            probe.seed = params.seed;
+            auto ideal = pathTraceProbes(scene, rays, *bake, lights, probe);
+            if (!ideal) return failWith(ideal.error());
+            auto idealImage = shadeFromCaches(scene, rays, *bake, *ideal, lights, camera, shade);
+            if (!idealImage) return failWith(idealImage.error());
+            auto e = compareImages(*idealImage, *reference);
+            if (!e) return failWith(e.error());
+            idealError = e->relativeRmse;
+            json["ideal_indirect"] = errorJson(*e);
+        }
+        std::printf("%6u %9zu %12.1f %14.4f %12.4f\n", links, bake->caches.size(), updateMs[1],
+                    error->relativeRmse, error->meanRatio);
+        linked.points.push_back({updateMs[1], 100.0 * error->relativeRmse});
+        linked.labels.push_back(fmt::format("nL {}", links));
+        Json run;
+        run["links_per_cache"] = links;
+        run["unique_caches"] = bake->caches.size();
+        run["update_ms_median"] = updateMs[1];
+        run["update_ms"] = updateMs;
+        run["indirect"] = errorJson(*error);
+        json["runs"].push_back(std::move(run));
+    }
+
+    Chart chart;
+    chart.title = fmt::format("Links per cache: CPU twin update time against error ({})",
+                              std::filesystem::path(params.scenePath).stem().string());
+    chart.xLabel = "CPU twin ms per update (median of 3)";
+    chart.yLabel = "indirect relative RMSE against the path-traced reference, %";
+    chart.logX = true;
+    ChartSeries floor{"ideal (path-traced) caches", glm::vec3(0.4f), {}, {}, true};
+    floor.points = {{linked.points.front().x, 100.0 * *idealError},
+                    {linked.points.back().x, 100.0 * *idealError}};
+    chart.series = {linked, floor};
+    const std::string jsonPath =
+        params.jsonPath.empty()
+            ? (std::filesystem::path(params.outDir) /
+               (std::filesystem::path(params.scenePath).stem().string() + "_links_sweep.json"))
+                  .string()
+            : params.jsonPath;
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(jsonPath).parent_path(), ec);
+    if (int exit = writeChartFile(chart, chartPathFor(jsonPath)); exit != 0) return exit;
+    return writeJson(json, jsonPath);
+}
+
 }  // namespace
 
 int runAccuracyBenchmark(const AccuracyParams& params) {
@@ -85,6 +199,11 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     auto loaded = loadLightSet(params.lightsPath, *scene);
     if (!loaded) return failWith(loaded.error());
     const LightSet& lights = *loaded;
+    if (!params.linksSweep.empty()) {
+        auto rays = EmbreeScene::create(*scene);
+        if (!rays) return failWith(rays.error());
+        return runLinksSweep(params, *scene, **rays, *camera, lights, *size);
+    }
 
     Json seconds;
     auto start = Clock::now();

@@ -6,6 +6,7 @@
 /// side-by-side PNGs with an error heat map. Never asserts.
 
 #include <string>
+#include <vector>
 
 #include "bake/bake.h"
 
@@ -25,6 +26,10 @@ struct AccuracyParams {
     std::string outDir = "accuracy";
     std::string jsonPath;         ///< empty: <outDir>/<scene>_accuracy.json
     uint64_t seed = 1;
+    /// Non-empty: the speed/accuracy trade-off instead of one comparison. One bake per nL,
+    /// each timed (CPU twin update) and compared with one reference; JSON
+    /// (<outDir>/<scene>_links_sweep.json unless jsonPath) and a PNG chart beside it.
+    std::vector<uint32_t> linksSweep;
 };
 
 /// Runs the comparison; returns the process exit code.

@@ -50,6 +50,12 @@ int picbenchMain(int argc, char** argv) {
     accuracy->add_option("--out-dir", accuracyParams.outDir, "folder for images and JSON (default accuracy)");
     accuracy->add_option("--json", accuracyParams.jsonPath, "JSON file (default <out-dir>/<scene>_accuracy.json)");
     accuracy->add_option("--ref-seed", accuracyParams.seed, "path tracer seed (default 1)");
+    accuracy
+        ->add_option("--links-sweep", accuracyParams.linksSweep,
+                     "links per cache to sweep: one bake each, the CPU twin's update time "
+                     "against the indirect error, JSON and a PNG chart (replaces --links)")
+        ->expected(1, -1)
+        ->check(CLI::Range(1u, 4096u));
     accuracyFlags.addTo(*accuracy);
 
     CLI::App* links = app.add_subcommand(

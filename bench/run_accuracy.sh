@@ -12,6 +12,9 @@ for links in 128 254; do
   $BENCH --scene "$SCENES/cornell.gltf" --size 128x128 --spp 1024 --probe-samples 512 --links $links \
     --json "$OUT/cornell_links$links.json"
 done
+# The speed/accuracy trade-off over nL (JSON and a PNG chart).
+$BENCH --scene "$SCENES/cornell.gltf" --size 128x128 --spp 1024 --probe-samples 512 \
+  --links-sweep 32 64 128 254 512
 $BENCH --scene "$SCENES/cornell_area.gltf" --size 128x128 --spp 1024 --probe-samples 512
 $BENCH --scene "$SCENES/two_floors.gltf" --camera 1.8,1.6,1.8,-1.5,0.8,-1.5,0,1,0,70 \
   --size 160x96 --spp 512 --probe-samples 512

@@ -35,8 +35,10 @@ std::string tickText(double value) {
     char text[32];
     if (std::abs(value) >= 1e5 || (std::abs(value) < 1e-3 && value != 0.0))
         std::snprintf(text, sizeof text, "%.0e", value);
+    else if (std::abs(value) >= 100.0)
+        std::snprintf(text, sizeof text, "%.0f", value);
     else
-        std::snprintf(text, sizeof text, "%g", value);
+        std::snprintf(text, sizeof text, "%.3g", value);  // data-valued ticks: 34.8, not 34.7887
     return text;
 }
 

@@ -73,6 +73,33 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
     EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);
 }
 
+TEST_F(PicbenchLinks, SweepChartsUpdateTimeAgainstError) {
+    // `accuracy --links-sweep`: one bake per nL (given unsorted, with a repeat), one reference.
+    const fs::path json = mDir / "sweep.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("accuracy --scene ") + PIC_TEST_SCENE_DIR +
+                      "/cornell.gltf "
+                      "--size 24x24 --spp 16 --probe-samples 16 --links-sweep 32 8 32 --json " +
+                      json.string(),
+                  err),
+              0)
+        << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    const nlohmann::json& runs = report.at("runs");
+    ASSERT_EQ(runs.size(), 2u);
+    EXPECT_EQ(runs[0].at("links_per_cache").get<int>(), 8);
+    EXPECT_EQ(runs[1].at("links_per_cache").get<int>(), 32);
+    for (const nlohmann::json& r : runs) {
+        EXPECT_GT(r.at("update_ms_median").get<double>(), 0.0);
+        const double rmse = r.at("indirect").at("relative_rmse").get<double>();
+        EXPECT_TRUE(std::isfinite(rmse));
+        EXPECT_GT(rmse, 0.0);
+    }
+    EXPECT_GT(report.at("ideal_indirect").at("relative_rmse").get<double>(), 0.0);
+    EXPECT_TRUE(fs::exists(mDir / "sweep.png"));
+}
+
 TEST_F(PicbenchLinks, MissingSceneIsBadInputNamingThePath) {
     std::string err;
     EXPECT_EQ(run("links --scene /nonexistent/scene.gltf", err), 2);
