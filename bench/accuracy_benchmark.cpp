@@ -67,6 +67,34 @@ float exposureFor(const Image& reference) {
     return mean > 0.0 ? static_cast<float>(0.25 / mean) : 1.0f;
 }
 
+int failWith(const Error& error) {
+    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
+    return exitCode(error);
+}
+
+/// The inputs both modes report.
+Json inputsJson(const AccuracyParams& params) {
+    Json json;
+    json["scene"] = params.scenePath;
+    json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
+    json["size"] = params.size;
+    json["reference_spp"] = params.spp;
+    json["probe_samples"] = params.probeSamples;
+    return json;
+}
+
+PathTraceParams referenceParams(const AccuracyParams& params, glm::uvec2 size,
+                                PathTraceParams::Component component) {
+    PathTraceParams trace;
+    trace.width = size.x;
+    trace.height = size.y;
+    trace.spp = params.spp;
+    trace.bounces = params.bounces;
+    trace.seed = params.seed;
+    trace.component = component;
+    return trace;
+}
+
 Json errorJson(const ImageError& e) {
     return {{"relative_rmse", e.relativeRmse}, {"rmse", e.rmse}, {"mean_ratio", e.meanRatio}};
 }
@@ -75,18 +103,8 @@ Json errorJson(const ImageError& e) {
 /// per nL, each with its CPU twin's update time (median of three) and its indirect error.
 int runLinksSweep(const AccuracyParams& params, const Scene& scene, const EmbreeScene& rays,
                   const Camera& camera, const LightSet& lights, glm::uvec2 size) {
-    auto failWith = [](const Error& error) {
-        std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-        return exitCode(error);
-    };
-    PathTraceParams trace;
-    trace.width = size.x;
-    trace.height = size.y;
-    trace.spp = params.spp;
-    trace.bounces = params.bounces;
-    trace.seed = params.seed;
-    trace.component = PathTraceParams::Component::Indirect;
-    auto reference = pathTrace(scene, rays, lights, camera, trace);
+    auto reference = pathTrace(scene, rays, lights, camera,
+                               referenceParams(params, size, PathTraceParams::Component::Indirect));
     if (!reference) return failWith(reference.error());
 
     ShadeParams shade;
@@ -98,12 +116,7 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
     std::sort(sweep.begin(), sweep.end());
     sweep.erase(std::unique(sweep.begin(), sweep.end()), sweep.end());
 
-    Json json;
-    json["scene"] = params.scenePath;
-    json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
-    json["size"] = params.size;
-    json["reference_spp"] = params.spp;
-    json["probe_samples"] = params.probeSamples;
+    Json json = inputsJson(params);
     json["runs"] = Json::array();
     std::optional<double> idealError;
     ChartSeries linked{"linked caches", glm::vec3(0.15f, 0.4f, 0.8f)};
@@ -186,10 +199,6 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
 }  // namespace
 
 int runAccuracyBenchmark(const AccuracyParams& params) {
-    auto failWith = [](const Error& error) {
-        std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-        return exitCode(error);
-    };
     auto size = parseImageSize(params.size);
     if (!size) return failWith(size.error());
     auto scene = loadScene(params.scenePath);
@@ -238,20 +247,15 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     if (auto ok = shadeBoth(**values, oursFull, oursIndirect); !ok) return failWith(ok.error());
     seconds["shade"] = secondsSince(start);
 
-    PathTraceParams trace;
-    trace.width = size->x;
-    trace.height = size->y;
-    trace.spp = params.spp;
-    trace.bounces = params.bounces;
-    trace.seed = params.seed;
-    trace.component = PathTraceParams::Component::Full;
     start = Clock::now();
-    auto refFull = pathTrace(*scene, **rays, lights, *camera, trace);
+    auto refFull = pathTrace(*scene, **rays, lights, *camera,
+                             referenceParams(params, *size, PathTraceParams::Component::Full));
     if (!refFull) return failWith(refFull.error());
     seconds["reference_full"] = secondsSince(start);
-    trace.component = PathTraceParams::Component::Indirect;
     start = Clock::now();
-    auto refIndirect = pathTrace(*scene, **rays, lights, *camera, trace);
+    auto refIndirect =
+        pathTrace(*scene, **rays, lights, *camera,
+                  referenceParams(params, *size, PathTraceParams::Component::Indirect));
     if (!refIndirect) return failWith(refIndirect.error());
     seconds["reference_indirect"] = secondsSince(start);
 
@@ -297,12 +301,7 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     if (auto ok = writeImage(base + "_indirect_side.png", indirectSide); !ok) return failWith(ok.error());
     if (auto ok = writeImage(base + "_full_side.png", fullSide); !ok) return failWith(ok.error());
 
-    Json json;
-    json["scene"] = params.scenePath;
-    json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
-    json["size"] = params.size;
-    json["reference_spp"] = params.spp;
-    json["probe_samples"] = params.probeSamples;
+    Json json = inputsJson(params);
     json["bake"] = {{"surfels", bake->params.surfels}, {"links_per_cache", bake->params.linksPerCache},
                     {"link_mode", bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp"},
                     {"bands_y", bake->params.bandsY}, {"bands_c", bake->params.bandsC},
