@@ -321,13 +321,21 @@ Result<std::vector<uint32_t>> GpuRuntime::nodeRadiance() {
     return packed;
 }
 
-Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
-    PIC_CHECK_EQ(nodeFlux.size(), mBake.nodes.size());
-    // What surfel lighting and the pull would have written: each node's radiance as RGBE8.
+std::vector<uint32_t> packNodeRadiance(const BakeData& bake, std::span<const glm::vec3> nodeFlux) {
+    PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
     std::vector<uint32_t> radiance(nodeFlux.size());
     for (size_t n = 0; n < nodeFlux.size(); ++n)
-        radiance[n] = packRgbe8(nodeFlux[n] * gpu::radianceScale(mBake.nodes[n].area));
-    PIC_TRY(mContext->upload(mNodeRadiance, radiance.data(), radiance.size() * sizeof(uint32_t)));
+        radiance[n] = packRgbe8(nodeFlux[n] * gpu::radianceScale(bake.nodes[n].area));
+    return radiance;
+}
+
+Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
+    return runCacheLighting(packNodeRadiance(mBake, nodeFlux));
+}
+
+Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const uint32_t> nodeRadiance) {
+    PIC_CHECK_EQ(nodeRadiance.size(), mBake.nodes.size());
+    PIC_TRY(mContext->upload(mNodeRadiance, nodeRadiance.data(), nodeRadiance.size_bytes()));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
         mCacheLighting->record(cmd);
         recordCacheReadback(cmd);

@@ -56,6 +56,10 @@ class LightmapCopyPass;
 
 /// The GPU backend. Besides the Runtime API it runs single passes on given inputs, so that
 /// tests compare each pass with its CPU twin on identical data. Not thread-safe.
+/// Each node's radiance Φ / (π·A) from its flux, as RGBE8: what surfel lighting (leaves) and
+/// the pull (inner nodes) write for cache lighting.
+std::vector<uint32_t> packNodeRadiance(const BakeData& bake, std::span<const glm::vec3> nodeFlux);
+
 class GpuRuntime final : public Runtime {
 public:
     /// `scene`, `rays` (for its ray offset) and `bake` must outlive the runtime.
@@ -80,8 +84,10 @@ public:
     /// Pull from the leaves `leaves` (nS): all 2nS − 1 node fluxes.
     Result<std::vector<glm::vec3>> runPull(std::span<const glm::vec3> leaves);
     /// Cache lighting from `nodeFlux` (2nS − 1 nodes), uploaded as the radiance RGBE8 that
-    /// surfel lighting and the pull write.
+    /// surfel lighting and the pull write (packNodeRadiance).
     Result<CacheValues> runCacheLighting(std::span<const glm::vec3> nodeFlux);
+    /// Cache lighting from radiance packed already, so that a benchmark times the pass alone.
+    Result<CacheValues> runCacheLighting(std::span<const uint32_t> nodeRadiance);
     /// Every node's radiance Φ / (π·A) as RGBE8, as the last update's surfel lighting
     /// (leaves) and pull (inner nodes) wrote it.
     Result<std::vector<uint32_t>> nodeRadiance();
