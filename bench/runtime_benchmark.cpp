@@ -302,6 +302,7 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                         run["cache_lighting_timing"] =
                             floor->deviceCopy ? "timestamps" : "wall clock";
                         run["link_bytes_per_bounce"] = linkBytes;
+                        run["link_texel_words"] = (*gpu)->linkTexelWords();
                         run["cache_lighting_bytes_per_second"] = linkRate;
                         run["bandwidth_ratio"] = linkRate / bandwidth;
                         run["gpu_memory_bytes"] = nlohmann::ordered_json::object();

@@ -19,17 +19,20 @@ layout(constant_id = 1) const uint kBandsC = 2u;
 layout(constant_id = 2) const uint kLinksPerCache = 128u;
 layout(constant_id = 3) const uint kLinkForm = 1u;
 layout(constant_id = 4) const uint kMapping = 0u;
+layout(constant_id = 5) const uint kTexelWords = 1u;  // words per texel of `links`
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 const uint kShPairs = (kCountY + 1u) / 2u;  // shared/cache_lighting.h shLinkWords − 1
+const uint kLinkWords = kLinkForm == kLinkFormRtp ? 3u : 1u + kShPairs;
+const uint kLinkTexels = kLinkWords / kTexelWords;  // the host picks a divisor
 
-layout(std430, binding = 0) readonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGBE8
-layout(std430, binding = 1) readonly buffer RtpLinks { GpuRtpLink rtpLinks[]; };    // chunk
-layout(std430, binding = 2) readonly buffer ShLinks { uint shLinks[]; };            // chunk
-layout(std430, binding = 3) writeonly buffer CacheY { float16_t cacheY[]; };
-layout(std430, binding = 4) writeonly buffer CacheCo { float16_t cacheCo[]; };
-layout(std430, binding = 5) writeonly buffer CacheCg { float16_t cacheCg[]; };
-layout(std140, binding = 6) uniform Sh { ShTables sh; };
+// Uniform texel buffers of uint words (shared/cache_lighting.h says why).
+layout(binding = 0) uniform usamplerBuffer nodeRadiance;  // RGBE8 per node
+layout(binding = 1) uniform usamplerBuffer links;  // the chunk's links, kTexelWords per texel
+layout(std430, binding = 2) writeonly buffer CacheY { float16_t cacheY[]; };
+layout(std430, binding = 3) writeonly buffer CacheCo { float16_t cacheCo[]; };
+layout(std430, binding = 4) writeonly buffer CacheCg { float16_t cacheCg[]; };
+layout(std140, binding = 5) uniform Sh { ShTables sh; };
 layout(push_constant) uniform Push { CacheLightingPush pc; };
 
 #include "lib/rgbe8.glsl"
@@ -45,16 +48,21 @@ float16_t toHalf(float value) {
 
 /// Adds link `slot` (within the chunk) to y, co, cg.
 void addLink(uint slot) {
+    uint words[1 + 64 / 2];  // kLinkWords at most, for lY ≤ 8 as basis[64] below
+    [[unroll]] for (uint t = 0u; t < kLinkTexels; ++t) {
+        const uvec4 texel = texelFetch(links, int(slot * kLinkTexels + t));
+        [[unroll]] for (uint c = 0u; c < kTexelWords; ++c) words[t * kTexelWords + c] = texel[c];
+    }
     if (kLinkForm == kLinkFormRtp) {
-        // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
-        const GpuRtpLink link = rtpLinks[slot];
-        const float visible = float(link.visibleAndCone & 0xFFFFu) * (1.0 / 65535.0);
+        // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction). The words are
+        // GpuRtpLink's node, directionOct, visibleAndCone.
+        const float visible = float(words[2] & 0xFFFFu) * (1.0 / 65535.0);
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = rgbToYCoCg(unpackRgbe8(nodeRadiance[link.node]));
+        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(words[0])).x));
         float cone[kBandsY];
-        coneZonal(unpackHalf2x16(link.visibleAndCone >> 16u).x, cone);
+        coneZonal(unpackHalf2x16(words[2] >> 16u).x, cone);
         float basis[64];
-        shEvaluate(decodeOctahedral(link.directionOct), basis);
+        shEvaluate(decodeOctahedral(words[1]), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float w = visible * cone[kShBandOf[i]] * basis[i];
             y[i] += radiance.x * w;
@@ -66,12 +74,10 @@ void addLink(uint slot) {
     } else {
         // SH-projected links: the node, then lY² half coefficients two per word, scaled by
         // π·A at upload to take the node's radiance; chroma takes the first lC².
-        const uint first = slot * (1u + kShPairs);
-        const uint node = shLinks[first];
-        if (node == kNoNode) return;
-        const vec3 radiance = rgbToYCoCg(unpackRgbe8(nodeRadiance[node]));
+        if (words[0] == kNoNode) return;
+        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(words[0])).x));
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
-            const vec2 pair = unpackHalf2x16(shLinks[first + 1u + p]);
+            const vec2 pair = unpackHalf2x16(words[1u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {
                 const uint i = 2u * p + h;
                 if (i >= kCountY) break;

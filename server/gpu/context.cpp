@@ -117,6 +117,22 @@ void Buffer::reset() {
     mMapped = nullptr;
 }
 
+TexelView& TexelView::operator=(TexelView&& other) noexcept {
+    if (this != &other) {
+        reset();
+        mDevice = std::exchange(other.mDevice, VK_NULL_HANDLE);
+        mView = std::exchange(other.mView, VK_NULL_HANDLE);
+    }
+    return *this;
+}
+
+void TexelView::reset() {
+    if (mDevice == VK_NULL_HANDLE) return;
+    if (mView) vkDestroyBufferView(mDevice, mView, nullptr);
+    mDevice = VK_NULL_HANDLE;
+    mView = VK_NULL_HANDLE;
+}
+
 DepthArray& DepthArray::operator=(DepthArray&& other) noexcept {
     if (this != &other) {
         reset();
@@ -500,6 +516,59 @@ Result<Buffer*> Context::staging(VkDeviceSize bytes) {
                        createBuffer(std::bit_ceil(bytes), 0, MemoryUse::Readback, "staging"));
     }
     return &mStaging;
+}
+
+bool Context::canReadTexels(VkFormat format) const {
+    VkFormatProperties properties{};
+    vkGetPhysicalDeviceFormatProperties(mPhysical, format, &properties);
+    return (properties.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT) != 0;
+}
+
+Result<TexelView> Context::createTexelView(const Buffer& buffer, VkFormat format,
+                                           VkDeviceSize offset, VkDeviceSize texels,
+                                           const char* what) {
+    // The 32-bit unsigned formats, by component count, are all texel views take.
+    VkDeviceSize texelBytes = 0;
+    switch (format) {
+    case VK_FORMAT_R32_UINT:
+        texelBytes = 4;
+        break;
+    case VK_FORMAT_R32G32_UINT:
+        texelBytes = 8;
+        break;
+    case VK_FORMAT_R32G32B32_UINT:
+        texelBytes = 12;
+        break;
+    case VK_FORMAT_R32G32B32A32_UINT:
+        texelBytes = 16;
+        break;
+    default:
+        return fail(ErrorCode::InvalidInput, "{}: texel format {} is not a uint format", what,
+                    int(format));
+    }
+    if (!canReadTexels(format))
+        return fail(ErrorCode::Unsupported, "{}: {} cannot read format {} as a texel buffer", what,
+                    mName, int(format));
+    const uint32_t maxTexels = mProperties.limits.maxTexelBufferElements;
+    if (texels == 0 || texels > maxTexels)
+        return fail(ErrorCode::Unsupported, "{}: a texel view of {} elements (1 to {} on {})", what,
+                    texels, maxTexels, mName);
+    if (offset % mProperties.limits.minTexelBufferOffsetAlignment != 0 ||
+        offset + texels * texelBytes > buffer.size())
+        return fail(ErrorCode::InvalidInput,
+                    "{}: texels [{}, {}) of {} bytes do not lie aligned within a buffer of {} "
+                    "bytes (offset alignment {})",
+                    what, offset, offset + texels * texelBytes, texelBytes, buffer.size(),
+                    mProperties.limits.minTexelBufferOffsetAlignment);
+    VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    info.buffer = buffer.handle();
+    info.format = format;
+    info.offset = offset;
+    info.range = texels * texelBytes;
+    TexelView view;
+    PIC_VK_TRY(vkCreateBufferView(mDevice, &info, nullptr, &view.mView));
+    view.mDevice = mDevice;
+    return view;
 }
 
 Result<void> Context::upload(Buffer& buffer, const void* data, VkDeviceSize bytes,

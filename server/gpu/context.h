@@ -66,6 +66,25 @@ private:
     void* mMapped = nullptr;
 };
 
+/// A typed view of a buffer range that shaders read as a uniform texel buffer
+/// (`usamplerBuffer`); move-only. Texel fetches are gathers without branches on lavapipe,
+/// where a storage-buffer load at an index that differs per lane is a branch per lane.
+class TexelView {
+public:
+    TexelView() = default;
+    TexelView(TexelView&& other) noexcept { *this = std::move(other); }
+    TexelView& operator=(TexelView&& other) noexcept;
+    ~TexelView() { reset(); }
+
+    VkBufferView handle() const { return mView; }
+    void reset();
+
+private:
+    friend class Context;
+    VkDevice mDevice = VK_NULL_HANDLE;
+    VkBufferView mView = VK_NULL_HANDLE;
+};
+
 /// A 2D-array depth image (shadow maps): one view of all layers for sampling and one view per
 /// layer for rendering.
 class DepthArray {
@@ -210,6 +229,13 @@ public:
                                     const char* what) {
         return createBufferWith(data.data(), data.size_bytes(), usage, what);
     }
+    /// Whether shaders may read `format` from a uniform texel buffer.
+    bool canReadTexels(VkFormat format) const;
+    /// A view of `texels` elements of `format` in `buffer` from byte `offset`, which the
+    /// buffer's usage must allow (VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT). Unsupported when
+    /// `texels` exceeds maxTexelBufferElements or the format cannot be a uniform texel buffer.
+    Result<TexelView> createTexelView(const Buffer& buffer, VkFormat format, VkDeviceSize offset,
+                                      VkDeviceSize texels, const char* what);
     /// Writes `bytes` of `data` into `buffer` at `offset`.
     Result<void> upload(Buffer& buffer, const void* data, VkDeviceSize bytes,
                         VkDeviceSize offset = 0);

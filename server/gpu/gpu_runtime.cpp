@@ -54,7 +54,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
 
     PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), 0,
                                                MemoryUse::Device, "node flux"));
-    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t), 0,
+    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t),
+                                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
                                                    MemoryUse::Device, "node radiance"));
     PIC_TRY_ASSIGN(mCacheY, ctx.createBuffer(2 * nC * countY, 0, MemoryUse::Device, "caches Y"));
     PIC_TRY_ASSIGN(mCacheCo, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Co"));
@@ -83,11 +84,12 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                    SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon(), mVisibility));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
     const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
-    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup));
+    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup,
+                                                             options.maxLinkTexelWords));
     PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
     PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(mNodeFlux, mNodeRadiance));
-    PIC_TRY(mCacheLighting->bind(mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
+    PIC_TRY(mCacheLighting->bind(ctx, mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
     PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
@@ -369,5 +371,9 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
 }
 
 uint64_t GpuRuntime::linkBytesPerBounce() const { return mCacheLighting->linkBytes(); }
+
+uint32_t GpuRuntime::linkTexelWords() const {
+    return mCacheLighting->texelWords();
+}
 
 }  // namespace pic

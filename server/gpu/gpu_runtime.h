@@ -43,6 +43,10 @@ struct GpuRuntimeOptions {
     /// Cache lighting gives each cache a subgroup (true) or an invocation (false); unset: a
     /// subgroup on a GPU, an invocation on a CPU device (gpu::CacheLightingPass::create).
     std::optional<bool> cachePerSubgroup;
+    /// Widest texel (in 32-bit words, 1 to 4) cache lighting reads its links in; the pass
+    /// takes the widest the device supports that divides a link. 1 reads a word at a time,
+    /// as on a device with no two- or three-word uint texel buffers (tests).
+    uint32_t maxLinkTexelWords = 4;
 };
 
 namespace gpu {
@@ -98,6 +102,8 @@ public:
     std::vector<std::pair<std::string, uint64_t>> memory() const;
     /// Link bytes cache lighting reads per bounce.
     uint64_t linkBytesPerBounce() const;
+    /// 32-bit words per texel cache lighting reads its links in.
+    uint32_t linkTexelWords() const;
     const gpu::Context& context() const { return *mContext; }
 
 private:

@@ -108,6 +108,8 @@ Result<VkDescriptorSet> Kernel::makeSet(std::span<const BindingResource> resourc
         if (write.descriptorType == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER) {
             images[i] = {r.sampler, r.imageView, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
             write.pImageInfo = &images[i];
+        } else if (write.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+            write.pTexelBufferView = &resources[i].texelView;
         } else {
             buffers[i] = {r.buffer, r.offset, r.range};
             write.pBufferInfo = &buffers[i];

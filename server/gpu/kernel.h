@@ -1,7 +1,7 @@
 #pragma once
-/// A compute pipeline with its descriptor layout: storage buffers and depth samplers by
-/// binding, push constants, uint specialization constants (STYLE.md 11), and the descriptor
-/// sets that bind concrete resources to it.
+/// A compute pipeline with its descriptor layout: storage and uniform buffers, uniform texel
+/// buffers and depth samplers by binding, push constants, uint specialization constants
+/// (STYLE.md 11), and the descriptor sets that bind concrete resources to it.
 
 #include <cstdint>
 #include <span>
@@ -19,13 +19,18 @@ struct BindingResource {
     VkDeviceSize range = VK_WHOLE_SIZE;
     VkImageView imageView = VK_NULL_HANDLE;  ///< combined image sampler (depth array)
     VkSampler sampler = VK_NULL_HANDLE;
+    VkBufferView texelView = VK_NULL_HANDLE;  ///< uniform texel buffer
 
     static BindingResource storage(uint32_t binding, const Buffer& buffer,
                                    VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE) {
-        return {binding, buffer.handle(), offset, range, VK_NULL_HANDLE, VK_NULL_HANDLE};
+        return {binding,        buffer.handle(), offset,        range,
+                VK_NULL_HANDLE, VK_NULL_HANDLE,  VK_NULL_HANDLE};
     }
     static BindingResource image(uint32_t binding, VkImageView view, VkSampler sampler) {
-        return {binding, VK_NULL_HANDLE, 0, 0, view, sampler};
+        return {binding, VK_NULL_HANDLE, 0, 0, view, sampler, VK_NULL_HANDLE};
+    }
+    static BindingResource texels(uint32_t binding, const TexelView& view) {
+        return {binding, VK_NULL_HANDLE, 0, 0, VK_NULL_HANDLE, VK_NULL_HANDLE, view.handle()};
     }
 };
 

@@ -14,11 +14,27 @@ namespace pic::gpu {
 namespace {
 
 /// Chunks hold a multiple of this many caches, so that every chunk's offset into the link
-/// buffers is a multiple of 256 bytes (the largest minStorageBufferOffsetAlignment in use).
+/// buffer is a multiple of 256 bytes (the largest minTexelBufferOffsetAlignment in use).
 constexpr uint32_t kChunkAlignment = 256;
 
-/// Node radiance, RTP links, SH links, caches Y, Co, Cg, SH tables.
-constexpr uint32_t kBindingCount = 7;
+/// Node radiance, links, caches Y, Co, Cg, SH tables.
+constexpr uint32_t kBindingCount = 6;
+
+/// The uint texel format of `words` 32-bit components.
+VkFormat uintTexelFormat(uint32_t words) {
+    constexpr std::array<VkFormat, 4> kFormats = {VK_FORMAT_R32_UINT, VK_FORMAT_R32G32_UINT,
+                                                  VK_FORMAT_R32G32B32_UINT,
+                                                  VK_FORMAT_R32G32B32A32_UINT};
+    return kFormats[words - 1];
+}
+
+/// The widest texel (in words, `maxWords` to 1) that divides a link of `linkWords` words and
+/// that the device reads as a uniform texel buffer (R32_UINT always is).
+uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t maxWords) {
+    for (uint32_t words = std::min(maxWords, 4u); words > 1; --words)
+        if (linkWords % words == 0 && context.canReadTexels(uintTexelFormat(words))) return words;
+    return 1;
+}
 
 }  // namespace
 
@@ -40,7 +56,8 @@ uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
 
 Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
                                                                      const BakeData& bake,
-                                                                     bool cachePerSubgroup) {
+                                                                     bool cachePerSubgroup,
+                                                                     uint32_t maxTexelWords) {
     std::unique_ptr<CacheLightingPass> pass(new CacheLightingPass());
     // Per subgroup: as many caches per workgroup as it has subgroups of the default size (the
     // shader strides over any the device leaves, should it launch fewer).
@@ -54,17 +71,19 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     pass->mCountY = bake.params.bandsY * bake.params.bandsY;
     const VkDeviceSize nLinks = VkDeviceSize{pass->mCacheCount} * links.linksPerCache;
 
-    // The widest per-link binding decides how many caches a chunk may hold.
-    const VkDeviceSize widest =
-        pass->mRtpForm ? sizeof(GpuRtpLink) : sizeof(uint32_t) * shLinkWords(pass->mCountY);
-    const VkDeviceSize perCache = std::max<VkDeviceSize>(widest * links.linksPerCache, 1);
-    const VkDeviceSize maxRange = context.properties().limits.maxStorageBufferRange;
-    VkDeviceSize chunk = (maxRange / perCache) / kChunkAlignment * kChunkAlignment;
+    // A chunk's links fill at most one texel view.
+    const uint32_t linkWords =
+        pass->mRtpForm ? sizeof(GpuRtpLink) / sizeof(uint32_t) : shLinkWords(pass->mCountY);
+    pass->mTexelWords = linkTexelWords(context, linkWords, maxTexelWords);
+    const VkDeviceSize texelsPerCache = std::max<VkDeviceSize>(
+        VkDeviceSize{linkWords / pass->mTexelWords} * links.linksPerCache, 1);
+    const VkDeviceSize maxTexels = context.properties().limits.maxTexelBufferElements;
+    const VkDeviceSize chunk = (maxTexels / texelsPerCache) / kChunkAlignment * kChunkAlignment;
     if (chunk == 0)
         return fail(ErrorCode::Unsupported,
-                    "{} links per cache need {} bytes per cache, too many for {} caches within "
-                    "one storage binding of {} bytes",
-                    links.linksPerCache, perCache, kChunkAlignment, maxRange);
+                    "{} links per cache need {} texels per cache, too many for {} caches within "
+                    "one texel view of {} texels",
+                    links.linksPerCache, texelsPerCache, kChunkAlignment, maxTexels);
     for (uint32_t first = 0; first < pass->mCacheCount; first += uint32_t(chunk)) {
         pass->mChunkFirst.push_back(first);
         pass->mChunkCount.push_back(std::min<uint32_t>(uint32_t(chunk), pass->mCacheCount - first));
@@ -72,16 +91,21 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
 
     KernelLayout layout;
     layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings[0] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // node radiance
+    layout.bindings[1] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // links
     layout.bindings[kBindingCount - 1] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
     layout.pushBytes = sizeof(CacheLightingPush);
-    layout.specialization = {bake.params.bandsY, bake.params.bandsC, links.linksPerCache,
+    layout.specialization = {bake.params.bandsY,
+                             bake.params.bandsC,
+                             links.linksPerCache,
                              pass->mRtpForm ? kLinkFormRtp : kLinkFormSh,
-                             cachePerSubgroup ? kCachePerSubgroup : kCachePerInvocation};
+                             cachePerSubgroup ? kCachePerSubgroup : kCachePerInvocation,
+                             pass->mTexelWords};
     layout.maxSets = std::max<uint32_t>(uint32_t(pass->mChunkFirst.size()), 1);
     PIC_TRY_ASSIGN(pass->mKernel,
                    Kernel::create(context, kSpirvCacheLightingComp, layout, "cache_lighting"));
 
-    PIC_TRY_ASSIGN(pass->mUnused, context.createBuffer(16, 0, MemoryUse::Device, "unused links"));
+    constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
     // The links take the node's radiance Φ / (π·A) rather than its flux (§4.7).
     if (pass->mRtpForm) {
         std::vector<GpuRtpLink> rtp(links.rtp.size());
@@ -94,9 +118,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                                             : GpuRtpLink{0, 0, 0};
             },
             4096);
-        PIC_TRY_ASSIGN(pass->mRtp,
-                       context.createBufferWith(std::span<const GpuRtpLink>(rtp), 0, "RTP links"));
-        pass->mLinkBytes = nLinks * sizeof(GpuRtpLink);
+        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const GpuRtpLink>(rtp),
+                                                              kTexels, "RTP links"));
     } else {
         const uint32_t countY = pass->mCountY;
         const size_t words = shLinkWords(countY);
@@ -114,35 +137,35 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                                          << (16 * (i % 2));
             },
             4096);
-        PIC_TRY_ASSIGN(pass->mSh,
-                       context.createBufferWith(std::span<const uint32_t>(sh), 0, "SH links"));
-        pass->mLinkBytes = nLinks * words * sizeof(uint32_t);
+        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const uint32_t>(sh),
+                                                              kTexels, "SH links"));
+    }
+    pass->mLinkBytes = nLinks * linkWords * sizeof(uint32_t);
+    const VkFormat format = uintTexelFormat(pass->mTexelWords);
+    const VkDeviceSize texelBytes = VkDeviceSize{pass->mTexelWords} * sizeof(uint32_t);
+    for (size_t k = 0; k < pass->mChunkFirst.size(); ++k) {
+        const VkDeviceSize first = VkDeviceSize{pass->mChunkFirst[k]} * texelsPerCache;
+        PIC_TRY_ASSIGN(TexelView view,
+                       context.createTexelView(pass->mLinks, format, first * texelBytes,
+                                               pass->mChunkCount[k] * texelsPerCache, "links"));
+        pass->mLinkViews.push_back(std::move(view));
     }
     return pass;
 }
 
-Result<void> CacheLightingPass::bind(const Buffer& nodeRadiance, const Buffer& cacheY,
-                                     const Buffer& cacheCo, const Buffer& cacheCg,
-                                     const Buffer& shTables) {
+Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeRadiance,
+                                     const Buffer& cacheY, const Buffer& cacheCo,
+                                     const Buffer& cacheCg, const Buffer& shTables) {
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
-    const VkDeviceSize nL = mLinksPerCache;
+    PIC_TRY_ASSIGN(mRadianceView, context.createTexelView(nodeRadiance, VK_FORMAT_R32_UINT, 0,
+                                                          nodeRadiance.size() / sizeof(uint32_t),
+                                                          "node radiance"));
     for (size_t k = 0; k < mChunkFirst.size(); ++k) {
-        const VkDeviceSize links = VkDeviceSize{mChunkFirst[k]} * nL;
-        const VkDeviceSize count = VkDeviceSize{mChunkCount[k]} * nL;
-        const auto chunkOf = [&](uint32_t binding, const Buffer& b, VkDeviceSize stride) {
-            return BindingResource::storage(binding, b, links * stride, count * stride);
-        };
-        // The other link form's bindings hold a small placeholder.
         const std::array<BindingResource, kBindingCount> resources = {
-            BindingResource::storage(0, nodeRadiance),
-            mRtpForm ? chunkOf(1, mRtp, sizeof(GpuRtpLink)) : BindingResource::storage(1, mUnused),
-            mRtpForm ? BindingResource::storage(2, mUnused)
-                     : chunkOf(2, mSh, sizeof(uint32_t) * shLinkWords(mCountY)),
-            BindingResource::storage(3, cacheY),
-            BindingResource::storage(4, cacheCo),
-            BindingResource::storage(5, cacheCg),
-            BindingResource::storage(6, shTables),
+            BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),
+            BindingResource::storage(2, cacheY),       BindingResource::storage(3, cacheCo),
+            BindingResource::storage(4, cacheCg),      BindingResource::storage(5, shTables),
         };
         PIC_TRY_ASSIGN(VkDescriptorSet set, mKernel.makeSet(resources));
         mSets.push_back(set);

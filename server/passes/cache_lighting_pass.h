@@ -1,9 +1,9 @@
 #pragma once
 /// Cache lighting on the GPU (paper 000 Figure 2 step 4, eq. 3, §4.6, §4.8): each cache's
 /// incident radiance from its nL links, YCoCg with lY / lC bands, half floats. Links stay in
-/// the bake's order, sequential per cache; they are bound in chunks of caches so that no
-/// binding exceeds the device's maxStorageBufferRange (128 MiB on lavapipe). CPU twin:
-/// server/cpu/cache_lighting.h.
+/// the bake's order, sequential per cache, and are read as uniform texel buffers in chunks of
+/// caches so that no view exceeds the device's maxTexelBufferElements (2^27 on lavapipe).
+/// CPU twin: server/cpu/cache_lighting.h.
 
 #include <memory>
 #include <vector>
@@ -27,16 +27,22 @@ public:
     /// Uploads the links (RTP: 12 bytes each, packRtpLink; SH: node index + lY² half
     /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
-    /// walks them (CPU devices); shaders/shared/cache_lighting.h says why.
+    /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
+    /// in the widest uint texels, up to `maxTexelWords` words, that the device supports and
+    /// that divide a link.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
-                                                             bool cachePerSubgroup);
-    /// Binds the node radiance (RGBE8 per node), the output caches (half) and the SH tables.
-    Result<void> bind(const Buffer& nodeRadiance, const Buffer& cacheY, const Buffer& cacheCo,
-                      const Buffer& cacheCg, const Buffer& shTables);
+                                                             bool cachePerSubgroup,
+                                                             uint32_t maxTexelWords = 4);
+    /// Binds the node radiance (RGBE8 per node; its usage must allow uniform texel buffers),
+    /// the output caches (half) and the SH tables.
+    Result<void> bind(Context& context, const Buffer& nodeRadiance, const Buffer& cacheY,
+                      const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& shTables);
     void record(VkCommandBuffer cmd);
     /// Link bytes read per update.
     VkDeviceSize linkBytes() const { return mLinkBytes; }
-    VkDeviceSize bytes() const { return mRtp.size() + mSh.size(); }
+    VkDeviceSize bytes() const { return mLinks.size(); }
+    /// 32-bit words per texel the links are read in (1 to 4).
+    uint32_t texelWords() const { return mTexelWords; }
     uint32_t chunks() const { return uint32_t(mChunkFirst.size()); }
 
 private:
@@ -48,9 +54,10 @@ private:
     uint32_t mLinksPerCache = 0;
     uint32_t mCountY = 0;
     VkDeviceSize mLinkBytes = 0;
-    Buffer mRtp;             ///< GpuRtpLink per link (RTP)
-    Buffer mSh;              ///< shLinkWords(lY²) words per link (SH)
-    Buffer mUnused;          ///< bound where the other link form's buffers go
+    uint32_t mTexelWords = 1;
+    Buffer mLinks;            ///< RTP: GpuRtpLink per link; SH: shLinkWords(lY²) words per link
+    TexelView mRadianceView;  ///< node radiance as uint texels
+    std::vector<TexelView> mLinkViews;  ///< per chunk: its links, mTexelWords words per texel
     std::vector<uint32_t> mChunkFirst;
     std::vector<uint32_t> mChunkCount;
     std::vector<VkDescriptorSet> mSets;

@@ -221,17 +221,30 @@ TEST(GpuCacheLighting, RtpLinksPackIntoTwelveBytes) {
 }
 
 /// Cache lighting for a link form and band split, each cache lit by a subgroup (as on a
-/// GPU) or by an invocation (as on a CPU device).
-class GpuCacheLighting
-    : public testing::TestWithParam<std::tuple<std::tuple<LinkMode, uint32_t, uint32_t>, bool>> {};
+/// GPU) or by an invocation (as on a CPU device), the links read in the widest texels the
+/// device has or a word at a time.
+class GpuCacheLighting : public testing::TestWithParam<
+                             std::tuple<std::tuple<LinkMode, uint32_t, uint32_t>, bool, uint32_t>> {
+};
 
 TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
-    const auto [form, perSubgroup] = GetParam();
+    const auto [form, perSubgroup, texelWords] = GetParam();
     const auto [mode, bandsY, bandsC] = form;
     const Baked& b = baked("cornell", mode, bandsY, bandsC);
     ASSERT_TRUE(b.ok);
-    auto gpu = gpuFor(b, {}, {.cachePerSubgroup = perSubgroup});
+    auto gpu = gpuFor(b, {}, {.cachePerSubgroup = perSubgroup, .maxLinkTexelWords = texelWords});
     ASSERT_TRUE(gpu);
+    // A link is 3 words (RTP) or 1 + ⌈lY²/2⌉; every device reads single words, and lavapipe
+    // three-word texels.
+    const uint32_t linkWords = mode == LinkMode::Rtp ? 3 : gpu::shLinkWords(bandsY * bandsY);
+    EXPECT_EQ(linkWords % gpu->linkTexelWords(), 0u);
+    EXPECT_LE(gpu->linkTexelWords(), texelWords);
+    if (texelWords == 1) {
+        EXPECT_EQ(gpu->linkTexelWords(), 1u);
+    }
+    if (gpu->context().isCpuDevice() && texelWords >= 3 && linkWords % 3 == 0) {
+        EXPECT_EQ(gpu->linkTexelWords(), 3u);
+    }
     const std::vector<glm::vec3> nodes = cpuNodeFlux(b, defaultLightSet(b.scene));
     CacheValues cpu;
     lightCaches(b.bake, nodes, cpu);
@@ -243,13 +256,18 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
     EXPECT_GT(relativeL2(cpu, CacheValues::zeros(cpu.cacheCount(), bandsY, bandsC)), 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    LinkFormsAndBands, GpuCacheLighting,
-    testing::Combine(
-        testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u), std::make_tuple(LinkMode::Rtp, 4u, 1u),
-                        std::make_tuple(LinkMode::Rtp, 2u, 2u), std::make_tuple(LinkMode::Sh, 3u, 2u),
-                        std::make_tuple(LinkMode::Sh, 4u, 2u), std::make_tuple(LinkMode::Sh, 1u, 1u)),
-        testing::Bool()));
+INSTANTIATE_TEST_SUITE_P(LinkFormsAndBands, GpuCacheLighting,
+                         testing::Combine(testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Rtp, 4u, 1u),
+                                                          std::make_tuple(LinkMode::Rtp, 2u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 4u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 1u, 1u)),
+                                          testing::Bool(), testing::Values(4u)));
+INSTANTIATE_TEST_SUITE_P(WordTexels, GpuCacheLighting,
+                         testing::Combine(testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 3u, 2u)),
+                                          testing::Bool(), testing::Values(1u)));
 
 /// Largest relative difference of a GPU flux from the CPU's over surfels and channels
 /// (differences below 1e−6 of the brightest surfel ignored).
