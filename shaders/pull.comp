@@ -7,16 +7,17 @@
 #include "lib/rgbe8.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) buffer NodeFlux { vec4 nodeFlux[]; };                 // W, RGB
-layout(std430, binding = 1) readonly buffer PullNodes { PullNode pullNodes[]; };  // inner nodes
+layout(std430, binding = 0) writeonly buffer NodeFlux { vec4 nodeFlux[]; };     // W, RGB
+layout(binding = 1) uniform usamplerBuffer pullNodes;  // PullNode per inner node
 layout(std430, binding = 2) writeonly buffer NodeRadiance { uint nodeRadiance[]; };  // RGBE8
+layout(binding = 3) uniform samplerBuffer childFlux;  // nodeFlux, read as RGBA32F texels
 layout(push_constant) uniform Push { PullPush pc; };
 
 void main() {
     const uint node = pc.firstNode + gl_GlobalInvocationID.x;
     if (node >= pc.endNode) return;
-    const PullNode inner = pullNodes[node - pc.surfelCount];
-    const vec3 flux = nodeFlux[inner.left].xyz + nodeFlux[inner.right].xyz;
+    const uvec4 inner = texelFetch(pullNodes, int(node - pc.surfelCount));  // PullNode
+    const vec3 flux = texelFetch(childFlux, int(inner.x)).xyz + texelFetch(childFlux, int(inner.y)).xyz;
     nodeFlux[node] = vec4(flux, 0.0);
-    nodeRadiance[node] = packRgbe8(flux * inner.radianceScale);
+    nodeRadiance[node] = packRgbe8(flux * uintBitsToFloat(inner.z));
 }

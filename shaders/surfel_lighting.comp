@@ -12,8 +12,6 @@
 // bounce part's loads and SH arithmetic (4.6 of 6.6 ms for 32k surfels, atrium).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
-#extension GL_EXT_shader_16bit_storage : require
-#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "shared/bake_layout.h"
 #include "shared/shadow_map.h"
@@ -27,22 +25,26 @@ layout(constant_id = 2) const uint kMode = kSurfelModeDirect;
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 
-layout(std430, binding = 0) readonly buffer Surfels { Surfel surfels[]; };
-layout(std430, binding = 1) readonly buffer Lights { GpuLight lights[]; };
+// Records read by index are uniform texel buffers: on lavapipe a storage-buffer load at a
+// per-lane index is a branch and a scalar load per lane, a texel fetch a gather. Mixed
+// records are RGBA32UI texels, their floats bit casts.
+layout(binding = 0) uniform usamplerBuffer surfelTexels;  // Surfel: 4 texels
+layout(binding = 1) uniform usamplerBuffer lightTexels;   // GpuLight: 5 texels
 layout(std430, binding = 2) readonly buffer ShadowLayers { GpuShadowLayer shadowLayers[]; };
-layout(std430, binding = 3) readonly buffer EmissiveScale { float emissiveScale[]; };  // per material
+layout(binding = 3) uniform samplerBuffer emissiveScale;  // per material
 layout(binding = 4) uniform sampler2DArray shadowMaps;
-layout(std430, binding = 5) buffer DirectFlux { vec4 directFlux[]; };   // nS
-layout(std430, binding = 6) buffer NodeFlux { vec4 nodeFlux[]; };       // leaves [0, nS)
-layout(std430, binding = 7) readonly buffer Stencils { SurfelStencil stencils[]; };
-layout(std430, binding = 8) readonly buffer CacheY { float16_t cacheY[]; };
-layout(std430, binding = 9) readonly buffer CacheCo { float16_t cacheCo[]; };
-layout(std430, binding = 10) readonly buffer CacheCg { float16_t cacheCg[]; };
+layout(std430, binding = 5) writeonly buffer DirectFlux { vec4 directFlux[]; };  // nS
+layout(std430, binding = 6) writeonly buffer NodeFlux { vec4 nodeFlux[]; };      // leaves [0, nS)
+layout(binding = 7) uniform usamplerBuffer stencilTexels;  // SurfelStencil: 4 texels
+layout(binding = 8) uniform samplerBuffer cacheY;          // half texels, nC·lY²
+layout(binding = 9) uniform samplerBuffer cacheCo;         // nC·lC²
+layout(binding = 10) uniform samplerBuffer cacheCg;
 layout(std140, binding = 11) uniform Sh { ShTables sh; };
 layout(std430, binding = 12) writeonly buffer GroupFlux { vec4 groupFlux[]; };
 // Rays mode: bit i % 32 of word light·⌈nS/32⌉ + i/32 is set where light reaches surfel i.
-layout(std430, binding = 13) readonly buffer Visibility { uint visibility[]; };
+layout(binding = 13) uniform usamplerBuffer visibility;
 layout(std430, binding = 14) writeonly buffer NodeRadiance { uint nodeRadiance[]; };  // leaves
+layout(binding = 15) uniform samplerBuffer directFluxTexels;  // binding 5, read by the bounce
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
@@ -51,16 +53,45 @@ layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 shared vec3 partial[kSurfelLightingGroup];  // per subgroup
 
+Surfel fetchSurfel(uint i) {
+    const int t = int(i) * 4;
+    const uvec4 a = texelFetch(surfelTexels, t);
+    const uvec4 b = texelFetch(surfelTexels, t + 1);
+    const uvec4 c = texelFetch(surfelTexels, t + 2);
+    const uvec4 d = texelFetch(surfelTexels, t + 3);
+    return Surfel(uintBitsToFloat(a.xyz), uintBitsToFloat(a.w), uintBitsToFloat(b.xyz), b.w,
+                  uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz), d.w);
+}
+
+GpuLight fetchLight(uint k) {
+    const int t = int(k) * 5;
+    const uvec4 a = texelFetch(lightTexels, t);
+    const uvec4 b = texelFetch(lightTexels, t + 1);
+    const uvec4 c = texelFetch(lightTexels, t + 2);
+    const uvec4 d = texelFetch(lightTexels, t + 3);
+    const uvec4 e = texelFetch(lightTexels, t + 4);
+    return GpuLight(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
+                    uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z,
+                    uintBitsToFloat(d.w), uintBitsToFloat(e.x), e.y, e.z, e.w);
+}
+
+SurfelStencil fetchStencil(uint i) {
+    const int t = int(i) * 4;
+    return SurfelStencil(texelFetch(stencilTexels, t), texelFetch(stencilTexels, t + 1),
+                         uintBitsToFloat(texelFetch(stencilTexels, t + 2)),
+                         uintBitsToFloat(texelFetch(stencilTexels, t + 3)));
+}
+
 void main() {
     const uint i = gl_GlobalInvocationID.x;
     vec3 flux = vec3(0.0);
     if (i < pc.surfelCount) {
-        const Surfel surfel = surfels[i];
+        const Surfel surfel = fetchSurfel(i);
         if (kMode != kSurfelModeBounce) {
             const uint words = (pc.surfelCount + 31u) / 32u;
             vec3 irradiance = vec3(0.0);
             for (uint k = 0u; k < pc.lightCount; ++k) {
-                const GpuLight light = lights[k];
+                const GpuLight light = fetchLight(k);
                 vec3 toLight;
                 float distance;
                 const vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
@@ -68,18 +99,18 @@ void main() {
                 if (!(e.r > 0.0 || e.g > 0.0 || e.b > 0.0)) continue;
                 const bool visible =
                     kMode == kSurfelModeDirectRays
-                        ? (visibility[k * words + (i >> 5u)] & (1u << (i & 31u))) != 0u
+                        ? (texelFetch(visibility, int(k * words + (i >> 5u))).x & (1u << (i & 31u))) != 0u
                         : shadowVisible(light, surfel.position, surfel.normal,
                                         dot(surfel.normal, toLight), pc.epsilon);
                 if (visible) irradiance += e;
             }
             flux = surfel.albedo * (surfel.area * irradiance) +
-                   (kPi * surfel.area * emissiveScale[surfel.material]) * surfel.emission;
+                   (kPi * surfel.area * texelFetch(emissiveScale, int(surfel.material)).x) * surfel.emission;
             directFlux[i] = vec4(flux, 0.0);
         } else {
             // Interpolate the previous bounce's caches in YCoCg, then convolve with the
             // clamped cosine about the normal.
-            const SurfelStencil s = stencils[i];
+            const SurfelStencil s = fetchStencil(i);
             float y[kCountY];
             float co[kCountC];
             float cg[kCountC];
@@ -89,10 +120,11 @@ void main() {
                 const float w = k < 4u ? s.weightLow[k] : s.weightHigh[k - 4u];
                 if (w == 0.0) continue;
                 const uint cache = k < 4u ? s.cacheLow[k] : s.cacheHigh[k - 4u];
-                [[unroll]] for (uint c = 0u; c < kCountY; ++c) y[c] += w * float(cacheY[cache * kCountY + c]);
+                [[unroll]] for (uint c = 0u; c < kCountY; ++c)
+                    y[c] += w * texelFetch(cacheY, int(cache * kCountY + c)).x;
                 [[unroll]] for (uint c = 0u; c < kCountC; ++c) {
-                    co[c] += w * float(cacheCo[cache * kCountC + c]);
-                    cg[c] += w * float(cacheCg[cache * kCountC + c]);
+                    co[c] += w * texelFetch(cacheCo, int(cache * kCountC + c)).x;
+                    cg[c] += w * texelFetch(cacheCg, int(cache * kCountC + c)).x;
                 }
             }
             float basis[64];
@@ -108,7 +140,7 @@ void main() {
             }
             // SH ringing can make irradiance negative on the dark side; cut at zero per channel.
             const vec3 irradiance = max(yCoCgToRgb(e), vec3(0.0));
-            flux = directFlux[i].xyz + surfel.albedo * (surfel.area * irradiance);
+            flux = texelFetch(directFluxTexels, int(i)).xyz + surfel.albedo * (surfel.area * irradiance);
         }
         nodeFlux[i] = vec4(flux, 0.0);
         // Cache lighting reads the leaf's radiance Φ / (π·A) (paper 000 §4.7).

@@ -527,10 +527,14 @@ bool Context::canReadTexels(VkFormat format) const {
 Result<TexelView> Context::createTexelView(const Buffer& buffer, VkFormat format,
                                            VkDeviceSize offset, VkDeviceSize texels,
                                            const char* what) {
-    // The 32-bit unsigned formats, by component count, are all texel views take.
+    // Formats of 32-bit components, and R16 SFLOAT, are all texel views take.
     VkDeviceSize texelBytes = 0;
     switch (format) {
+    case VK_FORMAT_R16_SFLOAT:
+        texelBytes = 2;
+        break;
     case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_R32_SFLOAT:
         texelBytes = 4;
         break;
     case VK_FORMAT_R32G32_UINT:
@@ -540,11 +544,12 @@ Result<TexelView> Context::createTexelView(const Buffer& buffer, VkFormat format
         texelBytes = 12;
         break;
     case VK_FORMAT_R32G32B32A32_UINT:
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
         texelBytes = 16;
         break;
     default:
-        return fail(ErrorCode::InvalidInput, "{}: texel format {} is not a uint format", what,
-                    int(format));
+        return fail(ErrorCode::InvalidInput, "{}: texel format {} is not one texel views take",
+                    what, int(format));
     }
     if (!canReadTexels(format))
         return fail(ErrorCode::Unsupported, "{}: {} cannot read format {} as a texel buffer", what,

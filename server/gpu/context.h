@@ -67,8 +67,8 @@ private:
 };
 
 /// A typed view of a buffer range that shaders read as a uniform texel buffer
-/// (`usamplerBuffer`); move-only. Texel fetches are gathers without branches on lavapipe,
-/// where a storage-buffer load at an index that differs per lane is a branch per lane.
+/// (`usamplerBuffer`, `samplerBuffer`); move-only. Texel fetches are gathers without branches on
+/// lavapipe, where a storage-buffer load at an index that differs per lane is a branch per lane.
 class TexelView {
 public:
     TexelView() = default;
@@ -231,8 +231,9 @@ public:
     }
     /// Whether shaders may read `format` from a uniform texel buffer.
     bool canReadTexels(VkFormat format) const;
-    /// A view of `texels` elements of `format` in `buffer` from byte `offset`, which the
-    /// buffer's usage must allow (VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT). Unsupported when
+    /// A view of `texels` elements of `format` (32-bit components: R32, R32G32, R32G32B32 or
+    /// R32G32B32A32 UINT; R16, R32 or R32G32B32A32 SFLOAT) in `buffer` from byte `offset`, which
+    /// the buffer's usage must allow (VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT). Unsupported when
     /// `texels` exceeds maxTexelBufferElements or the format cannot be a uniform texel buffer.
     Result<TexelView> createTexelView(const Buffer& buffer, VkFormat format, VkDeviceSize offset,
                                       VkDeviceSize texels, const char* what);

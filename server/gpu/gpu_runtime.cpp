@@ -52,14 +52,19 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     const uint32_t countY = mBake.params.bandsY * mBake.params.bandsY;
     const uint32_t countC = mBake.params.bandsC * mBake.params.bandsC;
 
-    PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), 0,
+    // The pull reads the node flux, cache lighting the node radiance, and the bounce's surfel
+    // lighting the caches as uniform texel buffers.
+    constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+    PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), kTexels,
                                                MemoryUse::Device, "node flux"));
-    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t),
-                                                   VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t), kTexels,
                                                    MemoryUse::Device, "node radiance"));
-    PIC_TRY_ASSIGN(mCacheY, ctx.createBuffer(2 * nC * countY, 0, MemoryUse::Device, "caches Y"));
-    PIC_TRY_ASSIGN(mCacheCo, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Co"));
-    PIC_TRY_ASSIGN(mCacheCg, ctx.createBuffer(2 * nC * countC, 0, MemoryUse::Device, "caches Cg"));
+    PIC_TRY_ASSIGN(mCacheY,
+                   ctx.createBuffer(2 * nC * countY, kTexels, MemoryUse::Device, "caches Y"));
+    PIC_TRY_ASSIGN(mCacheCo,
+                   ctx.createBuffer(2 * nC * countC, kTexels, MemoryUse::Device, "caches Co"));
+    PIC_TRY_ASSIGN(mCacheCg,
+                   ctx.createBuffer(2 * nC * countC, kTexels, MemoryUse::Device, "caches Cg"));
     if (!mCacheY.mapped() || !mCacheCo.mapped() || !mCacheCg.mapped()) {
         const VkDeviceSize bytes = mCacheY.size() + mCacheCo.size() + mCacheCg.size();
         PIC_TRY_ASSIGN(mCacheReadback,
@@ -88,7 +93,7 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                                              options.maxLinkTexelWords));
     PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
     PIC_TRY(bindVisibility());
-    PIC_TRY(mPull->bind(mNodeFlux, mNodeRadiance));
+    PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeRadiance));
     PIC_TRY(mCacheLighting->bind(ctx, mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
     PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
 

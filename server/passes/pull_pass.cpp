@@ -20,26 +20,36 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     pass->mSurfelCount = uint32_t(nS);
     pass->mLevelOffsets = bake.levelOffsets;
     KernelLayout layout;
-    layout.bindings.assign(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
     layout.pushBytes = sizeof(PullPush);
     PIC_TRY_ASSIGN(pass->mKernel, Kernel::create(context, kSpirvPullComp, layout, "pull"));
-    // Only the children and the area matter to the pull: 12 bytes per inner node instead of
+    // Only the children and the area matter to the pull: 16 bytes per inner node instead of
     // the 64-byte Node.
     std::vector<PullNode> inner(bake.nodes.size() - nS);
     for (size_t n = nS; n < bake.nodes.size(); ++n) {
         const Node& node = bake.nodes[n];
-        inner[n - nS] = {node.left, node.right, radianceScale(node.area)};
+        inner[n - nS] = {node.left, node.right, radianceScale(node.area), 0};
     }
-    PIC_TRY_ASSIGN(pass->mInnerNodes,
-                   context.createBufferWith(std::span<const PullNode>(inner), 0, "pull nodes"));
+    if (inner.empty()) return pass;  // a single surfel: nothing to pull
+    PIC_TRY_ASSIGN(pass->mInnerNodes, context.createBufferWith(
+                                          std::span<const PullNode>(inner),
+                                          VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
+    PIC_TRY_ASSIGN(pass->mInnerView,
+                   context.createTexelView(pass->mInnerNodes, VK_FORMAT_R32G32B32A32_UINT, 0,
+                                           inner.size(), "pull nodes"));
     return pass;
 }
 
-Result<void> PullPass::bind(const Buffer& nodeFlux, const Buffer& nodeRadiance) {
-    const std::array<BindingResource, 3> resources = {BindingResource::storage(0, nodeFlux),
-                                                      BindingResource::storage(1, mInnerNodes),
-                                                      BindingResource::storage(2, nodeRadiance)};
+Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeRadiance) {
+    if (!mInnerNodes.handle()) return {};
     PIC_TRY(mKernel.resetSets());
+    PIC_TRY_ASSIGN(mFluxView,
+                   context.createTexelView(nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT, 0,
+                                           nodeFlux.size() / sizeof(glm::vec4), "node flux"));
+    const std::array<BindingResource, 4> resources = {
+        BindingResource::storage(0, nodeFlux), BindingResource::texels(1, mInnerView),
+        BindingResource::storage(2, nodeRadiance), BindingResource::texels(3, mFluxView)};
     PIC_TRY_ASSIGN(mSet, mKernel.makeSet(resources));
     return {};
 }

@@ -19,9 +19,9 @@ class PullPass {
 public:
     /// Uploads each inner node's two children and 1 / (π·area).
     static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake);
-    /// Binds the node flux (vec4 per node) and node radiance (RGBE8 per node) buffers, whose
-    /// leaves surfel lighting writes.
-    Result<void> bind(const Buffer& nodeFlux, const Buffer& nodeRadiance);
+    /// Binds the node flux (vec4 per node; its usage must allow uniform texel buffers) and
+    /// node radiance (RGBE8 per node) buffers, whose leaves surfel lighting writes.
+    Result<void> bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeRadiance);
     /// Records every level with a barrier after each, so a level reads finished children.
     void record(VkCommandBuffer cmd);
     VkDeviceSize bytes() const { return mInnerNodes.size(); }
@@ -30,7 +30,9 @@ private:
     PullPass() = default;
     Kernel mKernel;
     VkDescriptorSet mSet = VK_NULL_HANDLE;
-    Buffer mInnerNodes;  ///< PullNode per inner node
+    Buffer mInnerNodes;    ///< PullNode per inner node (none for a single surfel)
+    TexelView mInnerView;  ///< mInnerNodes as RGBA32UI texels
+    TexelView mFluxView;   ///< the node flux as RGBA32F texels
     uint32_t mSurfelCount = 0;
     std::vector<uint32_t> mLevelOffsets;
 };

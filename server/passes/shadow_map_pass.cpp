@@ -417,7 +417,8 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     PIC_TRY_ASSIGN(pass->mIndices,
                    context.createBufferWith(std::span<const uint32_t>(indices),
                                             VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "shadow indices"));
-    PIC_TRY_ASSIGN(pass->mLights, context.createBuffer(sizeof(GpuLight) * kMaxLights, 0,
+    PIC_TRY_ASSIGN(pass->mLights, context.createBuffer(sizeof(GpuLight) * kMaxLights,
+                                                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
                                                        MemoryUse::Device, "lights"));
     PIC_TRY_ASSIGN(pass->mLayerBuffer, context.createBuffer(sizeof(GpuShadowLayer) * 6 * kMaxLights, 0,
                                                             MemoryUse::Device, "shadow layers"));

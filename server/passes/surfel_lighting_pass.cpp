@@ -11,9 +11,17 @@
 namespace pic::gpu {
 namespace {
 
-constexpr uint32_t kBindingCount = 15;
+constexpr uint32_t kBindingCount = 16;
 constexpr uint32_t kSamplerBinding = 4;
 constexpr uint32_t kShTablesBinding = 11;
+/// Bindings read as uniform texel buffers (shaders/surfel_lighting.comp says why).
+constexpr std::array<uint32_t, 9> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15};
+constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+
+/// How many texels of `texelBytes` `buffer` holds.
+VkDeviceSize texelCount(const Buffer& buffer, VkDeviceSize texelBytes) {
+    return buffer.size() / texelBytes;
+}
 
 }  // namespace
 
@@ -41,6 +49,7 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
     KernelLayout layout;
     layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     layout.bindings[kSamplerBinding] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    for (uint32_t b : kTexelBindings) layout.bindings[b] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
     layout.bindings[kShTablesBinding] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     layout.pushBytes = sizeof(SurfelLightingPush);
     layout.specialization = {bake.params.bandsY, bake.params.bandsC,
@@ -74,16 +83,30 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
         }
     }, 1024);
 
-    PIC_TRY_ASSIGN(pass->mSurfels, context.createBufferWith(bake.surfels.data(),
-                                                            nS * sizeof(pic::Surfel), 0, "surfels"));
+    PIC_TRY_ASSIGN(pass->mSurfels,
+                   context.createBufferWith(bake.surfels.data(), nS * sizeof(pic::Surfel), kTexels,
+                                            "surfels"));
     PIC_TRY_ASSIGN(pass->mStencils,
-                   context.createBufferWith(std::span<const SurfelStencil>(stencils), 0,
+                   context.createBufferWith(std::span<const SurfelStencil>(stencils), kTexels,
                                             "surfel stencils"));
     PIC_TRY_ASSIGN(pass->mEmissiveScale,
                    context.createBuffer(std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
-                                        0, MemoryUse::Device, "emissive scales"));
-    PIC_TRY_ASSIGN(pass->mDirectFlux, context.createBuffer(nS * sizeof(glm::vec4), 0,
+                                        kTexels, MemoryUse::Device, "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFlux, context.createBuffer(nS * sizeof(glm::vec4), kTexels,
                                                            MemoryUse::Device, "direct flux"));
+    // Records as RGBA32UI texels (their floats bit casts), flux as RGBA32F.
+    PIC_TRY_ASSIGN(pass->mSurfelView,
+                   context.createTexelView(pass->mSurfels, VK_FORMAT_R32G32B32A32_UINT, 0,
+                                           texelCount(pass->mSurfels, 16), "surfels"));
+    PIC_TRY_ASSIGN(pass->mStencilView,
+                   context.createTexelView(pass->mStencils, VK_FORMAT_R32G32B32A32_UINT, 0,
+                                           texelCount(pass->mStencils, 16), "surfel stencils"));
+    PIC_TRY_ASSIGN(pass->mEmissiveView,
+                   context.createTexelView(pass->mEmissiveScale, VK_FORMAT_R32_SFLOAT, 0,
+                                           texelCount(pass->mEmissiveScale, 4), "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFluxView,
+                   context.createTexelView(pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT, 0,
+                                           texelCount(pass->mDirectFlux, 16), "direct flux"));
     PIC_TRY_ASSIGN(pass->mGroupFlux,
                    context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
                                         MemoryUse::Readback, "surfel flux sums"));
@@ -94,8 +117,8 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
                                                                  MemoryUse::Device, "unused"));
         PIC_TRY_ASSIGN(pass->mUnusedDepth, context.createDepthArray(kMinShadowSide, 1));
     } else {
-        PIC_TRY_ASSIGN(pass->mUnusedVisibility,
-                       context.createBuffer(sizeof(uint32_t), 0, MemoryUse::Device, "unused"));
+        PIC_TRY_ASSIGN(pass->mUnusedVisibility, context.createBuffer(sizeof(uint32_t), kTexels,
+                                                                     MemoryUse::Device, "unused"));
     }
     return pass;
 }
@@ -104,26 +127,40 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     const bool rays = mVisibility == DirectVisibility::Rays;
     PIC_CHECK(rays ? r.rays != nullptr : r.shadows != nullptr);
     PIC_CHECK(r.nodeFlux && r.nodeRadiance && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    PIC_TRY(mDirect.resetSets());
+    PIC_TRY(mBounce.resetSets());
+    const Buffer& lights = rays ? r.rays->lightBuffer() : r.shadows->lightBuffer();
+    const Buffer& visibility = rays ? r.rays->visibilityBuffer() : mUnusedVisibility;
+    PIC_TRY_ASSIGN(mLightView, mContext.createTexelView(lights, VK_FORMAT_R32G32B32A32_UINT, 0,
+                                                        texelCount(lights, 16), "lights"));
+    PIC_TRY_ASSIGN(mVisibilityView,
+                   mContext.createTexelView(visibility, VK_FORMAT_R32_UINT, 0,
+                                            texelCount(visibility, 4), "visibility"));
+    const std::array<const Buffer*, 3> caches = {r.cacheY, r.cacheCo, r.cacheCg};
+    for (size_t c = 0; c < caches.size(); ++c) {
+        PIC_TRY_ASSIGN(mCacheViews[c],
+                       mContext.createTexelView(*caches[c], VK_FORMAT_R16_SFLOAT, 0,
+                                                texelCount(*caches[c], 2), "caches"));
+    }
     const std::array<BindingResource, kBindingCount> resources = {
-        BindingResource::storage(0, mSurfels),
-        BindingResource::storage(1, rays ? r.rays->lightBuffer() : r.shadows->lightBuffer()),
+        BindingResource::texels(0, mSurfelView),
+        BindingResource::texels(1, mLightView),
         BindingResource::storage(2, rays ? mUnusedLayers : r.shadows->layerBuffer()),
-        BindingResource::storage(3, mEmissiveScale),
+        BindingResource::texels(3, mEmissiveView),
         BindingResource::image(4, (rays ? mUnusedDepth : r.shadows->depth()).arrayView(),
                                mContext.nearestSampler()),
         BindingResource::storage(5, mDirectFlux),
         BindingResource::storage(6, *r.nodeFlux),
-        BindingResource::storage(7, mStencils),
-        BindingResource::storage(8, *r.cacheY),
-        BindingResource::storage(9, *r.cacheCo),
-        BindingResource::storage(10, *r.cacheCg),
+        BindingResource::texels(7, mStencilView),
+        BindingResource::texels(8, mCacheViews[0]),
+        BindingResource::texels(9, mCacheViews[1]),
+        BindingResource::texels(10, mCacheViews[2]),
         BindingResource::storage(11, *r.shTables),
         BindingResource::storage(12, mGroupFlux),
-        BindingResource::storage(13, rays ? r.rays->visibilityBuffer() : mUnusedVisibility),
+        BindingResource::texels(13, mVisibilityView),
         BindingResource::storage(14, *r.nodeRadiance),
+        BindingResource::texels(15, mDirectFluxView),
     };
-    PIC_TRY(mDirect.resetSets());
-    PIC_TRY(mBounce.resetSets());
     PIC_TRY_ASSIGN(mDirectSet, mDirect.makeSet(resources));
     PIC_TRY_ASSIGN(mBounceSet, mBounce.makeSet(resources));
     return {};

@@ -4,6 +4,7 @@
 /// light the previous bounce's caches deliver to it. CPU twin: server/cpu/surfel_lighting.h.
 /// The direct light's visibility comes from shadow maps or from host-traced rays.
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -39,6 +40,9 @@ struct SurfelLightingResources {
     const RayVisibilityPass* rays = nullptr;
     const Buffer* nodeFlux = nullptr;    ///< vec4 per node; the pass writes the leaves
     const Buffer* nodeRadiance = nullptr;  ///< RGBE8 per node; the pass writes the leaves
+    /// The buffers below the lights are read as uniform texel buffers: their usage must
+    /// allow it (VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT), as must the lights' and the
+    /// visibility's.
     const Buffer* cacheY = nullptr;      ///< half, nC·lY²: the previous bounce
     const Buffer* cacheCo = nullptr;     ///< half, nC·lC²
     const Buffer* cacheCg = nullptr;     ///< half, nC·lC²
@@ -89,6 +93,14 @@ private:
     Buffer mUnusedLayers;
     DepthArray mUnusedDepth;
     Buffer mUnusedVisibility;
+    /// Uniform texel views of what the shader reads by index.
+    TexelView mSurfelView;
+    TexelView mStencilView;
+    TexelView mEmissiveView;
+    TexelView mDirectFluxView;
+    TexelView mLightView;
+    TexelView mVisibilityView;
+    std::array<TexelView, 3> mCacheViews;  ///< Y, Co, Cg
 };
 
 }  // namespace pic::gpu

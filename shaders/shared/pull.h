@@ -9,13 +9,16 @@ PIC_NAMESPACE_BEGIN
 
 PIC_CONST(uint, kPullGroup, 64u);
 
-// An inner node as the pull reads it.
+// An inner node as the pull reads it: one RGBA32UI texel. The pull reads the inner nodes and
+// the children's flux as uniform texel buffers, gathers on lavapipe rather than a branch per
+// lane (shared/cache_lighting.h).
 struct PullNode {
     uint left;  // child nodes
     uint right;
     float radianceScale;  // 1 / (π · area): flux W → radiance W/(m²·sr) of a Lambertian node
+    uint pad0;
 };
-PIC_STRUCT_CHECK(PullNode, 12);
+PIC_STRUCT_CHECK(PullNode, 16);
 
 struct PullPush {
     uint firstNode;     // the level is nodes [firstNode, endNode)
