@@ -87,19 +87,6 @@ uint16_t floatToHalfClamped(float value) {
     return half;
 }
 
-float halfToFloat(uint16_t bits) {
-    const uint32_t sign = uint32_t(bits & 0x8000u) << 16;
-    const uint32_t exponent = (bits >> 10) & 0x1fu;
-    const uint32_t mantissa = bits & 0x3ffu;
-    if (exponent == 0) {
-        // Zero or subnormal: mantissa · 2^-24, exact in float.
-        const float magnitude = float(mantissa) * 0x1p-24f;
-        return sign ? -magnitude : magnitude;
-    }
-    if (exponent == 31) return std::bit_cast<float>(sign | 0x7f800000u | (mantissa << 13));
-    return std::bit_cast<float>(sign | ((exponent + 112) << 23) | (mantissa << 13));
-}
-
 uint32_t encodeOctahedral(const glm::vec3& unitDir) {
     const float l1 = std::abs(unitDir.x) + std::abs(unitDir.y) + std::abs(unitDir.z);
     if (!(l1 > 0.0f) || !std::isfinite(l1)) return encodeOctahedral({0.0f, 0.0f, 1.0f});

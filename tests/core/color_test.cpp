@@ -88,6 +88,11 @@ TEST(HalfFloat, EveryPatternRoundTrips) {
         const double reference = halfReference(bits);
         if (isHalfNan(bits)) {
             ASSERT_TRUE(std::isnan(value)) << std::hex << pattern;
+            // The payload moves to the float's top mantissa bits unchanged (no quieting).
+            ASSERT_EQ(std::bit_cast<uint32_t>(value), (uint32_t(bits & 0x8000) << 16) |
+                                                          0x7f800000u |
+                                                          (uint32_t(bits & 0x3ff) << 13))
+                << std::hex << pattern;
             const uint16_t back = floatToHalf(value);
             ASSERT_TRUE(isHalfNan(back)) << std::hex << pattern;
             ASSERT_EQ(back & 0x8000, bits & 0x8000);
