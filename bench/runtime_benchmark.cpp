@@ -73,14 +73,25 @@ struct BackendFigures {
     int lightsTraced = 0;          ///< GPU, rays: lights whose rays each update traced
 };
 
+/// Times `repeat` updates of `runtime`, each what the server's relight does for a light
+/// change: setLights, then textures() (the light-map copy: the GPU runtime records it in
+/// setLights and reads the layers back here, the CPU twin copies its caches here).
 Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step,
                                    const std::string& change) {
     BackendFigures figures;
     UpdateStats stats;
     PIC_TRY(runtime.setLights(changedLights(base, 0, step, change), &stats));  // warm-up
+    PIC_TRY(runtime.textures());
+    const auto msSince = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
     for (int k = 1; k <= repeat; ++k) {
+        const Clock::time_point start = Clock::now();
         PIC_TRY(runtime.setLights(changedLights(base, k, step, change), &stats));
-        figures.totalMs.push_back(stats.totalMs);
+        const Clock::time_point texturesStart = Clock::now();
+        PIC_TRY(runtime.textures());
+        stats.passMs["textures"] = msSince(texturesStart);
+        figures.totalMs.push_back(msSince(start));
         for (const auto& [pass, ms] : stats.passMs) figures.passMs[pass].push_back(ms);
         figures.bounces = stats.bounces;
         figures.shadowTriangles = stats.shadowTriangles;
