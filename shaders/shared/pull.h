@@ -8,6 +8,14 @@
 PIC_NAMESPACE_BEGIN
 
 PIC_CONST(uint, kPullGroup, 64u);
+// Specialization constant 0: one level per dispatch, or the tail, every level from the
+// first of a run of levels with at most kPullTailNodes nodes to the root, in one workgroup
+// with a barrier between levels (the hierarchy's upper levels are small: 16 of the moderate
+// atrium's 23 levels hold at most 256 nodes, and a dispatch with its barrier costs more than
+// their additions).
+PIC_CONST(uint, kPullModeLevel, 0u);
+PIC_CONST(uint, kPullModeTail, 1u);
+PIC_CONST(uint, kPullTailNodes, 256u);
 
 // An inner node as the pull reads it: one RGBA32UI texel. The pull reads the inner nodes and
 // the children's flux as uniform texel buffers, gathers on lavapipe rather than a branch per
@@ -21,8 +29,8 @@ struct PullNode {
 PIC_STRUCT_CHECK(PullNode, 16);
 
 struct PullPush {
-    uint firstNode;     // the level is nodes [firstNode, endNode)
-    uint endNode;
+    uint first;        // level mode: the level is nodes [first, end); tail mode: levels
+    uint end;          // [first, end), level k being nodes [levelOffsets[k − 1], levelOffsets[k])
     uint surfelCount;  // nS: inner node n is pullNodes[n − nS]
     uint pad0;
 };

@@ -24,6 +24,7 @@
 #include "server/cpu/pull.h"
 #include "server/cpu/surfel_lighting.h"
 #include "server/gpu/copy_probe.h"
+#include "shaders/shared/pull.h"
 #include "server/gpu/gpu_runtime.h"
 #include "server/passes/cache_lighting_pass.h"
 #include "server/passes/pull_pass.h"
@@ -130,6 +131,11 @@ double fractionDiffering(const std::vector<glm::vec3>& gpu, const std::vector<gl
 TEST(GpuPull, NodeFluxIsExact) {
     const Baked& b = baked("cornell", LinkMode::Rtp);
     ASSERT_TRUE(b.ok);
+    // Both of the pull's modes run: large levels a dispatch each, the small upper ones as
+    // the tail.
+    const std::vector<uint32_t>& offsets = b.bake.levelOffsets;
+    ASSERT_GT(offsets[1] - offsets[0], gpu::kPullTailNodes);
+    ASSERT_LE(offsets.back() - offsets[offsets.size() - 2], gpu::kPullTailNodes);
     auto gpu = gpuFor(b);
     ASSERT_TRUE(gpu);
     std::mt19937 rng(7);
