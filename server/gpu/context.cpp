@@ -518,6 +518,36 @@ Result<Buffer*> Context::staging(VkDeviceSize bytes) {
     return &mStaging;
 }
 
+namespace {
+
+/// Bytes per texel of the formats texel views take (0 for any other).
+VkDeviceSize texelSize(VkFormat format) {
+    switch (format) {
+    case VK_FORMAT_R16_SFLOAT:
+        return 2;
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_R32_SFLOAT:
+        return 4;
+    case VK_FORMAT_R32G32_UINT:
+        return 8;
+    case VK_FORMAT_R32G32B32_UINT:
+        return 12;
+    case VK_FORMAT_R32G32B32A32_UINT:
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+        return 16;
+    default:
+        return 0;
+    }
+}
+
+}  // namespace
+
+Result<TexelView> Context::createTexelView(const Buffer& buffer, VkFormat format,
+                                           const char* what) {
+    const VkDeviceSize texelBytes = texelSize(format);
+    return createTexelView(buffer, format, 0, texelBytes ? buffer.size() / texelBytes : 0, what);
+}
+
 bool Context::canReadTexels(VkFormat format) const {
     VkFormatProperties properties{};
     vkGetPhysicalDeviceFormatProperties(mPhysical, format, &properties);
@@ -527,30 +557,10 @@ bool Context::canReadTexels(VkFormat format) const {
 Result<TexelView> Context::createTexelView(const Buffer& buffer, VkFormat format,
                                            VkDeviceSize offset, VkDeviceSize texels,
                                            const char* what) {
-    // Formats of 32-bit components, and R16 SFLOAT, are all texel views take.
-    VkDeviceSize texelBytes = 0;
-    switch (format) {
-    case VK_FORMAT_R16_SFLOAT:
-        texelBytes = 2;
-        break;
-    case VK_FORMAT_R32_UINT:
-    case VK_FORMAT_R32_SFLOAT:
-        texelBytes = 4;
-        break;
-    case VK_FORMAT_R32G32_UINT:
-        texelBytes = 8;
-        break;
-    case VK_FORMAT_R32G32B32_UINT:
-        texelBytes = 12;
-        break;
-    case VK_FORMAT_R32G32B32A32_UINT:
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-        texelBytes = 16;
-        break;
-    default:
+    const VkDeviceSize texelBytes = texelSize(format);
+    if (texelBytes == 0)
         return fail(ErrorCode::InvalidInput, "{}: texel format {} is not one texel views take",
                     what, int(format));
-    }
     if (!canReadTexels(format))
         return fail(ErrorCode::Unsupported, "{}: {} cannot read format {} as a texel buffer", what,
                     mName, int(format));

@@ -237,6 +237,8 @@ public:
     /// `texels` exceeds maxTexelBufferElements or the format cannot be a uniform texel buffer.
     Result<TexelView> createTexelView(const Buffer& buffer, VkFormat format, VkDeviceSize offset,
                                       VkDeviceSize texels, const char* what);
+    /// A view of all of `buffer` as texels of `format` (as many as fit).
+    Result<TexelView> createTexelView(const Buffer& buffer, VkFormat format, const char* what);
     /// Writes `bytes` of `data` into `buffer` at `offset`.
     Result<void> upload(Buffer& buffer, const void* data, VkDeviceSize bytes,
                         VkDeviceSize offset = 0);

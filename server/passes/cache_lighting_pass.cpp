@@ -158,9 +158,8 @@ Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeRadianc
                                      const Buffer& cacheCg, const Buffer& shTables) {
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
-    PIC_TRY_ASSIGN(mRadianceView, context.createTexelView(nodeRadiance, VK_FORMAT_R32_UINT, 0,
-                                                          nodeRadiance.size() / sizeof(uint32_t),
-                                                          "node radiance"));
+    PIC_TRY_ASSIGN(mRadianceView,
+                   context.createTexelView(nodeRadiance, VK_FORMAT_R32_UINT, "node radiance"));
     for (size_t k = 0; k < mChunkFirst.size(); ++k) {
         const std::array<BindingResource, kBindingCount> resources = {
             BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),

@@ -46,9 +46,9 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     PIC_TRY_ASSIGN(pass->mInnerNodes, context.createBufferWith(
                                           std::span<const PullNode>(inner),
                                           VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
-    PIC_TRY_ASSIGN(pass->mInnerView,
-                   context.createTexelView(pass->mInnerNodes, VK_FORMAT_R32G32B32A32_UINT, 0,
-                                           inner.size(), "pull nodes"));
+    PIC_TRY_ASSIGN(
+        pass->mInnerView,
+        context.createTexelView(pass->mInnerNodes, VK_FORMAT_R32G32B32A32_UINT, "pull nodes"));
     PIC_TRY_ASSIGN(
         pass->mLevelOffsetBuffer,
         context.createBufferWith(std::span<const uint32_t>(offsets), 0, "level offsets"));
@@ -60,8 +60,7 @@ Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buff
     PIC_TRY(mLevel.resetSets());
     PIC_TRY(mTail.resetSets());
     PIC_TRY_ASSIGN(mFluxView,
-                   context.createTexelView(nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT, 0,
-                                           nodeFlux.size() / sizeof(glm::vec4), "node flux"));
+                   context.createTexelView(nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT, "node flux"));
     const std::array<BindingResource, 5> resources = {
         BindingResource::storage(0, nodeFlux), BindingResource::texels(1, mInnerView),
         BindingResource::storage(2, nodeRadiance), BindingResource::texels(3, mFluxView),

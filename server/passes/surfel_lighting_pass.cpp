@@ -18,11 +18,6 @@ constexpr uint32_t kShTablesBinding = 11;
 constexpr std::array<uint32_t, 9> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15};
 constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 
-/// How many texels of `texelBytes` `buffer` holds.
-VkDeviceSize texelCount(const Buffer& buffer, VkDeviceSize texelBytes) {
-    return buffer.size() / texelBytes;
-}
-
 }  // namespace
 
 const char* directVisibilityName(DirectVisibility visibility) {
@@ -96,17 +91,16 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
                                                            MemoryUse::Device, "direct flux"));
     // Records as RGBA32UI texels (their floats bit casts), flux as RGBA32F.
     PIC_TRY_ASSIGN(pass->mSurfelView,
-                   context.createTexelView(pass->mSurfels, VK_FORMAT_R32G32B32A32_UINT, 0,
-                                           texelCount(pass->mSurfels, 16), "surfels"));
-    PIC_TRY_ASSIGN(pass->mStencilView,
-                   context.createTexelView(pass->mStencils, VK_FORMAT_R32G32B32A32_UINT, 0,
-                                           texelCount(pass->mStencils, 16), "surfel stencils"));
-    PIC_TRY_ASSIGN(pass->mEmissiveView,
-                   context.createTexelView(pass->mEmissiveScale, VK_FORMAT_R32_SFLOAT, 0,
-                                           texelCount(pass->mEmissiveScale, 4), "emissive scales"));
-    PIC_TRY_ASSIGN(pass->mDirectFluxView,
-                   context.createTexelView(pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT, 0,
-                                           texelCount(pass->mDirectFlux, 16), "direct flux"));
+                   context.createTexelView(pass->mSurfels, VK_FORMAT_R32G32B32A32_UINT, "surfels"));
+    PIC_TRY_ASSIGN(
+        pass->mStencilView,
+        context.createTexelView(pass->mStencils, VK_FORMAT_R32G32B32A32_UINT, "surfel stencils"));
+    PIC_TRY_ASSIGN(
+        pass->mEmissiveView,
+        context.createTexelView(pass->mEmissiveScale, VK_FORMAT_R32_SFLOAT, "emissive scales"));
+    PIC_TRY_ASSIGN(
+        pass->mDirectFluxView,
+        context.createTexelView(pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT, "direct flux"));
     PIC_TRY_ASSIGN(pass->mGroupFlux,
                    context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
                                         MemoryUse::Readback, "surfel flux sums"));
@@ -131,16 +125,14 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     PIC_TRY(mBounce.resetSets());
     const Buffer& lights = rays ? r.rays->lightBuffer() : r.shadows->lightBuffer();
     const Buffer& visibility = rays ? r.rays->visibilityBuffer() : mUnusedVisibility;
-    PIC_TRY_ASSIGN(mLightView, mContext.createTexelView(lights, VK_FORMAT_R32G32B32A32_UINT, 0,
-                                                        texelCount(lights, 16), "lights"));
+    PIC_TRY_ASSIGN(mLightView,
+                   mContext.createTexelView(lights, VK_FORMAT_R32G32B32A32_UINT, "lights"));
     PIC_TRY_ASSIGN(mVisibilityView,
-                   mContext.createTexelView(visibility, VK_FORMAT_R32_UINT, 0,
-                                            texelCount(visibility, 4), "visibility"));
+                   mContext.createTexelView(visibility, VK_FORMAT_R32_UINT, "visibility"));
     const std::array<const Buffer*, 3> caches = {r.cacheY, r.cacheCo, r.cacheCg};
     for (size_t c = 0; c < caches.size(); ++c) {
         PIC_TRY_ASSIGN(mCacheViews[c],
-                       mContext.createTexelView(*caches[c], VK_FORMAT_R16_SFLOAT, 0,
-                                                texelCount(*caches[c], 2), "caches"));
+                       mContext.createTexelView(*caches[c], VK_FORMAT_R16_SFLOAT, "caches"));
     }
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::texels(0, mSurfelView),
