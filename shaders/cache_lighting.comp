@@ -54,15 +54,15 @@ void addLink(uint slot) {
         [[unroll]] for (uint c = 0u; c < kTexelWords; ++c) words[t * kTexelWords + c] = texel[c];
     }
     if (kLinkForm == kLinkFormRtp) {
-        // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction). The words are
-        // GpuRtpLink's node, directionOct, visibleAndCone.
-        const float visible = float(words[2] & 0xFFFFu) * (1.0 / 65535.0);
+        // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
+        const GpuRtpLink link = GpuRtpLink(words[0], words[1], words[2]);
+        const float visible = float(link.visibleAndCone & 0xFFFFu) * (1.0 / 65535.0);
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(words[0])).x));
+        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(link.node)).x));
         float cone[kBandsY];
-        coneZonal(unpackHalf2x16(words[2] >> 16u).x, cone);
+        coneZonal(unpackHalf2x16(link.visibleAndCone >> 16u).x, cone);
         float basis[64];
-        shEvaluate(decodeOctahedral(words[1]), basis);
+        shEvaluate(decodeOctahedral(link.directionOct), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float w = visible * cone[kShBandOf[i]] * basis[i];
             y[i] += radiance.x * w;

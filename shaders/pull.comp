@@ -18,25 +18,25 @@ layout(std430, binding = 4) readonly buffer LevelOffsets { uint levelOffsets[]; 
 layout(push_constant) uniform Push { PullPush pc; };
 
 /// Writes inner node `node`'s flux, the sum of its children's, and its radiance.
-void writeNode(uint node, uvec4 inner, vec3 flux) {
+void writeNode(uint node, PullNode inner, vec3 flux) {
     nodeFlux[node] = vec4(flux, 0.0);
-    nodeRadiance[node] = packRgbe8(flux * uintBitsToFloat(inner.z));
+    nodeRadiance[node] = packRgbe8(flux * inner.radianceScale);
 }
 
 void main() {
     if (kMode == kPullModeLevel) {
         const uint node = pc.first + gl_GlobalInvocationID.x;
         if (node >= pc.end) return;
-        const uvec4 inner = texelFetch(pullNodes, int(node - pc.surfelCount));  // PullNode
-        writeNode(node, inner,
-                  texelFetch(childFlux, int(inner.x)).xyz + texelFetch(childFlux, int(inner.y)).xyz);
+        const PullNode inner = fetchPullNode(pullNodes, node - pc.surfelCount);
+        writeNode(node, inner, texelFetch(childFlux, int(inner.left)).xyz +
+                                   texelFetch(childFlux, int(inner.right)).xyz);
     } else {
         // One workgroup: its invocations share each level's nodes, then wait for each other.
         for (uint level = pc.first; level < pc.end; ++level) {
             for (uint node = levelOffsets[level - 1u] + gl_LocalInvocationID.x;
                  node < levelOffsets[level]; node += gl_WorkGroupSize.x) {
-                const uvec4 inner = texelFetch(pullNodes, int(node - pc.surfelCount));
-                writeNode(node, inner, nodeFlux[inner.x].xyz + nodeFlux[inner.y].xyz);
+                const PullNode inner = fetchPullNode(pullNodes, node - pc.surfelCount);
+                writeNode(node, inner, nodeFlux[inner.left].xyz + nodeFlux[inner.right].xyz);
             }
             memoryBarrierBuffer();
             barrier();

@@ -53,45 +53,16 @@ layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 shared vec3 partial[kSurfelLightingGroup];  // per subgroup
 
-Surfel fetchSurfel(uint i) {
-    const int t = int(i) * 4;
-    const uvec4 a = texelFetch(surfelTexels, t);
-    const uvec4 b = texelFetch(surfelTexels, t + 1);
-    const uvec4 c = texelFetch(surfelTexels, t + 2);
-    const uvec4 d = texelFetch(surfelTexels, t + 3);
-    return Surfel(uintBitsToFloat(a.xyz), uintBitsToFloat(a.w), uintBitsToFloat(b.xyz), b.w,
-                  uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz), d.w);
-}
-
-GpuLight fetchLight(uint k) {
-    const int t = int(k) * 5;
-    const uvec4 a = texelFetch(lightTexels, t);
-    const uvec4 b = texelFetch(lightTexels, t + 1);
-    const uvec4 c = texelFetch(lightTexels, t + 2);
-    const uvec4 d = texelFetch(lightTexels, t + 3);
-    const uvec4 e = texelFetch(lightTexels, t + 4);
-    return GpuLight(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
-                    uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z,
-                    uintBitsToFloat(d.w), uintBitsToFloat(e.x), e.y, e.z, e.w);
-}
-
-SurfelStencil fetchStencil(uint i) {
-    const int t = int(i) * 4;
-    return SurfelStencil(texelFetch(stencilTexels, t), texelFetch(stencilTexels, t + 1),
-                         uintBitsToFloat(texelFetch(stencilTexels, t + 2)),
-                         uintBitsToFloat(texelFetch(stencilTexels, t + 3)));
-}
-
 void main() {
     const uint i = gl_GlobalInvocationID.x;
     vec3 flux = vec3(0.0);
     if (i < pc.surfelCount) {
-        const Surfel surfel = fetchSurfel(i);
+        const Surfel surfel = fetchSurfel(surfelTexels, i);
         if (kMode != kSurfelModeBounce) {
             const uint words = (pc.surfelCount + 31u) / 32u;
             vec3 irradiance = vec3(0.0);
             for (uint k = 0u; k < pc.lightCount; ++k) {
-                const GpuLight light = fetchLight(k);
+                const GpuLight light = fetchLight(lightTexels, k);
                 vec3 toLight;
                 float distance;
                 const vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
@@ -110,7 +81,7 @@ void main() {
         } else {
             // Interpolate the previous bounce's caches in YCoCg, then convolve with the
             // clamped cosine about the normal.
-            const SurfelStencil s = fetchStencil(i);
+            const SurfelStencil s = fetchStencil(stencilTexels, i);
             float y[kCountY];
             float co[kCountC];
             float cg[kCountC];

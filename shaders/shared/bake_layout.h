@@ -23,6 +23,20 @@ struct Surfel {
     uint triangle;   // scene triangle the surfel lies on
 };
 PIC_STRUCT_CHECK(Surfel, 64);
+#ifndef __cplusplus
+// Surfel i of a uniform texel buffer of RGBA32UI texels holding the records, four texels
+// each, the floats by bit cast (exact for every pattern; a float format could flush the
+// uint fields, which read as denormals).
+Surfel fetchSurfel(usamplerBuffer records, uint i) {
+    const int t = int(i) * 4;
+    const uvec4 a = texelFetch(records, t);
+    const uvec4 b = texelFetch(records, t + 1);
+    const uvec4 c = texelFetch(records, t + 2);
+    const uvec4 d = texelFetch(records, t + 3);
+    return Surfel(uintBitsToFloat(a.xyz), uintBitsToFloat(a.w), uintBitsToFloat(b.xyz), b.w,
+                  uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.xyz), d.w);
+}
+#endif
 
 // A node of the surfel hierarchy (paper 000 §4.3). Nodes [0, nS) are the leaves,
 // node i being surfel i; inner nodes follow, ordered by level so that each level

@@ -27,6 +27,13 @@ struct PullNode {
     uint pad0;
 };
 PIC_STRUCT_CHECK(PullNode, 16);
+#ifndef __cplusplus
+// Inner node i of a uniform texel buffer of RGBA32UI texels, one per record.
+PullNode fetchPullNode(usamplerBuffer records, uint i) {
+    const uvec4 t = texelFetch(records, int(i));
+    return PullNode(t.x, t.y, uintBitsToFloat(t.z), t.w);
+}
+#endif
 
 struct PullPush {
     uint first;        // level mode: the level is nodes [first, end); tail mode: levels

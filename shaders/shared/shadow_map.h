@@ -32,6 +32,21 @@ struct GpuLight {
     uint pad1;
 };
 PIC_STRUCT_CHECK(GpuLight, 80);
+#ifndef __cplusplus
+// Light k of a uniform texel buffer of RGBA32UI texels, five per record (as fetchSurfel in
+// bake_layout.h).
+GpuLight fetchLight(usamplerBuffer records, uint k) {
+    const int t = int(k) * 5;
+    const uvec4 a = texelFetch(records, t);
+    const uvec4 b = texelFetch(records, t + 1);
+    const uvec4 c = texelFetch(records, t + 2);
+    const uvec4 d = texelFetch(records, t + 3);
+    const uvec4 e = texelFetch(records, t + 4);
+    return GpuLight(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), uintBitsToFloat(b.w),
+                    uintBitsToFloat(c.xyz), uintBitsToFloat(c.w), uintBitsToFloat(d.x), d.y, d.z,
+                    uintBitsToFloat(d.w), uintBitsToFloat(e.x), e.y, e.z, e.w);
+}
+#endif
 
 // One layer of the depth array as the passes that sample it read it. Layers of one light
 // may differ in side: each is as wide as its own receivers need (footprint sides).

@@ -20,6 +20,16 @@ struct SurfelStencil {
     vec4 weightHigh;
 };
 PIC_STRUCT_CHECK(SurfelStencil, 64);
+#ifndef __cplusplus
+// Stencil i of a uniform texel buffer of RGBA32UI texels, four per record (as fetchSurfel in
+// bake_layout.h).
+SurfelStencil fetchStencil(usamplerBuffer records, uint i) {
+    const int t = int(i) * 4;
+    return SurfelStencil(texelFetch(records, t), texelFetch(records, t + 1),
+                         uintBitsToFloat(texelFetch(records, t + 2)),
+                         uintBitsToFloat(texelFetch(records, t + 3)));
+}
+#endif
 
 struct SurfelLightingPush {
     uint surfelCount;  // nS
