@@ -99,6 +99,11 @@ int picbenchMain(int argc, char** argv) {
                      "direct visibility of the GPU backend, one runtime each: auto (rays on a "
                      "CPU device, shadow maps on a GPU), shadow-maps, rays (default: auto)")
         ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
+    runtime
+        ->add_option("--lightmap-copy", runtimeParams.lightmapCopy,
+                     "where the GPU backend copies the caches into the textures: auto (the host "
+                     "on a CPU device, the device on a GPU), host, device (default: auto)")
+        ->check(CLI::IsMember({"auto", "host", "device"}));
     runtime->add_option("--changes", runtimeParams.changes,
                         "light changes: move-all, move-one, recolour (default: all three)")
         ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));

@@ -1,6 +1,7 @@
 #include "bench/runtime_benchmark.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <span>
 
 #include <nlohmann/json.hpp>
 
@@ -73,30 +75,39 @@ struct BackendFigures {
     int lightsTraced = 0;          ///< GPU, rays: lights whose rays each update traced
 };
 
-/// Times `repeat` updates of `runtime`, each what the server's relight does for a light
-/// change: setLights, then textures() (the light-map copy: the GPU runtime records it in
-/// setLights and reads the layers back here, the CPU twin copies its caches here).
-Result<BackendFigures> timeBackend(Runtime& runtime, const LightSet& base, int repeat, float step,
-                                   const std::string& change) {
-    BackendFigures figures;
+/// Times `repeat` updates of each runtime in `runtimes`, each what the server's relight does
+/// for a light change: setLights, then textures() (the light-map copy: the CPU twin, and the
+/// GPU runtime copying on the host, copy the caches here; on the device, the GPU runtime
+/// records the copy in setLights and reads the layers back here). The runtimes take turns,
+/// update by update, so that a busy spell of a shared machine slows both and their ratio
+/// holds.
+Result<std::vector<BackendFigures>> timeBackends(std::span<Runtime* const> runtimes,
+                                                 const LightSet& base, int repeat, float step,
+                                                 const std::string& change) {
+    std::vector<BackendFigures> figures(runtimes.size());
     UpdateStats stats;
-    PIC_TRY(runtime.setLights(changedLights(base, 0, step, change), &stats));  // warm-up
-    PIC_TRY(runtime.textures());
+    for (Runtime* runtime : runtimes) {  // warm-up
+        PIC_TRY(runtime->setLights(changedLights(base, 0, step, change), &stats));
+        PIC_TRY(runtime->textures());
+    }
     const auto msSince = [](Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
     };
     for (int k = 1; k <= repeat; ++k) {
-        const Clock::time_point start = Clock::now();
-        PIC_TRY(runtime.setLights(changedLights(base, k, step, change), &stats));
-        const Clock::time_point texturesStart = Clock::now();
-        PIC_TRY(runtime.textures());
-        stats.passMs["textures"] = msSince(texturesStart);
-        figures.totalMs.push_back(msSince(start));
-        for (const auto& [pass, ms] : stats.passMs) figures.passMs[pass].push_back(ms);
-        figures.bounces = stats.bounces;
-        figures.shadowTriangles = stats.shadowTriangles;
-        figures.shadowTexels = stats.shadowTexels;
-        figures.lightsTraced = stats.lightsTraced;
+        for (size_t r = 0; r < runtimes.size(); ++r) {
+            const Clock::time_point start = Clock::now();
+            PIC_TRY(runtimes[r]->setLights(changedLights(base, k, step, change), &stats));
+            const Clock::time_point texturesStart = Clock::now();
+            PIC_TRY(runtimes[r]->textures());
+            stats.passMs["textures"] = msSince(texturesStart);
+            BackendFigures& f = figures[r];
+            f.totalMs.push_back(msSince(start));
+            for (const auto& [pass, ms] : stats.passMs) f.passMs[pass].push_back(ms);
+            f.bounces = stats.bounces;
+            f.shadowTriangles = stats.shadowTriangles;
+            f.shadowTexels = stats.shadowTexels;
+            f.lightsTraced = stats.lightsTraced;
+        }
     }
     return figures;
 }
@@ -241,6 +252,8 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                     auto parsed = gpu::parseDirectVisibility(visibility);
                     if (!parsed) return reportError(parsed.error());
                     options.directVisibility = *parsed;
+                    if (params.lightmapCopy != "auto")
+                        options.lightmapCopyOnHost = params.lightmapCopy == "host";
                     auto gpu =
                         GpuRuntime::create(scene, *inputs->rays, *bake, bounceParams, options);
                     if (!gpu) return reportError(gpu.error());
@@ -255,36 +268,36 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                     const double pullWallMs = median(*pullWall);
                     const double linkBytes = double((*gpu)->linkBytesPerBounce());
                     for (const std::string& change : params.changes) {
-                        auto cpuFigures =
-                            timeBackend(**cpu, inputs->lights, params.repeat, step, change);
-                        if (!cpuFigures) return reportError(cpuFigures.error());
-                        auto gpuFigures =
-                            timeBackend(**gpu, inputs->lights, params.repeat, step, change);
-                        if (!gpuFigures) return reportError(gpuFigures.error());
+                        const std::array<Runtime*, 2> runtimes{cpu->get(), gpu->get()};
+                        auto figures =
+                            timeBackends(runtimes, inputs->lights, params.repeat, step, change);
+                        if (!figures) return reportError(figures.error());
+                        const BackendFigures& cpuFigures = (*figures)[0];
+                        const BackendFigures& gpuFigures = (*figures)[1];
                         const auto passMedian = [&](const BackendFigures& f, const char* pass) {
                             auto it = f.passMs.find(pass);
                             return it == f.passMs.end() ? 0.0 : median(it->second);
                         };
-                        const double cpuMs = median(cpuFigures->totalMs),
-                                     gpuMs = median(gpuFigures->totalMs);
+                        const double cpuMs = median(cpuFigures.totalMs),
+                                     gpuMs = median(gpuFigures.totalMs);
                         // Link bytes per second of one cache-lighting pass: every link is read
                         // once per bounce. Timestamps where they are honest, else wall clock.
                         const double cacheMs = floor->deviceCopy
-                                                   ? passMedian(*gpuFigures, "cache_lighting") /
-                                                         std::max(gpuFigures->bounces, 1)
+                                                   ? passMedian(gpuFigures, "cache_lighting") /
+                                                         std::max(gpuFigures.bounces, 1)
                                                    : cacheWallMs;
                         const double linkRate = cacheMs > 0.0 ? linkBytes / (cacheMs * 1e-3) : 0.0;
                         std::printf(
                             "%-9s %-4s %-7d %-8s %-5s %6zu %9.1f %9.1f %6.2f %9.1f %8.0f %8.2f "
                             "%9.1f %9.1f %9.1f %8.2f\n",
-                            setting.c_str(), linkMode.c_str(), gpuFigures->bounces, change.c_str(),
+                            setting.c_str(), linkMode.c_str(), gpuFigures.bounces, change.c_str(),
                             rays ? "rays" : "maps", bake->caches.size(), cpuMs, gpuMs,
                             gpuMs / cpuMs,
-                            passMedian(*gpuFigures, rays ? "visibility_rays" : "shadow_maps"),
-                            double(gpuFigures->shadowTriangles) * 1e-3,
-                            double(gpuFigures->shadowTexels) * 1e-6,
-                            passMedian(*gpuFigures, "surfel_lighting"),
-                            floor->deviceCopy ? passMedian(*gpuFigures, "pull") : pullWallMs,
+                            passMedian(gpuFigures, rays ? "visibility_rays" : "shadow_maps"),
+                            double(gpuFigures.shadowTriangles) * 1e-3,
+                            double(gpuFigures.shadowTexels) * 1e-6,
+                            passMedian(gpuFigures, "surfel_lighting"),
+                            floor->deviceCopy ? passMedian(gpuFigures, "pull") : pullWallMs,
                             cacheMs, linkRate / bandwidth);
 
                         nlohmann::ordered_json run;
@@ -304,8 +317,8 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                             run["shadow_sides"] =
                                 params.shadowEqualFootprint ? "footprint" : "uniform";
                         }
-                        run["cpu"] = figuresJson(*cpuFigures);
-                        run["gpu"] = figuresJson(*gpuFigures);
+                        run["cpu"] = figuresJson(cpuFigures);
+                        run["gpu"] = figuresJson(gpuFigures);
                         run["gpu_over_cpu"] = gpuMs / cpuMs;
                         run["cache_lighting_wall_ms_median"] = cacheWallMs;
                         run["pull_wall_ms_median"] = pullWallMs;
@@ -314,6 +327,7 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
                             floor->deviceCopy ? "timestamps" : "wall clock";
                         run["link_bytes_per_bounce"] = linkBytes;
                         run["link_texel_words"] = (*gpu)->linkTexelWords();
+                        run["lightmap_copy"] = (*gpu)->lightmapCopyOnHost() ? "host" : "device";
                         run["cache_lighting_bytes_per_second"] = linkRate;
                         run["bandwidth_ratio"] = linkRate / bandwidth;
                         run["gpu_memory_bytes"] = nlohmann::ordered_json::object();

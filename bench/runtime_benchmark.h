@@ -34,6 +34,8 @@ struct RuntimeBenchmarkParams {
     bool shadowEqualFootprint = true;              ///< GpuRuntimeOptions::shadowEqualFootprint
     /// GpuRuntimeOptions::directVisibility, one GPU runtime each: auto, shadow-maps, rays.
     std::vector<std::string> visibilities{"auto"};
+    /// GpuRuntimeOptions::lightmapCopyOnHost: auto, host or device.
+    std::string lightmapCopy = "auto";
     std::string jsonPath = "runtime_benchmark.json";
 };
 

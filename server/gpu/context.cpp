@@ -51,6 +51,17 @@ bool wantValidation(bool requested) {
     return requested;
 }
 
+/// Makes transfer and compute-shader writes recorded before it visible to host reads once
+/// the submission's fence has signalled: a fence alone does not make device writes visible
+/// to the host.
+void hostReadBarrier(VkCommandBuffer cmd) {
+    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+}
+
 }  // namespace
 
 const char* vkResultName(VkResult result) {
@@ -637,18 +648,9 @@ Result<void> Context::download(const Buffer& buffer, void* data, VkDeviceSize by
     PIC_TRY(submit([&](VkCommandBuffer cmd) {
         const VkBufferCopy region{offset, 0, bytes};
         vkCmdCopyBuffer(cmd, buffer.handle(), staging->handle(), 1, &region);
-        hostReadBarrier(cmd);
     }));
     std::memcpy(data, staging->mapped(), bytes);
     return {};
-}
-
-void Context::hostReadBarrier(VkCommandBuffer cmd) {
-    VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                         &barrier, 0, nullptr, 0, nullptr);
 }
 
 Result<std::vector<float>> Context::downloadDepthLayer(const DepthArray& depth, uint32_t layer) {
@@ -672,7 +674,6 @@ Result<std::vector<float>> Context::downloadDepthLayer(const DepthArray& depth, 
         region.imageExtent = {depth.size(), depth.size(), 1};
         vkCmdCopyImageToBuffer(cmd, depth.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                staging.handle(), 1, &region);
-        hostReadBarrier(cmd);
         // The copy finishes before the layer is sampled or rendered again.
         VkImageMemoryBarrier back = toCopy;
         back.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
@@ -943,6 +944,9 @@ Result<void> Context::submit(const std::function<void(VkCommandBuffer)>& record,
         mPendingBytes = 0;
     }
     record(mCommandBuffer);
+    // Whatever the submission wrote, the host may read once the fence has signalled (mapped
+    // buffers are read in place).
+    hostReadBarrier(mCommandBuffer);
     if (timer) timer->end(mCommandBuffer);
     PIC_VK_TRY(vkEndCommandBuffer(mCommandBuffer));
     VkSubmitInfo submitInfo{VK_STRUCTURE_TYPE_SUBMIT_INFO};

@@ -273,17 +273,14 @@ public:
     /// A timer for up to `passes` pass instances per command buffer.
     Result<PassTimer> createPassTimer(uint32_t passes);
 
-    /// Records `record` into a fresh command buffer, submits it and waits for it. A lost
-    /// device makes this and every later call fail.
+    /// Records `record` into a fresh command buffer, submits it and waits for it; the host may
+    /// then read whatever it wrote (the buffer ends with a transfer and compute to host-read
+    /// barrier). A lost device makes this and every later call fail.
     Result<void> submit(const std::function<void(VkCommandBuffer)>& record,
                         PassTimer* timer = nullptr);
 
     /// The nearest-filtering, clamp-to-edge sampler the passes read depth images with.
     VkSampler nearestSampler() const { return mNearestSampler; }
-
-    /// Records a barrier that makes transfer writes recorded before it visible to host reads
-    /// once the submission's fence has signalled.
-    static void hostReadBarrier(VkCommandBuffer cmd);
 
 private:
     Context() = default;

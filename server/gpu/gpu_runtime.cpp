@@ -91,15 +91,23 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup,
                                                              options.maxLinkTexelWords));
-    PIC_TRY_ASSIGN(mLightmapCopy, LightmapCopyPass::create(ctx, mBake));
     PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeRadiance));
     PIC_TRY(mCacheLighting->bind(ctx, mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
-    PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
+    mLightmapCopyOnHost = options.lightmapCopyOnHost.value_or(ctx.isCpuDevice());
+    if (!mLightmapCopyOnHost) PIC_TRY(lightmapCopyPass());
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
     mTextures = makeCacheTextures(mBake);
     return {};
+}
+
+Result<gpu::LightmapCopyPass*> GpuRuntime::lightmapCopyPass() {
+    if (!mLightmapCopy) {
+        PIC_TRY_ASSIGN(mLightmapCopy, gpu::LightmapCopyPass::create(*mContext, mBake));
+        PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
+    }
+    return mLightmapCopy.get();
 }
 
 Result<void> GpuRuntime::bindVisibility() {
@@ -160,13 +168,16 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         // No cache pass: the caches, and so the textures, hold no light.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         PIC_TRY(uploadCaches(mValues));
-        PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
+        if (!mLightmapCopyOnHost)
+            PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
         stats.totalMs = millisecondsSince(start);
         return &mValues;
     }
 
     // Each submission ends with a bounce's caches and, when another bounce may follow, the
-    // surfel flux that bounce would pull; the host reads the flux sums to decide.
+    // surfel flux that bounce would pull; the host reads the flux sums to decide. Copying the
+    // textures on the host, each one also reads its caches back, since only the host's look
+    // at the sums tells which bounce is the last.
     const auto cacheBounce = [&](VkCommandBuffer cmd, bool another, uint32_t sumSlot) {
         mTimer.begin(cmd, "pull");
         mPull->record(cmd);
@@ -180,6 +191,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         }
         // Everything written before the next submission's first pass reads it.
         gpu::computeBarrier(cmd);
+        if (mLightmapCopyOnHost) recordCacheReadback(cmd);
     };
 
     PIC_TRY(submitTimed(
@@ -214,11 +226,15 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         stats.surfelFlux = total;
     }
 
-    PIC_TRY(submitTimed([&](VkCommandBuffer cmd) {
-        mTimer.begin(cmd, "lightmap_copy");
-        mLightmapCopy->record(cmd);
-        recordCacheReadback(cmd);
-    }, stats));
+    if (!mLightmapCopyOnHost) {
+        PIC_TRY(submitTimed(
+            [&](VkCommandBuffer cmd) {
+                mTimer.begin(cmd, "lightmap_copy");
+                mLightmapCopy->record(cmd);
+                recordCacheReadback(cmd);
+            },
+            stats));
+    }
     readCaches(mValues);
     stats.totalMs = millisecondsSince(start);
     return &mValues;
@@ -226,7 +242,10 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
 
 Result<const CacheTextures*> GpuRuntime::textures() {
     if (!mTexturesCurrent) {
-        PIC_TRY(mLightmapCopy->read(*mContext, mTextures));
+        if (mLightmapCopyOnHost)
+            copyCachesToTextures(mBake, mValues, mTextures);
+        else
+            PIC_TRY(mLightmapCopy->read(*mContext, mTextures));
         mTexturesCurrent = true;
     }
     return &mTextures;
@@ -273,7 +292,6 @@ void GpuRuntime::recordCacheReadback(VkCommandBuffer cmd) {
         vkCmdCopyBuffer(cmd, buffer->handle(), mCacheReadback.handle(), 1, &region);
         offset += buffer->size();
     }
-    gpu::Context::hostReadBarrier(cmd);
 }
 
 void GpuRuntime::readCaches(CacheValues& values) const {
@@ -353,10 +371,11 @@ Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const uint32_t> nodeR
 }
 
 Result<CacheTextures> GpuRuntime::runLightmapCopy(const CacheValues& values) {
+    PIC_TRY_ASSIGN(gpu::LightmapCopyPass * pass, lightmapCopyPass());
     PIC_TRY(uploadCaches(values));
-    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd); }));
     CacheTextures textures = makeCacheTextures(mBake);
-    PIC_TRY(mLightmapCopy->read(*mContext, textures));
+    PIC_TRY(pass->read(*mContext, textures));
     mTexturesCurrent = false;
     return textures;
 }
@@ -369,7 +388,7 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
         {"node_flux", mNodeFlux.size()},
         {"node_radiance", mNodeRadiance.size()},
         {"caches", mCacheY.size() + mCacheCo.size() + mCacheCg.size()},
-        {"textures", mLightmapCopy->bytes()},
+        {"textures", mLightmapCopy ? mLightmapCopy->bytes() : 0},
         mShadows ? std::pair<std::string, uint64_t>{"shadow_maps", mShadows->bytes()}
                  : std::pair<std::string, uint64_t>{"visibility", mRayVisibility->bytes()},
     };

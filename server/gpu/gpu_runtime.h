@@ -47,6 +47,12 @@ struct GpuRuntimeOptions {
     /// takes the widest the device supports that divides a link. 1 reads a word at a time,
     /// as on a device with no two- or three-word uint texel buffers (tests).
     uint32_t maxLinkTexelWords = 4;
+    /// Where textures() gets the light-map copy (paper 000 Figure 2 step 5): true, on the
+    /// host from the caches setLights reads back anyway (server/cpu/lightmap_copy.h); false,
+    /// the LightmapCopyPass on the device, then the layers read back. Unset: the host on a
+    /// CPU device, whose memory is the host's, so the pass would only add a dispatch and a
+    /// submission; the device on a GPU.
+    std::optional<bool> lightmapCopyOnHost;
 };
 
 namespace gpu {
@@ -104,6 +110,9 @@ public:
     uint64_t linkBytesPerBounce() const;
     /// 32-bit words per texel cache lighting reads its links in.
     uint32_t linkTexelWords() const;
+    /// Whether textures() copies the caches on the host (GpuRuntimeOptions::lightmapCopyOnHost
+    /// resolved).
+    bool lightmapCopyOnHost() const { return mLightmapCopyOnHost; }
     const gpu::Context& context() const { return *mContext; }
 
 private:
@@ -122,6 +131,9 @@ private:
     Result<void> uploadCaches(const CacheValues& values);
     /// Records the copy of the caches into mCacheReadback when the host cannot map them.
     void recordCacheReadback(VkCommandBuffer cmd);
+    /// The light-map copy pass; when the host does the runtime's copy, made on first use
+    /// (runLightmapCopy).
+    Result<gpu::LightmapCopyPass*> lightmapCopyPass();
     /// The caches as the latest submission that recorded recordCacheReadback left them.
     void readCaches(CacheValues& values) const;
 
@@ -135,7 +147,8 @@ private:
     std::unique_ptr<gpu::SurfelLightingPass> mSurfels;
     std::unique_ptr<gpu::PullPass> mPull;
     std::unique_ptr<gpu::CacheLightingPass> mCacheLighting;
-    std::unique_ptr<gpu::LightmapCopyPass> mLightmapCopy;
+    std::unique_ptr<gpu::LightmapCopyPass> mLightmapCopy;  ///< see lightmapCopyPass()
+    bool mLightmapCopyOnHost = false;
     gpu::PassTimer mTimer;
     gpu::Buffer mNodeFlux;   ///< vec4 per node, W RGB
     gpu::Buffer mNodeRadiance;  ///< RGBE8 per node, Φ / (π·A) in W/(m²·sr), cache lighting's input

@@ -658,6 +658,57 @@ INSTANTIATE_TEST_SUITE_P(Visibility, GpuRuntimeMemory,
                                          gpu::DirectVisibility::Rays),
                          [](const auto& info) { return visibilityName(info.param); });
 
+// The light-map copy on the host (the default on a CPU device) and on the device give the
+// same textures bit for bit: both copy the same half-float caches, over every bounce of a
+// progressive update, with the device's memory mapped or not.
+class GpuRuntimeLightmapCopy : public testing::TestWithParam<bool> {};
+
+TEST_P(GpuRuntimeLightmapCopy, HostAndDeviceCopiesGiveTheSameTextures) {
+    const Baked& b = baked("cornell", LinkMode::Sh);
+    ASSERT_TRUE(b.ok);
+    const bool mapped = GetParam();
+    auto host = gpuFor(b, {}, {.mapDeviceMemory = mapped, .lightmapCopyOnHost = true});
+    auto device = gpuFor(b, {}, {.mapDeviceMemory = mapped, .lightmapCopyOnHost = false});
+    ASSERT_TRUE(host && device);
+    EXPECT_TRUE(host->lightmapCopyOnHost());
+    EXPECT_FALSE(device->lightmapCopyOnHost());
+    LightSet lights = defaultLightSet(b.scene);
+    for (int update = 0; update < 2; ++update) {
+        UpdateStats hostStats, deviceStats;
+        auto expected = device->setLights(lights, &deviceStats);
+        auto actual = host->setLights(lights, &hostStats);
+        ASSERT_TRUE(expected && actual);
+        EXPECT_GT(hostStats.bounces, 1);
+        EXPECT_EQ(hostStats.bounces, deviceStats.bounces);
+        EXPECT_EQ((*actual)->y, (*expected)->y);
+        EXPECT_FALSE(hostStats.passMs.contains("lightmap_copy"));
+        auto expectedTextures = device->textures();
+        auto actualTextures = host->textures();
+        ASSERT_TRUE(expectedTextures && actualTextures);
+        for (int ch = 0; ch < 3; ++ch) {
+            EXPECT_EQ((*actualTextures)->grid[ch], (*expectedTextures)->grid[ch]);
+            EXPECT_EQ((*actualTextures)->lightmap[ch], (*expectedTextures)->lightmap[ch]);
+        }
+        EXPECT_GT(*std::max_element((*actualTextures)->lightmap[0].begin(),
+                                    (*actualTextures)->lightmap[0].end()),
+                  0.0f);
+        lights.lights[0].position.y -= 0.1f;
+    }
+    EXPECT_EQ(host->context().validationMessages(), 0u);
+    EXPECT_EQ(device->context().validationMessages(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Memory, GpuRuntimeLightmapCopy, testing::Bool(),
+                         [](const auto& info) { return info.param ? "Mapped" : "Unmapped"; });
+
+TEST(GpuRuntime, LightmapCopyIsOnTheHostOnACpuDeviceByDefault) {
+    const Baked& b = baked("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = gpuFor(b);
+    ASSERT_TRUE(gpu);
+    EXPECT_EQ(gpu->lightmapCopyOnHost(), gpu->context().isCpuDevice());
+}
+
 TEST(GpuCopyProbe, CopiesEveryWordAndReportsARate) {
     auto context = gpu::Context::create({.mapDeviceMemory = false});
     ASSERT_TRUE(context) << context.error().message;
