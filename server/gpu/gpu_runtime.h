@@ -43,9 +43,9 @@ struct GpuRuntimeOptions {
     /// Cache lighting gives each cache a subgroup (true) or an invocation (false); unset: a
     /// subgroup on a GPU, an invocation on a CPU device (gpu::CacheLightingPass::create).
     std::optional<bool> cachePerSubgroup;
-    /// Widest texel (in 32-bit words, 1 to 4) cache lighting reads its links in; the pass
-    /// takes the widest the device supports that divides a link. 1 reads a word at a time,
-    /// as on a device with no two- or three-word uint texel buffers (tests).
+    /// Widest texel (in 32-bit words, 1 to 4) cache lighting reads its links in; of those the
+    /// device supports that divide a link the pass takes 4 or 2 words before 3. 1 reads a
+    /// word at a time, as on a device with no wider uint texel buffers (tests).
     uint32_t maxLinkTexelWords = 4;
     /// Where textures() gets the light-map copy (paper 000 Figure 2 step 5): true, on the
     /// host from the caches setLights reads back anyway (server/cpu/lightmap_copy.h); false,

@@ -28,8 +28,8 @@ public:
     /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
-    /// in the widest uint texels, up to `maxTexelWords` words, that the device supports and
-    /// that divide a link.
+    /// in uint texels of up to `maxTexelWords` words that the device supports and that divide
+    /// a link: 4 or 2 words before 3, else one.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
                                                              bool cachePerSubgroup,
                                                              uint32_t maxTexelWords = 4);

@@ -7,9 +7,10 @@
 // fit one texel view (maxTexelBufferElements).
 //
 // The node radiance and the links are read as uniform texel buffers of 32-bit uint texels, a
-// link in as few texels as divide it: on lavapipe a storage-buffer load whose index differs
-// // per lane is a branch and a scalar load per lane, a texel fetch is a gather. Moderate atrium,
-// one cache-lighting pass, medians of 5 alternated runs: RTP 5.4 → 3.9 ms, SH 8.9 → 3.7 ms.
+// link in texels of 4, 2 or 3 words that divide it (CacheLightingPass): on lavapipe a
+// storage-buffer load whose index differs per lane is a branch and a scalar load per lane, a
+// texel fetch a gather. Moderate atrium, one cache-lighting pass, medians of 5 alternated
+// runs: RTP 5.4 → 3.9 ms, SH 8.9 → 3.7 ms.
 #include "glue.h"
 
 PIC_NAMESPACE_BEGIN
@@ -39,7 +40,7 @@ PIC_STRUCT_CHECK(GpuRtpLink, 12);
 // An SH-projected link as the GPU reads it: the node index, then its lY² binary16
 // coefficients (rescaled by π·A to take the node's radiance) two per 32-bit word, the last
 // word's high half zero when lY² is odd. Whole words keep each lane's loads few: 1 + ⌈lY²/2⌉
-// (3, 6, 9 words for lY = 2, 3, 4: three-word texels).
+// (3, 6, 9 words for lY = 2, 3, 4).
 #ifdef __cplusplus
 inline constexpr uint shLinkWords(uint countY) {
     return 1u + (countY + 1u) / 2u;
