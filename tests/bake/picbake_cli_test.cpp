@@ -2,53 +2,23 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
+
+#include "tests/support/command.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct RunResult {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string readFile(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+namespace test = pic::test;
 
 class PicbakeCli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        mDir = fs::temp_directory_path() /
-               ("picbake_cli_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(mDir);
-    }
-    void TearDown() override { fs::remove_all(mDir); }
-
-    RunResult run(const std::string& args) {
-        fs::path out = mDir / "stdout.txt", err = mDir / "stderr.txt";
-        std::string command = std::string(PIC_PICBAKE) + " --quiet " + args + " >" + out.string() +
-                              " 2>" + err.string() + " </dev/null";
-        int status = std::system(command.c_str());
-        RunResult r;
-        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = readFile(out);
-        r.err = readFile(err);
-        return r;
+    test::CommandResult run(const std::string& args) {
+        return test::runCommand(std::string(PIC_PICBAKE) + " --quiet " + args, mDir.path());
     }
 
     std::string scene(const std::string& name) const {
@@ -60,16 +30,16 @@ protected:
                " --surfels 4096 --links 32 --grid-cell 0.25 --lightmap-texel 0.1";
     }
 
-    fs::path mDir;
+    test::ScratchDir mDir{"picbake_cli"};
 };
 
 TEST_F(PicbakeCli, BakeThenInfoJsonHasTheContractKeys) {
     std::string bake = (mDir / "cornell.pic").string();
-    RunResult baked = run(smallBake("cornell", bake));
+    test::CommandResult baked = run(smallBake("cornell", bake));
     ASSERT_EQ(baked.exitCode, 0) << baked.err;
     EXPECT_NE(baked.out.find("surfels"), std::string::npos);
     EXPECT_NE(baked.out.find("seconds"), std::string::npos);
-    RunResult info = run("info " + bake + " --json");
+    test::CommandResult info = run("info " + bake + " --json");
     ASSERT_EQ(info.exitCode, 0) << info.err;
     auto json = nlohmann::json::parse(info.out);
     for (const char* key : {"format_version", "scene_hash", "surfels", "nodes", "caches",
@@ -91,15 +61,16 @@ TEST_F(PicbakeCli, SameSceneFlagsAndSeedGiveAByteIdenticalFile) {
     std::string a = (mDir / "a.pic").string(), b = (mDir / "b.pic").string();
     ASSERT_EQ(run(smallBake("cornell", a) + " --seed 5").exitCode, 0);
     ASSERT_EQ(run(smallBake("cornell", b) + " --seed 5 --threads 1").exitCode, 0);
-    EXPECT_EQ(readFile(a), readFile(b));
+    EXPECT_EQ(test::readFile(a), test::readFile(b));
     std::string c = (mDir / "c.pic").string();
     ASSERT_EQ(run(smallBake("cornell", c) + " --seed 6").exitCode, 0);
-    EXPECT_NE(readFile(a), readFile(c));
+    EXPECT_NE(test::readFile(a), test::readFile(c));
 }
 
 TEST_F(PicbakeCli, ShLinkModeBakes) {
     std::string bake = (mDir / "sh.pic").string();
-    RunResult r = run(smallBake("cornell", bake) + " --link-mode sh --bands 4 --chroma-bands 3");
+    test::CommandResult r =
+        run(smallBake("cornell", bake) + " --link-mode sh --bands 4 --chroma-bands 3");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     auto json = nlohmann::json::parse(run("info " + bake + " --json").out);
     EXPECT_EQ(json["link_mode"], "sh");
@@ -110,9 +81,9 @@ TEST_F(PicbakeCli, ShLinkModeBakes) {
 TEST_F(PicbakeCli, TruncatedBakeIsACleanErrorWithExitCode2) {
     std::string bake = (mDir / "t.pic").string();
     ASSERT_EQ(run(smallBake("cornell", bake)).exitCode, 0);
-    std::string bytes = readFile(bake);
+    std::string bytes = test::readFile(bake);
     std::ofstream(bake, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size() / 2);
-    RunResult r = run("info " + bake);
+    test::CommandResult r = run("info " + bake);
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
 }
@@ -120,32 +91,33 @@ TEST_F(PicbakeCli, TruncatedBakeIsACleanErrorWithExitCode2) {
 TEST_F(PicbakeCli, CorruptedBakeIsACleanErrorWithExitCode2) {
     std::string bake = (mDir / "c.pic").string();
     ASSERT_EQ(run(smallBake("cornell", bake)).exitCode, 0);
-    std::string bytes = readFile(bake);
+    std::string bytes = test::readFile(bake);
     bytes[bytes.size() * 3 / 4] ^= 0x5A;
     std::ofstream(bake, std::ios::binary | std::ios::trunc).write(bytes.data(), bytes.size());
-    RunResult r = run("info " + bake);
+    test::CommandResult r = run("info " + bake);
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("checksum"), std::string::npos) << r.err;
 }
 
 TEST_F(PicbakeCli, MissingFilesAreCleanErrorsWithExitCode2) {
-    RunResult info = run("info " + (mDir / "nope.pic").string());
+    test::CommandResult info = run("info " + (mDir / "nope.pic").string());
     EXPECT_EQ(info.exitCode, 2);
     EXPECT_NE(info.err.find("nope.pic"), std::string::npos) << info.err;
-    RunResult bake = run("bake " + (mDir / "nope.gltf").string() + " -o " + (mDir / "x.pic").string());
+    test::CommandResult bake =
+        run("bake " + (mDir / "nope.gltf").string() + " -o " + (mDir / "x.pic").string());
     EXPECT_EQ(bake.exitCode, 2);
     EXPECT_NE(bake.err.find("nope.gltf"), std::string::npos) << bake.err;
 }
 
 TEST_F(PicbakeCli, NonTriangleGltfIsRefusedWithExitCode2) {
-    RunResult r = run("bake " + scene("bad_points") + " -o " + (mDir / "p.pic").string());
+    test::CommandResult r = run("bake " + scene("bad_points") + " -o " + (mDir / "p.pic").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("POINTS"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(mDir / "p.pic"));
 }
 
 TEST_F(PicbakeCli, GltfWithoutGeometryIsRefusedWithExitCode2) {
-    RunResult r = run("bake " + scene("bad_empty") + " -o " + (mDir / "e.pic").string());
+    test::CommandResult r = run("bake " + scene("bad_empty") + " -o " + (mDir / "e.pic").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("no triangle"), std::string::npos) << r.err;
 }
@@ -153,7 +125,7 @@ TEST_F(PicbakeCli, GltfWithoutGeometryIsRefusedWithExitCode2) {
 TEST_F(PicbakeCli, BadUsageExitsWith2) {
     EXPECT_EQ(run("bake").exitCode, 2);
     EXPECT_EQ(run("bake " + scene("cornell") + " -o x.pic --no-such-flag").exitCode, 2);
-    RunResult r = run(smallBake("cornell", (mDir / "x.pic").string()) + " --bands 12");
+    test::CommandResult r = run(smallBake("cornell", (mDir / "x.pic").string()) + " --bands 12");
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("12"), std::string::npos) << r.err;
 }

@@ -2,14 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
-#include <sys/wait.h>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
@@ -17,45 +12,17 @@
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/progress.h"
+#include "tests/support/command.h"
 
 namespace pic {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string readFile(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 class PicrefCli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        mDir = fs::temp_directory_path() /
-               ("picref_cli_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(mDir);
-    }
-    void TearDown() override { fs::remove_all(mDir); }
-
-    RunResult run(const std::string& args) {
-        fs::path out = mDir / "stdout.txt", err = mDir / "stderr.txt";
-        std::string command = std::string(PIC_PICREF) + " " + args + " >" + out.string() + " 2>" +
-                              err.string() + " </dev/null";
-        int status = std::system(command.c_str());
-        RunResult r;
-        r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        r.out = readFile(out);
-        r.err = readFile(err);
-        return r;
+    test::CommandResult run(const std::string& args) {
+        return test::runCommand(std::string(PIC_PICREF) + " " + args, mDir.path());
     }
 
     static std::string scene(const std::string& name) {
@@ -81,13 +48,13 @@ protected:
         return path;
     }
 
-    fs::path mDir;
+    test::ScratchDir mDir{"picref_cli"};
 };
 
 TEST_F(PicrefCli, RendersCornellToExr) {
     std::string out = (mDir / "cornell.exr").string();
-    RunResult r = run(scene("cornell") + " --scene-camera 0 --size 20x14 --spp 2 --out " + out +
-                      " --quiet --threads 2");
+    test::CommandResult r = run(scene("cornell") + " --scene-camera 0 --size 20x14 --spp 2 --out " +
+                                out + " --quiet --threads 2");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("samples/s"), std::string::npos) << r.err;
     auto image = readImage(out);
@@ -105,42 +72,43 @@ TEST_F(PicrefCli, RendersCornellToExr) {
 
 TEST_F(PicrefCli, CommandLineCameraComponentAndPng) {
     std::string out = (mDir / "indirect.png").string();
-    RunResult r = run(scene("cornell") +
-                      " --camera 0,0.5,2,0,0.5,0,0,1,0,40 --size 8x8 --spp 1 "
-                      "--component indirect --bounces 1 --seed 3 --exposure 2 --out " +
-                      out);
+    test::CommandResult r = run(scene("cornell") +
+                                " --camera 0,0.5,2,0,0.5,0,0,1,0,40 --size 8x8 --spp 1 "
+                                "--component indirect --bounces 1 --seed 3 --exposure 2 --out " +
+                                out);
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_TRUE(fs::exists(out));
 }
 
 TEST_F(PicrefCli, BadSizeIsBadUsageNamingTheValue) {
-    RunResult r = run(scene("cornell") + " --scene-camera 0 --size 12by5 --spp 1 --out " +
-                      (mDir / "x.exr").string());
+    test::CommandResult r = run(scene("cornell") + " --scene-camera 0 --size 12by5 --spp 1 --out " +
+                                (mDir / "x.exr").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("12by5"), std::string::npos) << r.err;
 }
 
 TEST_F(PicrefCli, MissingSceneIsBadInputNamingThePath) {
     std::string missing = (mDir / "nowhere.gltf").string();
-    RunResult r =
+    test::CommandResult r =
         run(missing + " --scene-camera 0 --size 4x4 --spp 1 --out " + (mDir / "x.exr").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("nowhere.gltf"), std::string::npos) << r.err;
 }
 
 TEST_F(PicrefCli, BadCameraIsBadUsageNamingTheValue) {
-    RunResult r = run(scene("cornell") + " --camera 1,2,3 --size 4x4 --spp 1 --out " +
-                      (mDir / "x.exr").string());
+    test::CommandResult r = run(scene("cornell") + " --camera 1,2,3 --size 4x4 --spp 1 --out " +
+                                (mDir / "x.exr").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("1,2,3"), std::string::npos) << r.err;
-    RunResult index = run(scene("cornell") + " --scene-camera 7 --size 4x4 --spp 1 --out " +
-                          (mDir / "x.exr").string());
+    test::CommandResult index =
+        run(scene("cornell") + " --scene-camera 7 --size 4x4 --spp 1 --out " +
+            (mDir / "x.exr").string());
     EXPECT_EQ(index.exitCode, 2);
     EXPECT_NE(index.err.find("7"), std::string::npos) << index.err;
 }
 
 TEST_F(PicrefCli, UnknownComponentIsBadUsageNamingTheValue) {
-    RunResult r =
+    test::CommandResult r =
         run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 --component glossy --out " +
             (mDir / "x.exr").string());
     EXPECT_EQ(r.exitCode, 2);
@@ -152,10 +120,10 @@ TEST_F(PicrefCli, ProbesWriteEveryCacheWithTheBakesBands) {
     auto info = inspectBakeFile(bakePath);
     ASSERT_TRUE(info) << info.error().message;
     std::string json = (mDir / "probes.json").string(), binary = (mDir / "probes.bin").string();
-    RunResult r = run("--quiet probes " + bakePath + " --scene " + scene("cornell") +
-                      " --samples 8 --bounces 1 --out " + json + " --binary " + binary);
+    test::CommandResult r = run("--quiet probes " + bakePath + " --scene " + scene("cornell") +
+                                " --samples 8 --bounces 1 --out " + json + " --binary " + binary);
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    auto probes = nlohmann::json::parse(readFile(json));
+    auto probes = nlohmann::json::parse(test::readFile(json));
     const uint32_t bandsY = info->params.bandsY, bandsC = info->params.bandsC;
     EXPECT_EQ(probes["bands"]["y"], bandsY);
     EXPECT_EQ(probes["bands"]["c"], bandsC);
@@ -176,15 +144,15 @@ TEST_F(PicrefCli, ProbesWriteEveryCacheWithTheBakesBands) {
 
 TEST_F(PicrefCli, ProbesRefuseABakeOfAnotherScene) {
     std::string bakePath = bake("cornell");
-    RunResult r = run("probes " + bakePath + " --scene " + scene("cornell_area") +
-                      " --samples 4 --out " + (mDir / "p.json").string());
+    test::CommandResult r = run("probes " + bakePath + " --scene " + scene("cornell_area") +
+                                " --samples 4 --out " + (mDir / "p.json").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("cornell_area"), std::string::npos) << r.err;
 }
 
 TEST_F(PicrefCli, ImageFlagsDoNotApplyToProbes) {
-    RunResult r = run("probes x.pic --scene " + scene("cornell") + " --size 4x4 --out " +
-                      (mDir / "p.json").string());
+    test::CommandResult r = run("probes x.pic --scene " + scene("cornell") + " --size 4x4 --out " +
+                                (mDir / "p.json").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
 }

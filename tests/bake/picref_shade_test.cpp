@@ -1,14 +1,10 @@
 // `picref shade` end to end: the real binary on a bake written in-process, its image and its
 // exit codes for bad input.
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -18,6 +14,7 @@
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/progress.h"
+#include "tests/support/command.h"
 
 namespace pic {
 namespace {
@@ -73,35 +70,20 @@ const ShadeFixture& fixture() {
     return f;
 }
 
-/// Exit code and stderr of `picref shade ARGS`.
-struct RunResult {
-    int exitCode = -1;
-    std::string stderrText;
-};
-
-RunResult runShade(const std::string& args) {
-    const std::string errPath = (fixture().dir / "stderr.txt").string();
-    const std::string command =
-        fmt::format("'{}' shade {} --quiet 2> '{}' > /dev/null", PIC_PICREF, args, errPath);
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream in(errPath);
-    std::stringstream text;
-    text << in.rdbuf();
-    result.stderrText = text.str();
-    return result;
+/// Exit code and output of `picref shade ARGS`.
+test::CommandResult runShade(const std::string& args) {
+    return test::runCommand(fmt::format("'{}' shade {} --quiet", PIC_PICREF, args), fixture().dir);
 }
 
 TEST(PicrefShade, WritesAFiniteImageOfCornell) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
     const std::string out = (f.dir / "cornell.exr").string();
-    const RunResult run =
+    const test::CommandResult run =
         runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 32x32 --out '{}'",
                              scenePath("cornell"), f.cornellBake, out));
-    ASSERT_EQ(run.exitCode, 0) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("bounces"), std::string::npos) << run.stderrText;
+    ASSERT_EQ(run.exitCode, 0) << run.err;
+    EXPECT_NE(run.err.find("bounces"), std::string::npos) << run.err;
     auto image = readImage(out);
     ASSERT_TRUE(image.has_value()) << image.error().message;
     ASSERT_EQ(image->width, 32u);
@@ -119,11 +101,11 @@ TEST(PicrefShade, WritesAFiniteImageOfCornell) {
 TEST(PicrefShade, RefusesABakeOfAnotherScene) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
-    const RunResult run =
+    const test::CommandResult run =
         runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 8x8 --out '{}'",
                              scenePath("cornell"), f.otherBake, (f.dir / "other.exr").string()));
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("different scene"), std::string::npos) << run.stderrText;
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_NE(run.err.find("different scene"), std::string::npos) << run.err;
 }
 
 TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
@@ -134,11 +116,11 @@ TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
     const char* backends[2] = {"cpu", "gpu"};
     for (int b = 0; b < 2; ++b) {
         const std::string out = (f.dir / fmt::format("{}.exr", backends[b])).string();
-        const RunResult run = runShade(fmt::format(
+        const test::CommandResult run = runShade(fmt::format(
             "'{}' --bake '{}' --backend {} --scene-camera 0 --size 48x48 --component indirect "
             "--out '{}'",
             scenePath("cornell"), f.cornellBake, backends[b], out));
-        ASSERT_EQ(run.exitCode, 0) << run.stderrText;
+        ASSERT_EQ(run.exitCode, 0) << run.err;
         auto image = readImage(out);
         ASSERT_TRUE(image.has_value()) << image.error().message;
         images[b] = std::move(*image);
@@ -152,12 +134,12 @@ TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
 TEST(PicrefShade, UnknownGpuDeviceIsABadInput) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
-    const RunResult run = runShade(
-        fmt::format("'{}' --bake '{}' --backend gpu --device no-such-gpu --scene-camera 0 "
-                    "--size 8x8 --out '{}'",
-                    scenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("no-such-gpu"), std::string::npos) << run.stderrText;
+    const test::CommandResult run =
+        runShade(fmt::format("'{}' --bake '{}' --backend gpu --device no-such-gpu --scene-camera 0 "
+                             "--size 8x8 --out '{}'",
+                             scenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_NE(run.err.find("no-such-gpu"), std::string::npos) << run.err;
 }
 
 TEST(PicrefShade, BadUsageExitsWithTwo) {
@@ -165,22 +147,22 @@ TEST(PicrefShade, BadUsageExitsWithTwo) {
     ASSERT_TRUE(f.ok);
     const std::string base = fmt::format("'{}' --bake '{}'", scenePath("cornell"), f.cornellBake);
     // No --out.
-    RunResult run = runShade(base + " --scene-camera 0 --size 8x8");
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("--out"), std::string::npos) << run.stderrText;
+    test::CommandResult run = runShade(base + " --scene-camera 0 --size 8x8");
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_NE(run.err.find("--out"), std::string::npos) << run.err;
     // A malformed size is named.
     run = runShade(
         base + fmt::format(" --scene-camera 0 --size 8by8 --out '{}'", (f.dir / "a.exr").string()));
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("8by8"), std::string::npos) << run.stderrText;
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_NE(run.err.find("8by8"), std::string::npos) << run.err;
     // A camera the scene does not have.
     run = runShade(
         base + fmt::format(" --scene-camera 7 --size 8x8 --out '{}'", (f.dir / "b.exr").string()));
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
-    EXPECT_NE(run.stderrText.find("7"), std::string::npos) << run.stderrText;
+    EXPECT_EQ(run.exitCode, 2) << run.err;
+    EXPECT_NE(run.err.find("7"), std::string::npos) << run.err;
     // Neither --camera nor --scene-camera.
     run = runShade(base + fmt::format(" --size 8x8 --out '{}'", (f.dir / "c.exr").string()));
-    EXPECT_EQ(run.exitCode, 2) << run.stderrText;
+    EXPECT_EQ(run.exitCode, 2) << run.err;
 }
 
 }  // namespace

@@ -3,45 +3,30 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
-#include <sys/wait.h>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
+
+#include "tests/support/command.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace test = pic::test;
 
 class PicbenchRuntime : public ::testing::Test {
 protected:
-    void SetUp() override {
-        mDir = fs::temp_directory_path() /
-               ("picbench_runtime_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(mDir);
-    }
-    void TearDown() override { fs::remove_all(mDir); }
-
-    /// Runs picbench with `args`, returns its exit code with stderr in `err`.
+    /// Runs picbench with `args`; returns its exit code, stderr in `err`.
     int run(const std::string& args, std::string& err) {
-        const fs::path errPath = mDir / "stderr.txt";
-        const std::string command = std::string(PIC_PICBENCH) + " --quiet " + args + " >" +
-                                    (mDir / "stdout.txt").string() + " 2>" + errPath.string() +
-                                    " </dev/null";
-        const int status = std::system(command.c_str());
-        std::ifstream in(errPath);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        err = ss.str();
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        test::CommandResult result =
+            test::runCommand(std::string(PIC_PICBENCH) + " --quiet " + args, mDir.path());
+        err = std::move(result.err);
+        return result.exitCode;
     }
 
-    fs::path mDir;
+    test::ScratchDir mDir{"picbench_runtime"};
 };
 
 TEST_F(PicbenchRuntime, ReportsEveryKindOfLightChange) {
