@@ -17,8 +17,9 @@ struct CopyProbeParams {
 
 /// Bytes copied per second by a compute shader copying one device buffer into another,
 /// by timestamps: the median over the timed submissions. The copy is checked against the
-/// data it was given (an error when it differs). Lavapipe's timestamps do not wait for a
-/// dispatch, so its figure means nothing; the check still holds.
+/// data it was given (an error when it differs). The benchmarks take memcpy as the floor on
+/// a CPU device (whose timestamps were once seen not to wait for a dispatch); the check
+/// holds on any device.
 Result<double> computeCopyBandwidth(Context& context, const CopyProbeParams& params = {});
 
 }  // namespace pic::gpu
