@@ -68,6 +68,7 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
                                                     options.bounces, gpuOptions));
         served->mDevice = gpu->context().deviceName();
         served->mDirectVisibility = gpu::directVisibilityName(gpu->directVisibility());
+        served->mLightmapCopy = gpu->lightmapCopyOnHost() ? "host" : "device";
         served->mRuntime = std::move(gpu);
     } else if (options.backend == "cpu") {
         PIC_TRY_ASSIGN(served->mRuntime, createCpuRuntime(served->mScene, *served->mRays,

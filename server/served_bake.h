@@ -54,6 +54,9 @@ public:
     /// Where the GPU backend's direct visibility comes from ("shadow-maps", "rays"), empty
     /// for the CPU twin (which traces rays).
     const std::string& directVisibility() const { return mDirectVisibility; }
+    /// Where the GPU backend copies the caches into the textures ("host", "device"), empty
+    /// for the CPU twin (which copies on the host).
+    const std::string& lightmapCopy() const { return mLightmapCopy; }
 
     /// Relights the scene with `lights` and copies the resulting textures as half floats, one
     /// session at a time (the runtime keeps per-light state such as shadow maps).
@@ -71,6 +74,7 @@ private:
     std::mutex mRuntimeMutex;
     std::string mDevice;
     std::string mDirectVisibility;
+    std::string mLightmapCopy;
     v1::BakeSummary mSummary;
     v1::SceneHeader mHeader;
     std::vector<std::string> mAssetBytes;
