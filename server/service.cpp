@@ -14,6 +14,7 @@
 #include "proto/pic.grpc.pb.h"
 #include "proto/wire.h"
 #include "server/session_store.h"
+#include "server/token_digest.h"
 
 namespace pic {
 
@@ -48,7 +49,7 @@ struct PicServer::State {
         {
             std::lock_guard lock(mutex);
             for (const auto& [id, session] : sessions)
-                snapshot.push_back({id, session->editorToken(), session->viewerToken(),
+                snapshot.push_back({id, session->editorDigest(), session->viewerDigest(),
                                     session->bake().id(), session->latestVersion(),
                                     session->latestLights()});
         }
@@ -81,8 +82,8 @@ struct PicServer::State {
 
 namespace {
 
-/// Compares tokens in time independent of where they differ.
-bool sameToken(const std::string& a, const std::string& b) {
+/// Compares token digests in time independent of where they differ.
+bool sameDigest(const std::string& a, const std::string& b) {
     if (a.size() != b.size()) return false;
     unsigned char diff = 0;
     for (size_t i = 0; i < a.size(); ++i) diff |= (unsigned char)(a[i] ^ b[i]);
@@ -108,9 +109,10 @@ Access authorise(const PicServer::State& state, const std::string& id, const std
                                      fmt::format("no session \"{}\"", id));
         return access;
     }
-    if (sameToken(token, access.session->editorToken()))
+    const std::string digest = tokenDigest(token);
+    if (sameDigest(digest, access.session->editorDigest()))
         access.role = v1::EDITOR;
-    else if (sameToken(token, access.session->viewerToken()))
+    else if (sameDigest(digest, access.session->viewerDigest()))
         access.role = v1::VIEWER;
     else
         access.status = grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
@@ -282,6 +284,7 @@ public:
             return finish(context, grpc::Status(grpc::StatusCode::NOT_FOUND,
                                                 fmt::format("no bake \"{}\"", request->bake_id())));
         std::shared_ptr<Session> session;
+        std::string editorToken, viewerToken;
         {
             std::lock_guard lock(mState->mutex);
             if (mState->sessions.size() >= mState->options.maxSessions)
@@ -291,14 +294,18 @@ public:
                                                        mState->options.maxSessions)));
             std::string id = mState->randomHex(2);
             while (mState->sessions.contains(id)) id = mState->randomHex(2);
-            session = std::make_shared<Session>(id, mState->randomHex(4), mState->randomHex(4),
-                                                *bake, mState->options.session);
+            editorToken = mState->randomHex(4);
+            viewerToken = mState->randomHex(4);
+            session =
+                std::make_shared<Session>(id, tokenDigest(editorToken), tokenDigest(viewerToken),
+                                          *bake, mState->options.session);
             mState->sessions[id] = session;
         }
         mState->markDirty();
+        // The only time the tokens leave the server; it keeps their digests.
         response->set_session(session->id());
-        response->set_editor_token(session->editorToken());
-        response->set_viewer_token(session->viewerToken());
+        response->set_editor_token(editorToken);
+        response->set_viewer_token(viewerToken);
         response->set_bake_id(bake->id());
         response->set_version(session->latestVersion());
         return finish(context, grpc::Status::OK);
@@ -431,8 +438,9 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
                 continue;
             }
             SessionStart start{entry.version + 1, std::move(entry.lights)};
-            state.sessions[entry.id] = std::make_shared<Session>(
-                entry.id, entry.editorToken, entry.viewerToken, *bake, options.session, std::move(start));
+            state.sessions[entry.id] =
+                std::make_shared<Session>(entry.id, entry.editorDigest, entry.viewerDigest, *bake,
+                                          options.session, std::move(start));
         }
         if (!stored.empty())
             std::fprintf(stderr, "picserver: %zu of %zu sessions restored from %s\n",

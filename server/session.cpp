@@ -58,11 +58,11 @@ uint64_t SubscriberSlot::skipped() const {
     return mSkipped;
 }
 
-Session::Session(std::string id, std::string editorToken, std::string viewerToken,
+Session::Session(std::string id, std::string editorDigest, std::string viewerDigest,
                  ServedBake& bake, SessionOptions options, SessionStart start)
     : mId(std::move(id)),
-      mEditorToken(std::move(editorToken)),
-      mViewerToken(std::move(viewerToken)),
+      mEditorDigest(std::move(editorDigest)),
+      mViewerDigest(std::move(viewerDigest)),
       mBake(bake),
       mOptions(std::move(options)) {
     mLatestLights = start.lights ? std::move(*start.lights) : defaultLightSet(bake.scene());

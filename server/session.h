@@ -104,7 +104,8 @@ struct SessionStart {
 class Session {
 public:
     /// Starts the session's worker and queues its first version.
-    Session(std::string id, std::string editorToken, std::string viewerToken, ServedBake& bake,
+    /// The tokens come as their digests (tokenDigest): the session never holds a token.
+    Session(std::string id, std::string editorDigest, std::string viewerDigest, ServedBake& bake,
             SessionOptions options, SessionStart start = SessionStart());
     /// Stops the worker (an update in progress finishes first).
     ~Session();
@@ -112,8 +113,9 @@ public:
     Session& operator=(const Session&) = delete;
 
     const std::string& id() const { return mId; }
-    const std::string& editorToken() const { return mEditorToken; }
-    const std::string& viewerToken() const { return mViewerToken; }
+    /// tokenDigest of the editor's and the viewers' tokens.
+    const std::string& editorDigest() const { return mEditorDigest; }
+    const std::string& viewerDigest() const { return mViewerDigest; }
     ServedBake& bake() const { return mBake; }
 
     /// Queues a light set, checked against the scene (InvalidInput naming the problem), and
@@ -150,8 +152,8 @@ private:
     void publish(std::shared_ptr<const Update> update);
 
     std::string mId;
-    std::string mEditorToken;
-    std::string mViewerToken;
+    std::string mEditorDigest;
+    std::string mViewerDigest;
     ServedBake& mBake;
     SessionOptions mOptions;
 

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "server/token_digest.h"
+
 namespace pic {
 
 namespace {
@@ -18,7 +20,13 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr int kFormat = 1;
+/// 2: token digests; 1: plain tokens (read, digested on load).
+constexpr int kFormat = 2;
+
+/// 64 lowercase hex digits, as tokenDigest writes.
+bool isDigest(const std::string& text) {
+    return text.size() == 64 && text.find_first_not_of("0123456789abcdef") == std::string::npos;
+}
 
 }  // namespace
 
@@ -29,24 +37,35 @@ Result<std::vector<StoredSession>> SessionStore::load() const {
     if (!file) return fail(ErrorCode::Io, "cannot open the session database {}", mPath);
     const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
     const Json root = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (!root.is_object() || root.value("format", 0) != kFormat || !root.contains("sessions") ||
+    const int format = root.is_object() ? root.value("format", 0) : 0;
+    if ((format != 1 && format != kFormat) || !root.contains("sessions") ||
         !root["sessions"].is_array())
         return fail(ErrorCode::Corrupt,
-                    "{} is not a pic session database of format {} (move it away to start afresh)",
+                    "{} is not a pic session database of format 1 or {} (move it away to start "
+                    "afresh)",
                     mPath, kFormat);
     std::vector<StoredSession> sessions;
     for (const Json& entry : root["sessions"]) {
         StoredSession session;
         try {
             session.id = entry.at("id").get<std::string>();
-            session.editorToken = entry.at("editor_token").get<std::string>();
-            session.viewerToken = entry.at("viewer_token").get<std::string>();
+            if (format == 1) {
+                session.editorDigest = tokenDigest(entry.at("editor_token").get<std::string>());
+                session.viewerDigest = tokenDigest(entry.at("viewer_token").get<std::string>());
+            } else {
+                session.editorDigest = entry.at("editor_token_sha256").get<std::string>();
+                session.viewerDigest = entry.at("viewer_token_sha256").get<std::string>();
+            }
             session.bakeId = entry.at("bake_id").get<std::string>();
             session.version = entry.at("version").get<uint64_t>();
         } catch (const Json::exception& error) {
             return fail(ErrorCode::Corrupt, "{}: session entry {}: {}", mPath, sessions.size(),
                         error.what());
         }
+        if (!isDigest(session.editorDigest) || !isDigest(session.viewerDigest))
+            return fail(ErrorCode::Corrupt,
+                        "{}: session {}: a token digest is not 64 lowercase hex digits", mPath,
+                        session.id);
         auto lights = parseLightSet(entry.value("lights", Json::object()).dump());
         if (!lights)
             return fail(ErrorCode::Corrupt, "{}: session {}: {}", mPath, session.id,
@@ -64,8 +83,8 @@ Result<void> SessionStore::save(const std::vector<StoredSession>& sessions) {
     for (const StoredSession& session : sessions) {
         Json entry;
         entry["id"] = session.id;
-        entry["editor_token"] = session.editorToken;
-        entry["viewer_token"] = session.viewerToken;
+        entry["editor_token_sha256"] = session.editorDigest;
+        entry["viewer_token_sha256"] = session.viewerDigest;
         entry["bake_id"] = session.bakeId;
         entry["version"] = session.version;
         entry["lights"] = Json::parse(toJson(session.lights));
@@ -75,7 +94,7 @@ Result<void> SessionStore::save(const std::vector<StoredSession>& sessions) {
 
     std::lock_guard lock(mMutex);
     const std::string temp = mPath + ".tmp";
-    // Owner-only: the file holds the sessions' tokens.
+    // Owner-only: the digests cannot be presented as tokens, but the sessions are private.
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
     if (fd < 0) return fail(ErrorCode::Io, "cannot write the session database {}", temp);
     size_t written = 0;

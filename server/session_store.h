@@ -1,9 +1,10 @@
 #pragma once
 /// The server's database (`picserver --db FILE`): its sessions, so that a restarted server
-/// keeps them, with their tokens, bake and last light set. One JSON file, rewritten atomically
-/// (temporary file, fsync, rename) by the server's housekeeping thread soon after a session is
-/// created, relit or removed (handlers never wait for the disk); readable
-/// by its owner only, since it holds the tokens.
+/// keeps them, with their tokens' digests (server/token_digest.h), bake and last light set.
+/// One JSON file, rewritten atomically (temporary file, fsync, rename) by the server's
+/// housekeeping thread soon after a session is created, relit or removed (handlers never wait
+/// for the disk); readable by its owner only. Format 2 keeps the digests; a format-1 file
+/// (plain tokens) still loads, its tokens digested, and the next save writes format 2.
 
 #include <cstdint>
 #include <mutex>
@@ -18,8 +19,8 @@ namespace pic {
 /// What the database keeps of one session.
 struct StoredSession {
     std::string id;
-    std::string editorToken;
-    std::string viewerToken;
+    std::string editorDigest;  ///< tokenDigest of the editor token
+    std::string viewerDigest;  ///< tokenDigest of the viewer token
     std::string bakeId;
     uint64_t version = 0;  ///< the newest version it had accepted
     LightSet lights;       ///< the light set of that version

@@ -28,14 +28,15 @@
 #include "bake/bake.h"
 #include "client/connection.h"
 #include "client/renderer.h"
+#include "core/bake_file.h"
 #include "core/camera.h"
+#include "core/gltf_loader.h"
 #include "core/image.h"
+#include "proto/wire.h"
 #include "server/cpu/cache_shading.h"
 #include "server/cpu/cpu_runtime.h"
-#include "core/bake_file.h"
-#include "core/gltf_loader.h"
-#include "proto/wire.h"
 #include "server/service.h"
+#include "server/token_digest.h"
 
 namespace pic {
 namespace {
@@ -371,7 +372,16 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
         EXPECT_EQ(*version, 2u);
     }
     EXPECT_EQ(fs::status(db).permissions() & fs::perms::others_read, fs::perms::none)
-        << "the database holds tokens";
+        << "the database is private";
+    {
+        // It holds the tokens' digests, not the tokens.
+        std::ifstream in(db);
+        const std::string text{std::istreambuf_iterator<char>(in),
+                               std::istreambuf_iterator<char>()};
+        EXPECT_EQ(text.find(editor), std::string::npos);
+        EXPECT_EQ(text.find(viewer), std::string::npos);
+        EXPECT_NE(text.find(tokenDigest(viewer)), std::string::npos);
+    }
     Served restarted = serve("cpu", 32, std::chrono::hours(1), db.string());
     ASSERT_TRUE(restarted.connection);
     auto joined = restarted.connection->joinSession(id, viewer);
@@ -403,6 +413,55 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
+    fs::remove(db);
+}
+
+// A database written before the digests (format 1: plain tokens) still loads: its tokens
+// open their sessions, and the next save keeps only their digests.
+TEST(Stream, AFormatOneDatabaseLoadsAndIsRewrittenWithDigests) {
+    const fs::path db =
+        fs::temp_directory_path() / fmt::format("pic_sessions_v1_{}.json", getpid());
+    fs::remove(db);
+    std::string id, editor, viewer;
+    {
+        Served served = serve("cpu", 32, std::chrono::hours(1), db.string());
+        ASSERT_TRUE(served.connection);
+        auto session = served.connection->createSession();
+        ASSERT_TRUE(session);
+        id = session->session();
+        editor = session->editor_token();
+        viewer = session->viewer_token();
+    }
+    // Rewrite it as format 1 would have had it.
+    {
+        std::ifstream in(db);
+        nlohmann::json root = nlohmann::json::parse(in);
+        root["format"] = 1;
+        for (nlohmann::json& entry : root["sessions"]) {
+            entry.erase("editor_token_sha256");
+            entry.erase("viewer_token_sha256");
+            entry["editor_token"] = editor;
+            entry["viewer_token"] = viewer;
+        }
+        std::ofstream(db) << root.dump(2);
+    }
+    {
+        Served restarted = serve("cpu", 32, std::chrono::hours(1), db.string());
+        ASSERT_TRUE(restarted.connection);
+        auto joined = restarted.connection->joinSession(id, viewer);
+        ASSERT_TRUE(joined) << joined.error().message;
+        auto version = restarted.connection->setLights(id, editor, pointLight(0.1f));
+        EXPECT_TRUE(version) << (version ? "" : version.error().message);
+        auto denied = restarted.connection->setLights(id, "not-a-token", pointLight(0.1f));
+        EXPECT_FALSE(denied);
+    }
+    std::ifstream in(db);
+    const nlohmann::json root = nlohmann::json::parse(in);
+    EXPECT_EQ(root.at("format"), 2);
+    const std::string text = root.dump();
+    EXPECT_EQ(text.find(editor), std::string::npos);
+    EXPECT_EQ(text.find(viewer), std::string::npos);
+    EXPECT_EQ(root.at("sessions").at(0).at("editor_token_sha256"), tokenDigest(editor));
     fs::remove(db);
 }
 
