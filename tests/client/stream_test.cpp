@@ -37,6 +37,7 @@
 #include "server/cpu/cpu_runtime.h"
 #include "server/service.h"
 #include "server/token_digest.h"
+#include "tests/support/command.h"
 
 namespace pic {
 namespace {
@@ -46,12 +47,12 @@ using namespace std::chrono_literals;
 
 const std::string kScene = std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf";
 
-/// A small bake of the Cornell box, written once per test run.
+/// A small bake of the Cornell box, written once per test process into a scratch directory
+/// that goes when the process exits.
 const std::string& bakePath() {
+    static const test::ScratchDir dir("pic_stream_test");
     static const std::string path = [] {
-        const std::string out = (fs::temp_directory_path() /
-                                 fmt::format("pic_stream_test_{}.pic", getpid()))
-                                    .string();
+        const std::string out = (dir / "cornell.pic").string();
         auto scene = loadScene(kScene);
         EXPECT_TRUE(scene);
         BakeOptions options;
@@ -355,8 +356,8 @@ TEST(Stream, IdleSessionsWithoutSubscribersAreRemoved) {
 }
 
 TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
-    const fs::path db = fs::temp_directory_path() / fmt::format("pic_sessions_{}.json", getpid());
-    fs::remove(db);
+    const test::ScratchDir dir("pic_sessions");
+    const fs::path db = dir / "sessions.json";
     std::string id, editor, viewer;
     const LightSet lights = pointLight(0.25f);
     {
@@ -413,15 +414,13 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
-    fs::remove(db);
 }
 
 // A database written before the digests (format 1: plain tokens) still loads: its tokens
 // open their sessions, and the next save keeps only their digests.
 TEST(Stream, AFormatOneDatabaseLoadsAndIsRewrittenWithDigests) {
-    const fs::path db =
-        fs::temp_directory_path() / fmt::format("pic_sessions_v1_{}.json", getpid());
-    fs::remove(db);
+    const test::ScratchDir dir("pic_sessions_v1");
+    const fs::path db = dir / "sessions.json";
     std::string id, editor, viewer;
     {
         Served served = serve("cpu", 32, std::chrono::hours(1), db.string());
@@ -462,7 +461,6 @@ TEST(Stream, AFormatOneDatabaseLoadsAndIsRewrittenWithDigests) {
     EXPECT_EQ(text.find(editor), std::string::npos);
     EXPECT_EQ(text.find(viewer), std::string::npos);
     EXPECT_EQ(root.at("sessions").at(0).at("editor_token_sha256"), tokenDigest(editor));
-    fs::remove(db);
 }
 
 TEST(Stream, HealthCheckSaysServing) {
@@ -657,7 +655,8 @@ TEST(Stream, LightSetsCoalesceWhileAnUpdateComputes) {
 TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
-    const fs::path cache = fs::temp_directory_path() / fmt::format("pic_stream_cache_{}", getpid());
+    const test::ScratchDir dir("pic_stream_cache");
+    const fs::path cache = dir / "cache";
     bool downloaded = false;
     auto client = served.connection->fetchScene("", cache.string(), &downloaded);
     ASSERT_TRUE(client) << client.error().message;
@@ -695,7 +694,6 @@ TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     auto missing = served.connection->fetchScene("0123456789abcdef", cache.string());
     ASSERT_FALSE(missing);
     EXPECT_EQ(missing.error().code, ErrorCode::NotFound);
-    fs::remove_all(cache);
 }
 
 TEST(Stream, GpuBackendServesTheSameProtocol) {
@@ -714,7 +712,8 @@ TEST(Stream, GpuBackendServesTheSameProtocol) {
 TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
-    const fs::path cache = fs::temp_directory_path() / fmt::format("pic_stream_render_{}", getpid());
+    const test::ScratchDir dir("pic_stream_render");
+    const fs::path cache = dir / "cache";
     auto client = served.connection->fetchScene("", cache.string());
     ASSERT_TRUE(client) << client.error().message;
     auto session = served.connection->createSession();
@@ -761,7 +760,6 @@ TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
                 error->relativeRmse, error->meanRatio);
     EXPECT_LE(error->relativeRmse, 0.01);
     EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
-    fs::remove_all(cache);
 }
 
 /// Runs a command with its stdout on a pipe; the child's pid and the read end.
@@ -828,7 +826,8 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     const std::string session = json["session"], editor = json["editor_token"],
                       viewer = json["viewer_token"];
 
-    const fs::path lightsFile = fs::temp_directory_path() / fmt::format("pic_cli_lights_{}.json", getpid());
+    const test::ScratchDir dir("pic_cli");
+    const fs::path lightsFile = dir / "lights.json";
     {
         std::FILE* f = std::fopen(lightsFile.c_str(), "w");
         std::fputs(R"({"lights":[{"id":"lamp","type":"point","position":[0,0.6,0],"intensity":3}]})", f);
@@ -851,7 +850,7 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_EQ(exit, 0) << watched;
     EXPECT_NE(watched.find("version 2: key"), std::string::npos) << watched;
 
-    const fs::path report = fs::temp_directory_path() / fmt::format("pic_cli_load_{}.json", getpid());
+    const fs::path report = dir / "load.json";
     std::string loaded = run(client + " load --server " + address + " --clients 3 --duration 1 "
                                   "--update-rate 4 --report " + report.string(),
                              exit);
@@ -864,8 +863,8 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_GE(loadReport["frames_received"].get<int>(), 3);
     EXPECT_EQ(loadReport["errors"].get<int>(), 0);
 
-    const fs::path image = fs::temp_directory_path() / fmt::format("pic_cli_render_{}.exr", getpid());
-    const fs::path cacheDir = fs::temp_directory_path() / fmt::format("pic_cli_cache_{}", getpid());
+    const fs::path image = dir / "render.exr";
+    const fs::path cacheDir = dir / "cache";
     std::string rendered = run(client + " render --server " + address + " --session " + session +
                                    " --token " + editor + " --lights " + lightsFile.string() +
                                    " --scene-camera 0 --size 63x56 --component indirect --cache-dir " +
@@ -882,8 +881,6 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
                                      " --out " + image.string() + " 2>&1",
                                  exit);
     EXPECT_EQ(exit, 2) << viewerPush;
-    fs::remove(image);
-    fs::remove_all(cacheDir);
 
     std::string stats = run(client + " stats --server " + address + " --session " + session +
                                 " --token " + viewer,
@@ -904,8 +901,6 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     kill(server.pid, SIGTERM);
     EXPECT_EQ(waitExit(server.pid), 0);
     std::fclose(server.out);
-    fs::remove(lightsFile);
-    fs::remove(report);
 }
 
 TEST(StreamCli, TlsServerAndClient) {
