@@ -10,6 +10,7 @@
 #include "core/frame_codec.h"
 #include "core/gltf_loader.h"
 #include "core/hash.h"
+#include "core/light_set.h"
 #include "server/cpu/cpu_runtime.h"
 #include "server/encoder.h"
 #include "server/gpu/gpu_runtime.h"
@@ -78,6 +79,8 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
                     options.backend);
     }
 
+    PIC_TRY(served->warmUp());
+
     v1::BakeSummary& summary = served->mSummary;
     summary.set_bake_id(served->mId);
     summary.set_scene_name(fs::path(scenePath).filename().string());
@@ -125,6 +128,16 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
     add("layout/triangle_uvs", bytesOf(mBake.lightmap.triangleUvs));
     add("layout/grid_coverage", coverageBytes(mBake.grid.cacheIndex));
     add("layout/lightmap_coverage", coverageBytes(mBake.lightmap.cacheIndex));
+    return {};
+}
+
+Result<void> ServedBake::warmUp() {
+    const auto start = std::chrono::steady_clock::now();
+    UpdateStats stats;
+    PIC_TRY(mRuntime->setLights(defaultLightSet(mScene), &stats));
+    PIC_TRY(mRuntime->textures());
+    mWarmUpMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return {};
 }
 

@@ -35,6 +35,7 @@
 #include "proto/wire.h"
 #include "server/cpu/cache_shading.h"
 #include "server/cpu/cpu_runtime.h"
+#include "server/encoder.h"
 #include "server/service.h"
 #include "server/token_digest.h"
 #include "tests/support/command.h"
@@ -461,6 +462,34 @@ TEST(Stream, AFormatOneDatabaseLoadsAndIsRewrittenWithDigests) {
     EXPECT_EQ(text.find(editor), std::string::npos);
     EXPECT_EQ(text.find(viewer), std::string::npos);
     EXPECT_EQ(root.at("sessions").at(0).at("editor_token_sha256"), tokenDigest(editor));
+}
+
+// The load runs one update with the scene's own lights (ServedBake::warmUp), and a session
+// that then asks for the same lights gets the same caches as a runtime that never ran one.
+TEST(Stream, ALoadRunsAFirstUpdateThatChangesNoResult) {
+    ServeOptions options;
+    options.backend = "cpu";
+    options.bounces.bounces = 1;
+    auto served = ServedBake::load(bakePath(), kScene, options);
+    ASSERT_TRUE(served) << served.error().message;
+    EXPECT_GT((*served)->warmUpMs(), 0.0);
+    UpdateStats stats;
+    HalfFrame frame;
+    const LightSet lights = pointLight(0.25f);
+    ASSERT_TRUE((*served)->relight(lights, stats, frame));
+
+    auto bake = readBakeFile(bakePath());
+    ASSERT_TRUE(bake);
+    auto scene = loadScene(kScene);
+    ASSERT_TRUE(scene);
+    auto rays = EmbreeScene::create(*scene);
+    ASSERT_TRUE(rays);
+    auto fresh = createCpuRuntime(*scene, **rays, *bake, BounceParams{1});
+    ASSERT_TRUE(fresh);
+    ASSERT_TRUE((*fresh)->setLights(lights));
+    auto textures = (*fresh)->textures();
+    ASSERT_TRUE(textures);
+    EXPECT_TRUE(frame == halfFrameOf(**textures));
 }
 
 TEST(Stream, HealthCheckSaysServing) {
