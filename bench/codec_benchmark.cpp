@@ -43,13 +43,17 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
         double(bake->caches.size()) *
         double(bake->params.bandsY * bake->params.bandsY + 2 * bake->params.bandsC * bake->params.bandsC);
     const float step = 1e-3f * scene.bounds.diagonal();
-    std::vector<double> keyBits, deltaBits, keyCacheBits, deltaCacheBits, encodeMs, decodeMs;
+    // Per zstd level, over the updates after the first (whose delta has no base).
+    struct LevelSamples {
+        std::vector<double> keyBits, deltaBits, keyCacheBits, deltaCacheBits, keyMs, deltaMs,
+            decodeMs;
+    };
+    std::vector<LevelSamples> samples(params.zstdLevels.size());
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     HalfFrame previous;
     double values = 0.0;
-    std::printf("%-7s %12s %12s %14s %14s %10s %10s\n", "update", "key bytes", "delta bytes",
-                "key bits/val", "delta bits/val", "encode ms", "decode ms");
     for (int k = 0; k <= params.updates; ++k) {
+        std::fprintf(stderr, "picbench: update %d of %d\n", k, params.updates);
         if (auto caches = runtime->setLights(changedLights(inputs->lights, k, step, params.change)); !caches)
             return reportError(caches.error());
         auto textures = runtime->textures();
@@ -57,47 +61,89 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
         const HalfFrame frame = halfFrameOf(**textures);
         values = double(frameValues(frame));
 
-        Clock::time_point start = Clock::now();
-        auto key = encodeFrame(frame, nullptr, params.zstdLevel);
-        const double keyMs = msSince(start);
-        if (!key) return reportError(key.error());
-        nlohmann::ordered_json row{{"update", k}, {"key_bytes", key->bytes()}, {"key_encode_ms", keyMs}};
-        if (k == 0) {
-            std::printf("%-7d %12zu %12s %14.2f %14s %10.2f %10s\n", k, key->bytes(), "-",
-                        8.0 * double(key->bytes()) / values, "-", keyMs, "-");
-        } else {
-            start = Clock::now();
-            auto delta = encodeFrame(frame, &previous, params.zstdLevel);
-            const double deltaMs = msSince(start);
-            if (!delta) return reportError(delta.error());
-            // The receiver holds the previous version and applies the delta.
-            HalfFrame received = previous;
-            start = Clock::now();
-            if (auto decoded = decodeFrame(*delta, received); !decoded) return reportError(decoded.error());
-            const double ms = msSince(start);
-            if (!(received == frame)) {
-                std::fprintf(stderr, "picbench: error: update %d: decoding the delta frame did not give back the encoder's input\n", k);
-                return 1;
+        nlohmann::ordered_json row{{"update", k}, {"levels", nlohmann::ordered_json::array()}};
+        for (size_t i = 0; i < params.zstdLevels.size(); ++i) {
+            const int level = params.zstdLevels[i];
+            LevelSamples& sampled = samples[i];
+            Clock::time_point start = Clock::now();
+            auto key = encodeFrame(frame, nullptr, level);
+            const double keyMs = msSince(start);
+            if (!key) return reportError(key.error());
+            nlohmann::ordered_json entry{
+                {"zstd_level", level}, {"key_bytes", key->bytes()}, {"key_encode_ms", keyMs}};
+            if (k > 0) {
+                start = Clock::now();
+                auto delta = encodeFrame(frame, &previous, level);
+                const double deltaMs = msSince(start);
+                if (!delta) return reportError(delta.error());
+                // The receiver holds the previous version and applies the delta.
+                HalfFrame received = previous;
+                start = Clock::now();
+                if (auto decoded = decodeFrame(*delta, received); !decoded)
+                    return reportError(decoded.error());
+                const double decodeMs = msSince(start);
+                if (!(received == frame)) {
+                    std::fprintf(stderr,
+                                 "picbench: error: update %d, zstd level %d: decoding the delta "
+                                 "frame did not give back the encoder's input\n",
+                                 k, level);
+                    return 1;
+                }
+                sampled.keyBits.push_back(8.0 * double(key->bytes()) / values);
+                sampled.deltaBits.push_back(8.0 * double(delta->bytes()) / values);
+                sampled.keyCacheBits.push_back(8.0 * double(key->bytes()) / cacheCoefficients);
+                sampled.deltaCacheBits.push_back(8.0 * double(delta->bytes()) / cacheCoefficients);
+                sampled.keyMs.push_back(keyMs);
+                sampled.deltaMs.push_back(deltaMs);
+                sampled.decodeMs.push_back(decodeMs);
+                entry["delta_bytes"] = delta->bytes();
+                entry["delta_encode_ms"] = deltaMs;
+                entry["delta_decode_ms"] = decodeMs;
             }
-            keyBits.push_back(8.0 * double(key->bytes()) / values);
-            deltaBits.push_back(8.0 * double(delta->bytes()) / values);
-            keyCacheBits.push_back(8.0 * double(key->bytes()) / cacheCoefficients);
-            deltaCacheBits.push_back(8.0 * double(delta->bytes()) / cacheCoefficients);
-            encodeMs.push_back(deltaMs);
-            decodeMs.push_back(ms);
-            std::printf("%-7d %12zu %12zu %14.2f %14.2f %10.2f %10.2f\n", k, key->bytes(), delta->bytes(),
-                        keyBits.back(), deltaBits.back(), deltaMs, ms);
-            row["delta_bytes"] = delta->bytes();
-            row["delta_encode_ms"] = deltaMs;
-            row["delta_decode_ms"] = ms;
+            row["levels"].push_back(std::move(entry));
         }
-        frames.push_back(row);
+        frames.push_back(std::move(row));
         previous = frame;
     }
-    std::printf("medians: key %.2f bits per texture value (%.2f per cache coefficient), delta %.2f "
-                "(%.2f); encode %.2f ms, decode %.2f ms\n",
-                median(keyBits), median(keyCacheBits), median(deltaBits), median(deltaCacheBits),
-                median(encodeMs), median(decodeMs));
+
+    std::printf("medians over %d updates; bits per texture value (per unique cache coefficient)\n",
+                params.updates);
+    std::printf("%5s %15s %15s %13s %15s %10s\n", "zstd", "key bits", "delta bits", "key enc ms",
+                "delta enc ms", "decode ms");
+    nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+    Chart chart;
+    chart.title = fmt::format("Stream frame size against encode time per zstd level, {} {}",
+                              params.setting, params.linkMode);
+    chart.xLabel = "encode ms (median)";
+    chart.yLabel = "bits per texture value (median)";
+    chart.logX = true;
+    ChartSeries keySeries{"key frames", {0.2f, 0.35f, 0.75f}},
+        deltaSeries{"delta frames", {0.85f, 0.45f, 0.1f}};
+    for (size_t i = 0; i < params.zstdLevels.size(); ++i) {
+        const LevelSamples& level = samples[i];
+        nlohmann::ordered_json entry;
+        entry["zstd_level"] = params.zstdLevels[i];
+        entry["key_bits_per_value_median"] = median(level.keyBits);
+        entry["delta_bits_per_value_median"] = median(level.deltaBits);
+        entry["key_bits_per_cache_coefficient_median"] = median(level.keyCacheBits);
+        entry["delta_bits_per_cache_coefficient_median"] = median(level.deltaCacheBits);
+        entry["key_encode_ms_median"] = median(level.keyMs);
+        entry["delta_encode_ms_median"] = median(level.deltaMs);
+        entry["delta_decode_ms_median"] = median(level.decodeMs);
+        std::printf("%5d %7.2f (%5.2f) %7.2f (%5.2f) %13.2f %15.2f %10.2f\n", params.zstdLevels[i],
+                    median(level.keyBits), median(level.keyCacheBits), median(level.deltaBits),
+                    median(level.deltaCacheBits), median(level.keyMs), median(level.deltaMs),
+                    median(level.decodeMs));
+        const std::string label = fmt::format("zstd {}", params.zstdLevels[i]);
+        keySeries.points.push_back({median(level.keyMs), median(level.keyBits)});
+        keySeries.labels.push_back(label);
+        deltaSeries.points.push_back({median(level.deltaMs), median(level.deltaBits)});
+        deltaSeries.labels.push_back(label);
+        levels.push_back(std::move(entry));
+    }
+    keySeries.connected = deltaSeries.connected = params.zstdLevels.size() > 1;
+    chart.series = {keySeries, deltaSeries};
+    const int charted = writeChartFile(chart, chartPathFor(params.jsonPath));
 
     nlohmann::ordered_json json;
     json["scene"] = params.scenePath;
@@ -105,19 +151,15 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
     json["link_mode"] = params.linkMode;
     json["backend"] = runtime->name();
     json["change"] = params.change;
-    json["zstd_level"] = params.zstdLevel;
+
     json["caches"] = bake->caches.size();
     json["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
     json["texture_values_per_frame"] = values;
     json["cache_coefficients"] = cacheCoefficients;
-    json["key_bits_per_value_median"] = median(keyBits);
-    json["delta_bits_per_value_median"] = median(deltaBits);
-    json["key_bits_per_cache_coefficient_median"] = median(keyCacheBits);
-    json["delta_bits_per_cache_coefficient_median"] = median(deltaCacheBits);
-    json["delta_encode_ms_median"] = median(encodeMs);
-    json["delta_decode_ms_median"] = median(decodeMs);
-    json["frames"] = frames;
-    return writeJson(json, params.jsonPath);
+    json["levels"] = std::move(levels);
+    json["frames"] = std::move(frames);
+    const int written = writeJson(json, params.jsonPath);
+    return charted != 0 ? charted : written;
 }
 
 }  // namespace pic

@@ -2,12 +2,14 @@
 /// `picbench codec`: what the stream costs per frame. Bakes the scene at a paper 000 Table 2
 /// setting, runs `updates` light changes on one runtime backend, turns each update's cache
 /// textures into the stream's half planes and encodes them as a key frame and as a delta
-/// from the previous update. Prints per-frame bytes as bits per SH coefficient (over the
-/// texture values the frame carries, and over the unique caches' coefficients), encode and
-/// decode ms, and checks that decoding gives back the encoder's input exactly (exit 1 if
-/// not). Writes JSON.
+/// from the previous update, at each of several zstd levels. Prints per level the median
+/// bits per SH coefficient (over the texture values the frame carries, and over the unique
+/// caches' coefficients) and encode and decode ms, and checks that decoding gives back the
+/// encoder's input exactly (exit 1 if not). Writes JSON and, beside it, a PNG chart of size
+/// against encode time, one point per level.
 
 #include <string>
+#include <vector>
 
 namespace pic {
 
@@ -19,7 +21,8 @@ struct CodecBenchmarkParams {
     std::string backend = "cpu";       ///< "cpu" or "gpu": the textures are the same to 1 %
     std::string change = "move-one";   ///< bench_common.h changedLights
     int updates = 10;
-    int zstdLevel = 3;
+    std::vector<int> zstdLevels{1, 3, 6, 9,
+                                19};  ///< every frame is coded at each (picserver's default: 3)
     std::string jsonPath = "codec_benchmark.json";
 };
 

@@ -141,7 +141,11 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));
     codec->add_option("--updates", codecParams.updates, "light changes after the first frame (default 10)")
         ->check(CLI::Range(1, 100000));
-    codec->add_option("--zstd-level", codecParams.zstdLevel, "zstd level (default 3)")->check(CLI::Range(1, 19));
+    codec
+        ->add_option("--zstd-levels", codecParams.zstdLevels,
+                     "zstd levels to code every frame at, charted as size against encode time "
+                     "(default 1 3 6 9 19)")
+        ->check(CLI::Range(1, 19));
     codec->add_option("--json", codecParams.jsonPath, "JSON file (default codec_benchmark.json)");
 
     CLI::App* stream = app.add_subcommand(

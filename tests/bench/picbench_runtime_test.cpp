@@ -110,17 +110,31 @@ TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {
     // picbench codec exits 1 if a decoded frame differs from the encoder's input.
     const fs::path json = mDir / "codec.json";
     std::string err;
-    ASSERT_EQ(run(std::string("codec --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --updates 3 "
-                  "--json " + json.string(), err), 0) << err;
+    ASSERT_EQ(run(std::string("codec --scene ") + PIC_TEST_SCENE_DIR +
+                      "/cornell.gltf --updates 3 "
+                      "--zstd-levels 1 19 --json " +
+                      json.string(),
+                  err),
+              0)
+        << err;
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);
-    const double key = report.at("key_bits_per_value_median").get<double>();
-    const double delta = report.at("delta_bits_per_value_median").get<double>();
-    EXPECT_GT(key, 0.0);
-    EXPECT_LT(key, 16.0);  // below raw halves
-    EXPECT_GT(delta, 0.0);
-    EXPECT_LT(delta, key);
+    const nlohmann::json& levels = report.at("levels");
+    ASSERT_EQ(levels.size(), 2u);
+    for (const nlohmann::json& level : levels) {
+        const double key = level.at("key_bits_per_value_median").get<double>();
+        const double delta = level.at("delta_bits_per_value_median").get<double>();
+        EXPECT_GT(key, 0.0);
+        EXPECT_LT(key, 16.0);  // below raw halves
+        EXPECT_GT(delta, 0.0);
+        EXPECT_LT(delta, key);
+    }
+    // zstd's strongest level codes the same frames smaller than its fastest.
+    EXPECT_LT(levels[1].at("key_bits_per_value_median").get<double>(),
+              levels[0].at("key_bits_per_value_median").get<double>());
     EXPECT_EQ(report.at("frames").size(), 4u);
+    EXPECT_EQ(report.at("frames")[3].at("levels").size(), 2u);
+    EXPECT_TRUE(fs::exists(mDir / "codec.png"));
 }
 
 TEST_F(PicbenchRuntime, RefusesAnUnknownChange) {
