@@ -6,7 +6,6 @@
 #include "bench/bench_common.h"
 #include "core/frame_codec.h"
 #include "server/cpu/cpu_runtime.h"
-#include "server/encoder.h"
 #include "server/gpu/gpu_runtime.h"
 
 namespace pic {
@@ -39,27 +38,22 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
         runtime = std::move(*cpu);
     }
 
-    const double cacheCoefficients =
-        double(bake->caches.size()) *
-        double(bake->params.bandsY * bake->params.bandsY + 2 * bake->params.bandsC * bake->params.bandsC);
+    const double values =
+        double(bake->caches.size()) * double(bake->params.bandsY * bake->params.bandsY +
+                                             2 * bake->params.bandsC * bake->params.bandsC);
     const float step = 1e-3f * scene.bounds.diagonal();
     // Per zstd level, over the updates after the first (whose delta has no base).
     struct LevelSamples {
-        std::vector<double> keyBits, deltaBits, keyCacheBits, deltaCacheBits, keyMs, deltaMs,
-            decodeMs;
+        std::vector<double> keyBits, deltaBits, keyMs, deltaMs, decodeMs;
     };
     std::vector<LevelSamples> samples(params.zstdLevels.size());
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     HalfFrame previous;
-    double values = 0.0;
     for (int k = 0; k <= params.updates; ++k) {
         std::fprintf(stderr, "picbench: update %d of %d\n", k, params.updates);
-        if (auto caches = runtime->setLights(changedLights(inputs->lights, k, step, params.change)); !caches)
-            return reportError(caches.error());
-        auto textures = runtime->textures();
-        if (!textures) return reportError(textures.error());
-        const HalfFrame frame = halfFrameOf(**textures);
-        values = double(frameValues(frame));
+        auto caches = runtime->setLights(changedLights(inputs->lights, k, step, params.change));
+        if (!caches) return reportError(caches.error());
+        const HalfFrame frame = halfFrameOf(**caches);
 
         nlohmann::ordered_json row{{"update", k}, {"levels", nlohmann::ordered_json::array()}};
         for (size_t i = 0; i < params.zstdLevels.size(); ++i) {
@@ -91,8 +85,6 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
                 }
                 sampled.keyBits.push_back(8.0 * double(key->bytes()) / values);
                 sampled.deltaBits.push_back(8.0 * double(delta->bytes()) / values);
-                sampled.keyCacheBits.push_back(8.0 * double(key->bytes()) / cacheCoefficients);
-                sampled.deltaCacheBits.push_back(8.0 * double(delta->bytes()) / cacheCoefficients);
                 sampled.keyMs.push_back(keyMs);
                 sampled.deltaMs.push_back(deltaMs);
                 sampled.decodeMs.push_back(decodeMs);
@@ -106,38 +98,35 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
         previous = frame;
     }
 
-    std::printf("medians over %d updates; bits per texture value (per unique cache coefficient)\n",
-                params.updates);
-    std::printf("%5s %15s %15s %13s %15s %10s\n", "zstd", "key bits", "delta bits", "key enc ms",
-                "delta enc ms", "decode ms");
+    std::printf("medians over %d updates\n", params.updates);
+    std::printf("%5s %8s %10s %14s %16s %11s %13s %9s\n", "zstd", "key kB", "delta kB",
+                "key bits/coef", "delta bits/coef", "key enc ms", "delta enc ms", "decode ms");
     nlohmann::ordered_json levels = nlohmann::ordered_json::array();
     Chart chart;
     chart.title = fmt::format("Stream frame size against encode time per zstd level, {} {}",
                               params.setting, params.linkMode);
     chart.xLabel = "encode ms (median)";
-    chart.yLabel = "bits per texture value (median)";
+    chart.yLabel = "bits per cache coefficient (median)";
     chart.logX = true;
     ChartSeries keySeries{"key frames", {0.2f, 0.35f, 0.75f}},
         deltaSeries{"delta frames", {0.85f, 0.45f, 0.1f}};
     for (size_t i = 0; i < params.zstdLevels.size(); ++i) {
         const LevelSamples& level = samples[i];
+        const double keyBits = median(level.keyBits), deltaBits = median(level.deltaBits);
         nlohmann::ordered_json entry;
         entry["zstd_level"] = params.zstdLevels[i];
-        entry["key_bits_per_value_median"] = median(level.keyBits);
-        entry["delta_bits_per_value_median"] = median(level.deltaBits);
-        entry["key_bits_per_cache_coefficient_median"] = median(level.keyCacheBits);
-        entry["delta_bits_per_cache_coefficient_median"] = median(level.deltaCacheBits);
+        entry["key_bits_per_coefficient_median"] = keyBits;
+        entry["delta_bits_per_coefficient_median"] = deltaBits;
         entry["key_encode_ms_median"] = median(level.keyMs);
         entry["delta_encode_ms_median"] = median(level.deltaMs);
         entry["delta_decode_ms_median"] = median(level.decodeMs);
-        std::printf("%5d %7.2f (%5.2f) %7.2f (%5.2f) %13.2f %15.2f %10.2f\n", params.zstdLevels[i],
-                    median(level.keyBits), median(level.keyCacheBits), median(level.deltaBits),
-                    median(level.deltaCacheBits), median(level.keyMs), median(level.deltaMs),
-                    median(level.decodeMs));
+        std::printf("%5d %8.1f %10.1f %14.2f %16.2f %11.2f %13.2f %9.2f\n", params.zstdLevels[i],
+                    keyBits * values / 8e3, deltaBits * values / 8e3, keyBits, deltaBits,
+                    median(level.keyMs), median(level.deltaMs), median(level.decodeMs));
         const std::string label = fmt::format("zstd {}", params.zstdLevels[i]);
-        keySeries.points.push_back({median(level.keyMs), median(level.keyBits)});
+        keySeries.points.push_back({median(level.keyMs), keyBits});
         keySeries.labels.push_back(label);
-        deltaSeries.points.push_back({median(level.deltaMs), median(level.deltaBits)});
+        deltaSeries.points.push_back({median(level.deltaMs), deltaBits});
         deltaSeries.labels.push_back(label);
         levels.push_back(std::move(entry));
     }
@@ -151,11 +140,9 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
     json["link_mode"] = params.linkMode;
     json["backend"] = runtime->name();
     json["change"] = params.change;
-
     json["caches"] = bake->caches.size();
     json["bands"] = {{"y", bake->params.bandsY}, {"c", bake->params.bandsC}};
-    json["texture_values_per_frame"] = values;
-    json["cache_coefficients"] = cacheCoefficients;
+    json["coefficients_per_frame"] = values;
     json["levels"] = std::move(levels);
     json["frames"] = std::move(frames);
     const int written = writeJson(json, params.jsonPath);

@@ -1,10 +1,9 @@
 #pragma once
 /// `picbench codec`: what the stream costs per frame. Bakes the scene at a paper 000 Table 2
-/// setting, runs `updates` light changes on one runtime backend, turns each update's cache
-/// textures into the stream's half planes and encodes them as a key frame and as a delta
-/// from the previous update, at each of several zstd levels. Prints per level the median
-/// bits per SH coefficient (over the texture values the frame carries, and over the unique
-/// caches' coefficients) and encode and decode ms, and checks that decoding gives back the
+/// setting, runs `updates` light changes on one runtime backend, turns each update's caches
+/// into the stream's half planes and encodes them as a key frame and as a delta from the
+/// previous update, at each of several zstd levels. Prints per level the median bytes, bits
+/// per cache coefficient and encode and decode ms, and checks that decoding gives back the
 /// encoder's input exactly (exit 1 if not). Writes JSON and, beside it, a PNG chart of size
 /// against encode time, one point per level.
 

@@ -117,10 +117,10 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
     auto connection = PicConnection::connect(server.address);
     if (!connection) return reportError(connection.error());
 
+    // A frame's values: every cache's SH coefficients (core/frame_codec.h).
     const double values = [&] {
         const double lY = bake->params.bandsY, lC = bake->params.bandsC;
-        const double texels = double(bake->grid.cacheIndex.size() + bake->lightmap.cacheIndex.size());
-        return texels * (lY * lY + 2.0 * lC * lC);
+        return double(bake->caches.size()) * (lY * lY + 2.0 * lC * lC);
     }();
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::printf("%8s %8s %9s %9s %9s %9s %10s %10s %12s %11s %11s %10s %10s %8s\n", "clients",

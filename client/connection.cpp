@@ -10,6 +10,7 @@
 
 #include "core/color.h"
 #include "core/gltf_loader.h"
+#include "core/sh.h"
 #include "proto/wire.h"
 
 namespace pic {
@@ -221,6 +222,22 @@ Result<std::string> readAsset(const fs::path& folder, const std::string& name) {
 }
 
 /// Loads the scene and layout kept in `folder` for `header`.
+/// An index map asset: `entries` little-endian u32, each a cache below `caches` or kNoCache.
+Result<std::vector<uint32_t>> readIndexMap(const fs::path& folder, const std::string& name,
+                                           uint64_t entries, uint32_t caches) {
+    PIC_TRY_ASSIGN(std::string bytes, readAsset(folder, name));
+    if (bytes.size() != entries * sizeof(uint32_t))
+        return fail(ErrorCode::Corrupt, "{} holds {} bytes for {} entries of 4", name, bytes.size(),
+                    entries);
+    std::vector<uint32_t> map(entries);
+    if (!map.empty()) std::memcpy(map.data(), bytes.data(), bytes.size());
+    for (size_t i = 0; i < map.size(); ++i)
+        if (map[i] != kNoCache && map[i] >= caches)
+            return fail(ErrorCode::Corrupt, "{} entry {} names cache {} of {}", name, i, map[i],
+                        caches);
+    return map;
+}
+
 Result<ClientScene> loadClientScene(const fs::path& folder, const v1::SceneHeader& header) {
     ClientScene client;
     client.header = header;
@@ -238,17 +255,18 @@ Result<ClientScene> loadClientScene(const fs::path& folder, const v1::SceneHeade
                     uvs.size(), client.scene.triangles.size());
     client.triangleUvs.resize(client.scene.triangles.size() * 3);
     if (!uvs.empty()) std::memcpy(client.triangleUvs.data(), uvs.data(), uvs.size());
-    PIC_TRY_ASSIGN(std::string grid, readAsset(folder, "layout/grid_coverage"));
-    PIC_TRY_ASSIGN(std::string lightmap, readAsset(folder, "layout/lightmap_coverage"));
+    const uint32_t bandsY = header.bands_y(), bandsC = header.bands_c();
+    if (bandsY < 1 || bandsY > uint32_t(kMaxShBands) || bandsC > bandsY)
+        return fail(ErrorCode::Corrupt,
+                    "the header's band counts {} (luma) and {} (chroma) are out of range", bandsY,
+                    bandsC);
     const uint64_t vertices =
         uint64_t(header.grid().dims_x()) * header.grid().dims_y() * header.grid().dims_z();
     const uint64_t texels = uint64_t(header.lightmap_width()) * header.lightmap_height();
-    if (grid.size() != vertices || lightmap.size() != texels)
-        return fail(ErrorCode::Corrupt,
-                    "coverage of {} grid vertices and {} texels for a layout of {} and {}",
-                    grid.size(), lightmap.size(), vertices, texels);
-    client.gridCoverage.assign(grid.begin(), grid.end());
-    client.lightmapCoverage.assign(lightmap.begin(), lightmap.end());
+    PIC_TRY_ASSIGN(client.gridCaches,
+                   readIndexMap(folder, "layout/grid_caches", vertices, header.caches()));
+    PIC_TRY_ASSIGN(client.lightmapCaches,
+                   readIndexMap(folder, "layout/lightmap_caches", texels, header.caches()));
     return client;
 }
 
@@ -314,7 +332,7 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
     if (encoded.key()) {
         // A key frame sets the sizes; decode into a copy so a corrupt one changes nothing.
         HalfFrame decoded;
-        for (int t = 0; t < kFrameTextures; ++t)
+        for (int t = 0; t < kFramePlanes; ++t)
             decoded.planes[size_t(t)].resize(encoded.planes[size_t(t)].values);
         PIC_TRY(decodeFrame(encoded, decoded));
         mFrame = std::move(decoded);
@@ -325,35 +343,19 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
     return {};
 }
 
+CacheIndexMaps ClientScene::indexMaps() const {
+    return CacheIndexMaps{
+        glm::uvec3(header.grid().dims_x(), header.grid().dims_y(), header.grid().dims_z()),
+        gridCaches, header.lightmap_width(), header.lightmap_height(), lightmapCaches};
+}
+
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame) {
     const v1::SceneHeader& header = scene.header;
-    CacheTextures textures;
-    textures.bandsY = header.bands_y();
-    textures.bandsC = header.bands_c();
-    textures.gridDims = glm::uvec3(header.grid().dims_x(), header.grid().dims_y(),
-                                   header.grid().dims_z());
-    textures.lightmapWidth = header.lightmap_width();
-    textures.lightmapHeight = header.lightmap_height();
-    const size_t vertices = scene.gridCoverage.size();
-    const size_t texels = scene.lightmapCoverage.size();
-    for (int ch = 0; ch < 3; ++ch) {
-        const std::vector<uint16_t>& grid = frame.planes[size_t(ch)];
-        const std::vector<uint16_t>& lightmap = frame.planes[size_t(3 + ch)];
-        const size_t layers = textures.layers(ch);
-        if (grid.size() != layers * vertices || lightmap.size() != layers * texels)
-            return fail(ErrorCode::InvalidInput,
-                        "frame planes {} and {} hold {} and {} values; the layout needs {} × {} "
-                        "and {} × {}",
-                        frameTextureName(ch), frameTextureName(3 + ch), grid.size(),
-                        lightmap.size(), layers, vertices, layers, texels);
-        textures.grid[size_t(ch)].resize(grid.size());
-        for (size_t i = 0; i < grid.size(); ++i) textures.grid[size_t(ch)][i] = halfToFloat(grid[i]);
-        textures.lightmap[size_t(ch)].resize(lightmap.size());
-        for (size_t i = 0; i < lightmap.size(); ++i)
-            textures.lightmap[size_t(ch)][i] = halfToFloat(lightmap[i]);
-    }
-    textures.gridCoverage.assign(scene.gridCoverage.begin(), scene.gridCoverage.end());
-    textures.lightmapCoverage.assign(scene.lightmapCoverage.begin(), scene.lightmapCoverage.end());
+    PIC_TRY_ASSIGN(CacheValues values,
+                   cacheValuesOf(frame, header.caches(), header.bands_y(), header.bands_c()));
+    const CacheIndexMaps maps = scene.indexMaps();
+    CacheTextures textures = makeCacheTextures(maps, header.bands_y(), header.bands_c());
+    copyCachesToTextures(maps, values, textures);
     return textures;
 }
 

@@ -28,8 +28,11 @@ struct ClientScene {
     std::string folder;                     ///< where the assets were written
     Scene scene;
     std::vector<glm::vec2> triangleUvs;     ///< 3 light-map UVs per triangle (kNotLightmapped: grid)
-    std::vector<uint8_t> gridCoverage;      ///< 1 per grid vertex that holds a cache
-    std::vector<uint8_t> lightmapCoverage;  ///< 1 per light-map texel that holds a cache
+    std::vector<uint32_t> gridCaches;       ///< per grid vertex its cache, kNoCache for none
+    std::vector<uint32_t> lightmapCaches;   ///< per light-map texel its cache, kNoCache for none
+
+    /// Where a frame's caches go in the textures (views into this scene).
+    CacheIndexMaps indexMaps() const;
 };
 
 /// One Subscribe call: frames as they arrive, until the stream ends or is cancelled.
@@ -109,8 +112,10 @@ private:
     uint64_t mVersion = 0;
 };
 
-/// The textures of `frame` for `scene`: halves widened to floats, coverage from the layout.
-/// InvalidInput when the frame's planes do not match the scene's layout and band counts.
+/// The textures of `frame` for `scene`: its caches, halves widened to floats, written into
+/// every grid vertex and light-map texel that holds them (server/cpu/lightmap_copy.h), with
+/// coverage from the index maps. InvalidInput when the frame's planes do not hold the
+/// scene's caches and band counts.
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);
 
 /// The renderer's layout (client/renderer.h) of a downloaded scene.

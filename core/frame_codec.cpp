@@ -4,6 +4,9 @@
 
 #include <zstd.h>
 
+#include "core/color.h"
+#include "core/sh.h"
+
 namespace pic {
 namespace {
 
@@ -50,10 +53,9 @@ void untransform(std::span<const uint8_t> bytes, bool delta, std::span<uint16_t>
 
 }  // namespace
 
-const char* frameTextureName(int texture) {
-    static const char* const kNames[kFrameTextures] = {"grid_y",     "grid_co",     "grid_cg",
-                                                       "lightmap_y", "lightmap_co", "lightmap_cg"};
-    return texture >= 0 && texture < kFrameTextures ? kNames[texture] : "unknown";
+const char* framePlaneName(int plane) {
+    static const char* const kNames[kFramePlanes] = {"cache_y", "cache_co", "cache_cg"};
+    return plane >= 0 && plane < kFramePlanes ? kNames[plane] : "unknown";
 }
 
 size_t EncodedFrame::bytes() const {
@@ -76,15 +78,14 @@ Result<EncodedFrame> encodeFrame(const HalfFrame& frame, const HalfFrame* base, 
         ZSTD_isError(ZSTD_CCtx_setParameter(context.get(), ZSTD_c_checksumFlag, 1)))
         return fail(ErrorCode::Internal, "zstd: could not set up compression at level {}", zstdLevel);
     EncodedFrame encoded;
-    for (int t = 0; t < kFrameTextures; ++t) {
+    for (int t = 0; t < kFramePlanes; ++t) {
         const std::vector<uint16_t>& plane = frame.planes[t];
         if (plane.size() > UINT32_MAX / 2)
             return fail(ErrorCode::InvalidInput, "frame plane {} has {} values, too many",
-                        frameTextureName(t), plane.size());
+                        framePlaneName(t), plane.size());
         if (base && base->planes[t].size() != plane.size())
-            return fail(ErrorCode::InvalidInput,
-                        "frame plane {} has {} values but its base has {}", frameTextureName(t),
-                        plane.size(), base->planes[t].size());
+            return fail(ErrorCode::InvalidInput, "frame plane {} has {} values but its base has {}",
+                        framePlaneName(t), plane.size(), base->planes[t].size());
         const std::vector<uint8_t> raw = transform(plane, base ? base->planes[t].data() : nullptr);
         EncodedPlane& out = encoded.planes[t];
         out.encoding = base ? PlaneEncoding::Delta : PlaneEncoding::Key;
@@ -94,7 +95,7 @@ Result<EncodedFrame> encodeFrame(const HalfFrame& frame, const HalfFrame* base, 
                                            raw.data(), raw.size());
         if (ZSTD_isError(size))
             return fail(ErrorCode::Internal, "zstd could not compress plane {}: {}",
-                        frameTextureName(t), ZSTD_getErrorName(size));
+                        framePlaneName(t), ZSTD_getErrorName(size));
         out.bytes.resize(size);
     }
     return encoded;
@@ -103,10 +104,10 @@ Result<EncodedFrame> encodeFrame(const HalfFrame& frame, const HalfFrame* base, 
 Result<void> decodeFrame(const EncodedFrame& encoded, HalfFrame& frame) {
     // Decompress and check every plane before touching `frame`, so that a bad frame leaves
     // the receiver's state as it was.
-    std::array<std::vector<uint8_t>, kFrameTextures> raw;
-    for (int t = 0; t < kFrameTextures; ++t) {
+    std::array<std::vector<uint8_t>, kFramePlanes> raw;
+    for (int t = 0; t < kFramePlanes; ++t) {
         const EncodedPlane& plane = encoded.planes[t];
-        const char* name = frameTextureName(t);
+        const char* name = framePlaneName(t);
         if (plane.encoding != PlaneEncoding::Key && plane.encoding != PlaneEncoding::Delta)
             return fail(ErrorCode::Corrupt, "frame plane {}: unknown encoding {}", name,
                         int(plane.encoding));
@@ -129,9 +130,55 @@ Result<void> decodeFrame(const EncodedFrame& encoded, HalfFrame& frame) {
             return fail(ErrorCode::Corrupt, "frame plane {}: decompressed {} bytes, expected {}",
                         name, size, expected);
     }
-    for (int t = 0; t < kFrameTextures; ++t)
+    for (int t = 0; t < kFramePlanes; ++t)
         untransform(raw[t], encoded.planes[t].encoding == PlaneEncoding::Delta, frame.planes[t]);
     return {};
+}
+
+HalfFrame halfFrameOf(const CacheValues& values) {
+    HalfFrame frame;
+    const size_t caches = values.cacheCount();
+    const std::array<const std::vector<float>*, kFramePlanes> channels = {&values.y, &values.co,
+                                                                          &values.cg};
+    for (int ch = 0; ch < kFramePlanes; ++ch) {
+        // Cache-major in, coefficient-major out.
+        const std::vector<float>& source = *channels[size_t(ch)];
+        const size_t count = caches ? source.size() / caches : 0;
+        std::vector<uint16_t>& plane = frame.planes[size_t(ch)];
+        plane.resize(source.size());
+        for (size_t c = 0; c < caches; ++c)
+            for (size_t k = 0; k < count; ++k)
+                plane[k * caches + c] = floatToHalfClamped(source[c * count + k]);
+    }
+    return frame;
+}
+
+Result<CacheValues> cacheValuesOf(const HalfFrame& frame, size_t caches, uint32_t bandsY,
+                                  uint32_t bandsC) {
+    if (bandsY < 1 || bandsY > uint32_t(kMaxShBands) || bandsC > bandsY)
+        return fail(ErrorCode::InvalidInput, "frame: {} luma and {} chroma bands are out of range",
+                    bandsY, bandsC);
+    CacheValues values = CacheValues::zeros(caches, bandsY, bandsC);
+    std::array<std::vector<float>*, kFramePlanes> channels = {&values.y, &values.co, &values.cg};
+    for (int ch = 0; ch < kFramePlanes; ++ch) {
+        std::vector<float>& target = *channels[size_t(ch)];
+        const std::vector<uint16_t>& plane = frame.planes[size_t(ch)];
+        const size_t count = ch == 0 ? size_t{bandsY} * bandsY : size_t{bandsC} * bandsC;
+        if (plane.size() != target.size())
+            return fail(ErrorCode::InvalidInput,
+                        "frame plane {} holds {} values; {} caches × {} coefficients need {}",
+                        framePlaneName(ch), plane.size(), caches, count, target.size());
+        for (size_t c = 0; c < caches; ++c)
+            for (size_t k = 0; k < count; ++k)
+                target[c * count + k] = halfToFloat(plane[k * caches + c]);
+    }
+    return values;
+}
+
+size_t frameValues(const HalfFrame& frame) {
+    size_t values = 0;
+    for (const auto& plane : frame.planes) values += plane.size();
+    return values;
 }
 
 }  // namespace pic

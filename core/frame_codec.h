@@ -1,15 +1,20 @@
 #pragma once
-/// The frame codec: one version's cache textures, as half floats, compressed for the stream
-/// (paper 001's YCoCg split is already in the textures: Y with lY² layers, Co and Cg with
-/// lC²). Lossless: decoding reproduces the encoder's half-float input bit for bit.
+/// The frame codec: one version's caches, as half floats, compressed for the stream (paper
+/// 001's YCoCg split: Y with lY² coefficients per cache, Co and Cg with lC²). Lossless:
+/// decoding reproduces the encoder's half-float input bit for bit.
 ///
-/// Each of the six planes (grid and light map × Y, Co, Cg; server/cpu/lightmap_copy.h
-/// layout) is coded on its own:
+/// A frame holds the unique caches, not the textures renderers sample: the thin client
+/// writes them into its textures through the index maps it downloaded with the scene
+/// (server/cpu/lightmap_copy.h), which hold most caches more than once. Each of the three
+/// planes (Y, Co, Cg) is coefficient-major, coefficient k of cache c at k·nC + c, so that
+/// neighbouring values are the same coefficient of neighbouring caches; each is coded on
+/// its own:
 ///   1. each half's bit pattern h becomes its rank o(h) in float order (negative values
 ///      reversed), so that nearby values have nearby ranks across zero;
-///   2. key planes take the difference from the previous value in the plane (neighbouring
-///      texels are alike), delta planes the difference from the same value in the base
-///      version (a light change moves most values a little); differences wrap mod 2¹⁶;
+///   2. key planes take the difference from the previous value in the plane (caches placed
+///      one after another are mostly near each other), delta planes the difference from the
+///      same value in the base version (a light change moves most values a little);
+///      differences wrap mod 2¹⁶;
 ///   3. differences are zigzagged (small negatives become small positives) and split into
 ///      a plane of low bytes followed by a plane of high bytes, mostly zero;
 ///   4. zstd.
@@ -22,21 +27,22 @@
 #include <string>
 #include <vector>
 
+#include "core/cache_values.h"
 #include "core/error.h"
 
 namespace pic {
 
-/// The planes of a frame, in wire order.
-enum class FrameTexture : uint8_t { GridY, GridCo, GridCg, LightmapY, LightmapCo, LightmapCg };
-inline constexpr int kFrameTextures = 6;
+/// The planes of a frame, in wire order: the caches' Y, Co and Cg coefficients.
+enum class FramePlane : uint8_t { CacheY, CacheCo, CacheCg };
+inline constexpr int kFramePlanes = 3;
 
-/// "grid_y", "lightmap_cg", … for logs and messages.
-const char* frameTextureName(int texture);
+/// "cache_y", "cache_co", "cache_cg" for logs and messages.
+const char* framePlaneName(int plane);
 
 /// Every plane of one version as half-float bit patterns: what the encoder takes and the
 /// decoder reproduces.
 struct HalfFrame {
-    std::array<std::vector<uint16_t>, kFrameTextures> planes;
+    std::array<std::vector<uint16_t>, kFramePlanes> planes;
 
     bool operator==(const HalfFrame&) const = default;
 };
@@ -53,7 +59,7 @@ struct EncodedPlane {
 };
 
 struct EncodedFrame {
-    std::array<EncodedPlane, kFrameTextures> planes;
+    std::array<EncodedPlane, kFramePlanes> planes;
 
     /// Compressed bytes over all planes.
     size_t bytes() const;
@@ -68,6 +74,19 @@ inline constexpr int kDefaultZstdLevel = 3;
 /// planes must have the same sizes (InvalidInput naming the plane otherwise).
 Result<EncodedFrame> encodeFrame(const HalfFrame& frame, const HalfFrame* base,
                                  int zstdLevel = kDefaultZstdLevel);
+
+/// The caches' three coefficient planes (Y, Co, Cg; layout above) as half floats, saturated
+/// to ±65504 so that no infinity reaches a client. The GPU writes halves already, so this
+/// loses nothing there.
+HalfFrame halfFrameOf(const CacheValues& values);
+
+/// The caches again from the planes, halves widened to floats: what a client holds.
+/// InvalidInput naming the plane when a plane does not hold `caches` × its coefficients.
+Result<CacheValues> cacheValuesOf(const HalfFrame& frame, size_t caches, uint32_t bandsY,
+                                  uint32_t bandsC);
+
+/// Values over all three planes: lY² + 2·lC² SH coefficients per cache.
+size_t frameValues(const HalfFrame& frame);
 
 /// Decodes `encoded` into `frame`, whose planes already have their sizes (from the scene's
 /// layout): a key plane replaces its plane, a delta plane applies to it, which must hold the

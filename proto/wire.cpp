@@ -121,10 +121,10 @@ Result<LightSet> fromProto(const v1::LightSet& lights) {
 
 void toProto(const EncodedFrame& encoded, v1::Frame& frame) {
     frame.clear_planes();
-    for (int t = 0; t < kFrameTextures; ++t) {
+    for (int t = 0; t < kFramePlanes; ++t) {
         const EncodedPlane& plane = encoded.planes[size_t(t)];
         v1::Plane& wire = *frame.add_planes();
-        wire.set_texture(v1::Texture(t));
+        wire.set_channel(v1::Channel(t));
         wire.set_encoding(plane.encoding == PlaneEncoding::Key ? v1::KEY : v1::DELTA);
         wire.set_values(plane.values);
         wire.set_data(plane.bytes.data(), plane.bytes.size());
@@ -132,15 +132,16 @@ void toProto(const EncodedFrame& encoded, v1::Frame& frame) {
 }
 
 Result<EncodedFrame> planesFromProto(v1::Frame& frame) {
-    if (frame.planes_size() != kFrameTextures)
+    if (frame.planes_size() != kFramePlanes)
         return fail(ErrorCode::Corrupt, "frame of version {} has {} planes, expected {}",
-                    frame.version(), frame.planes_size(), kFrameTextures);
+                    frame.version(), frame.planes_size(), kFramePlanes);
     EncodedFrame encoded;
-    for (int t = 0; t < kFrameTextures; ++t) {
+    for (int t = 0; t < kFramePlanes; ++t) {
         v1::Plane& wire = *frame.mutable_planes(t);
-        if (wire.texture() != v1::Texture(t))
-            return fail(ErrorCode::Corrupt, "frame of version {}: plane {} is texture {}, expected {}",
-                        frame.version(), t, int(wire.texture()), frameTextureName(t));
+        if (wire.channel() != v1::Channel(t))
+            return fail(ErrorCode::Corrupt,
+                        "frame of version {}: plane {} is channel {}, expected {}", frame.version(),
+                        t, int(wire.channel()), framePlaneName(t));
         EncodedPlane& plane = encoded.planes[size_t(t)];
         if (wire.encoding() == v1::KEY)
             plane.encoding = PlaneEncoding::Key;
@@ -148,7 +149,7 @@ Result<EncodedFrame> planesFromProto(v1::Frame& frame) {
             plane.encoding = PlaneEncoding::Delta;
         else
             return fail(ErrorCode::Corrupt, "frame of version {}: plane {} has encoding {}",
-                        frame.version(), frameTextureName(t), int(wire.encoding()));
+                        frame.version(), framePlaneName(t), int(wire.encoding()));
         plane.values = wire.values();
         const std::string& data = wire.data();
         plane.bytes.assign(data.begin(), data.end());

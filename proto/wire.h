@@ -21,10 +21,10 @@ v1::LightSet toProto(const LightSet& lights);
 /// naming the offending field ("lights[2].intensity") and value: InvalidInput.
 Result<LightSet> fromProto(const v1::LightSet& lights);
 
-/// The six planes of an encoded frame into `frame` (other fields untouched).
+/// The planes of an encoded frame into `frame` (other fields untouched).
 void toProto(const EncodedFrame& encoded, v1::Frame& frame);
 
-/// The planes of a wire frame: Corrupt when there are not six, in texture order, with known
+/// The planes of a wire frame: Corrupt when there are not three, in channel order, with known
 /// encodings. The bytes are moved out of `frame`.
 Result<EncodedFrame> planesFromProto(v1::Frame& frame);
 

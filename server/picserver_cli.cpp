@@ -169,15 +169,13 @@ int picserverMain(int argc, char** argv) {
         const v1::BakeSummary& summary = (*bake)->summary();
         std::fprintf(stderr,
                      "picserver: bake %s: %s, %u triangles, %u surfels, %u caches × %u %s links, "
-                     "%s backend%s%s%s%s%s%s, loaded in %.1f s (a first update %.0f ms of it)\n",
+                     "%s backend%s%s%s%s, loaded in %.1f s (a first update %.0f ms of it)\n",
                      summary.bake_id().c_str(), summary.scene_name().c_str(), summary.triangles(),
                      summary.surfels(), summary.caches(), summary.links_per_cache(),
                      summary.link_mode().c_str(), serve.backend.c_str(),
                      (*bake)->device().empty() ? "" : " on ", (*bake)->device().c_str(),
                      (*bake)->directVisibility().empty() ? "" : ", direct visibility by ",
                      (*bake)->directVisibility().c_str(),
-                     (*bake)->lightmapCopy().empty() ? "" : ", light-map copy on the ",
-                     (*bake)->lightmapCopy().c_str(),
                      std::chrono::duration<double>(Clock::now() - start).count(),
                      (*bake)->warmUpMs());
         bakes.push_back(std::move(*bake));

@@ -12,7 +12,6 @@
 #include "core/hash.h"
 #include "core/light_set.h"
 #include "server/cpu/cpu_runtime.h"
-#include "server/encoder.h"
 #include "server/gpu/gpu_runtime.h"
 
 namespace pic {
@@ -33,12 +32,6 @@ template <class T>
 std::string bytesOf(const std::vector<T>& values) {
     std::string bytes(values.size() * sizeof(T), '\0');
     if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
-    return bytes;
-}
-
-std::string coverageBytes(const std::vector<uint32_t>& cacheIndex) {
-    std::string bytes(cacheIndex.size(), '\0');
-    for (size_t i = 0; i < cacheIndex.size(); ++i) bytes[i] = cacheIndex[i] != kNoCache ? 1 : 0;
     return bytes;
 }
 
@@ -69,7 +62,6 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
                                                     options.bounces, gpuOptions));
         served->mDevice = gpu->context().deviceName();
         served->mDirectVisibility = gpu::directVisibilityName(gpu->directVisibility());
-        served->mLightmapCopy = gpu->lightmapCopyOnHost() ? "host" : "device";
         served->mRuntime = std::move(gpu);
     } else if (options.backend == "cpu") {
         PIC_TRY_ASSIGN(served->mRuntime, createCpuRuntime(served->mScene, *served->mRays,
@@ -110,6 +102,7 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
     grid.set_dims_z(mBake.grid.dims.z);
     header.set_lightmap_width(mBake.lightmap.width);
     header.set_lightmap_height(mBake.lightmap.height);
+    header.set_caches(uint32_t(mBake.caches.size()));
 
     const auto add = [&](std::string name, std::string bytes) {
         v1::AssetInfo& asset = *header.add_assets();
@@ -126,8 +119,8 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
         add("scene/" + file, std::move(bytes));
     }
     add("layout/triangle_uvs", bytesOf(mBake.lightmap.triangleUvs));
-    add("layout/grid_coverage", coverageBytes(mBake.grid.cacheIndex));
-    add("layout/lightmap_coverage", coverageBytes(mBake.lightmap.cacheIndex));
+    add("layout/grid_caches", bytesOf(mBake.grid.cacheIndex));
+    add("layout/lightmap_caches", bytesOf(mBake.lightmap.cacheIndex));
     return {};
 }
 
@@ -135,7 +128,6 @@ Result<void> ServedBake::warmUp() {
     const auto start = std::chrono::steady_clock::now();
     UpdateStats stats;
     PIC_TRY(mRuntime->setLights(defaultLightSet(mScene), &stats));
-    PIC_TRY(mRuntime->textures());
     mWarmUpMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return {};
@@ -143,13 +135,8 @@ Result<void> ServedBake::warmUp() {
 
 Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame) {
     std::lock_guard lock(mRuntimeMutex);
-    PIC_TRY(mRuntime->setLights(lights, &stats));
-    const auto start = std::chrono::steady_clock::now();
-    PIC_TRY_ASSIGN(const CacheTextures* textures, mRuntime->textures());
-    frame = halfFrameOf(*textures);
-    // Host time, beside the passes' device times: reading the textures back to the host.
-    stats.passMs["readback"] =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    PIC_TRY_ASSIGN(const CacheValues* values, mRuntime->setLights(lights, &stats));
+    frame = halfFrameOf(*values);
     return {};
 }
 

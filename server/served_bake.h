@@ -54,9 +54,6 @@ public:
     /// Where the GPU backend's direct visibility comes from ("shadow-maps", "rays"), empty
     /// for the CPU twin (which traces rays).
     const std::string& directVisibility() const { return mDirectVisibility; }
-    /// Where the GPU backend copies the caches into the textures ("host", "device"), empty
-    /// for the CPU twin (which copies on the host).
-    const std::string& lightmapCopy() const { return mLightmapCopy; }
 
     /// Milliseconds of the update run at load (see warmUp).
     double warmUpMs() const { return mWarmUpMs; }
@@ -82,7 +79,6 @@ private:
     std::mutex mRuntimeMutex;
     std::string mDevice;
     std::string mDirectVisibility;
-    std::string mLightmapCopy;
     double mWarmUpMs = 0.0;
     v1::BakeSummary mSummary;
     v1::SceneHeader mHeader;

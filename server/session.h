@@ -34,12 +34,12 @@ namespace pic {
 
 class ServedBake;
 
-/// One computed version: its textures as halves and its frames on the wire.
+/// One computed version: its caches as halves and its frames on the wire.
 class Update {
 public:
     uint64_t version = 0;
     uint64_t baseVersion = 0;               ///< what `broadcast` applies to; 0 when it is a key frame
-    std::shared_ptr<const HalfFrame> frame; ///< the textures, kept while anyone may need a key frame
+    std::shared_ptr<const HalfFrame> frame;  ///< the caches, kept while anyone may need a key frame
     std::shared_ptr<const v1::Frame> broadcast;
     UpdateStats stats;
     double encodeMs = 0.0;

@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -44,13 +45,32 @@ struct CacheTextures {
     uint32_t layers(int ch) const { return ch == 0 ? bandsY * bandsY : bandsC * bandsC; }
 };
 
-/// Textures sized for `bake`, coefficients zero, coverage written (it depends on the bake
-/// only, so it is uploaded once).
+/// Where the caches go in the textures: the bake's index maps (GridLayout::cacheIndex,
+/// LightmapLayout::cacheIndex), kNoCache where a vertex or texel holds none. The server has
+/// them in its bake; a thin client downloads them with the scene.
+struct CacheIndexMaps {
+    glm::uvec3 gridDims{0u};
+    std::span<const uint32_t> grid;  ///< dims.x·dims.y·dims.z, GridLayout vertex order
+    uint32_t lightmapWidth = 0;
+    uint32_t lightmapHeight = 0;
+    std::span<const uint32_t> lightmap;  ///< width·height, LightmapLayout texel order
+};
+
+/// The index maps of `bake` (views into it).
+CacheIndexMaps cacheIndexMapsOf(const BakeData& bake);
+
+/// Textures for `maps` with lY and lC bands, coefficients zero, coverage written (it depends
+/// on the maps only, so it is uploaded once).
+CacheTextures makeCacheTextures(const CacheIndexMaps& maps, uint32_t bandsY, uint32_t bandsC);
+/// The same for `bake`'s maps and band counts.
 CacheTextures makeCacheTextures(const BakeData& bake);
 
 /// Copies every cache's coefficients into each grid vertex and light-map texel that holds it;
-/// texels without a cache stay 0. `textures` comes from makeCacheTextures for the same bake
-/// and `values` has the bake's caches and band counts.
+/// texels without a cache stay 0. `textures` comes from makeCacheTextures for the same maps
+/// and `values` has the band counts of `textures` and every cache the maps name.
+void copyCachesToTextures(const CacheIndexMaps& maps, const CacheValues& values,
+                          CacheTextures& textures);
+/// The same through `bake`'s maps; `values` has exactly the bake's caches.
 void copyCachesToTextures(const BakeData& bake, const CacheValues& values, CacheTextures& textures);
 
 }  // namespace pic

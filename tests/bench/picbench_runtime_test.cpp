@@ -122,16 +122,16 @@ TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {
     const nlohmann::json& levels = report.at("levels");
     ASSERT_EQ(levels.size(), 2u);
     for (const nlohmann::json& level : levels) {
-        const double key = level.at("key_bits_per_value_median").get<double>();
-        const double delta = level.at("delta_bits_per_value_median").get<double>();
+        const double key = level.at("key_bits_per_coefficient_median").get<double>();
+        const double delta = level.at("delta_bits_per_coefficient_median").get<double>();
         EXPECT_GT(key, 0.0);
         EXPECT_LT(key, 16.0);  // below raw halves
         EXPECT_GT(delta, 0.0);
         EXPECT_LT(delta, key);
     }
     // zstd's strongest level codes the same frames smaller than its fastest.
-    EXPECT_LT(levels[1].at("key_bits_per_value_median").get<double>(),
-              levels[0].at("key_bits_per_value_median").get<double>());
+    EXPECT_LT(levels[1].at("key_bits_per_coefficient_median").get<double>(),
+              levels[0].at("key_bits_per_coefficient_median").get<double>());
     EXPECT_EQ(report.at("frames").size(), 4u);
     EXPECT_EQ(report.at("frames")[3].at("levels").size(), 2u);
     EXPECT_TRUE(fs::exists(mDir / "codec.png"));

@@ -30,12 +30,12 @@
 #include "client/renderer.h"
 #include "core/bake_file.h"
 #include "core/camera.h"
+#include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "proto/wire.h"
 #include "server/cpu/cache_shading.h"
 #include "server/cpu/cpu_runtime.h"
-#include "server/encoder.h"
 #include "server/service.h"
 #include "server/token_digest.h"
 #include "tests/support/command.h"
@@ -68,6 +68,34 @@ const std::string& bakePath() {
         return out;
     }();
     return path;
+}
+
+/// The CPU twin on the test bake, set up as serve() runs it (one bounce): it is
+/// deterministic, so it gives the served caches for the same lights.
+struct Twin {
+    Scene scene;
+    BakeData bake;
+    std::unique_ptr<EmbreeScene> rays;
+    std::unique_ptr<Runtime> runtime;
+};
+
+std::unique_ptr<Twin> cpuTwin() {
+    auto twin = std::make_unique<Twin>();
+    auto scene = loadScene(kScene);
+    auto bake = readBakeFile(bakePath());
+    EXPECT_TRUE(scene && bake);
+    if (!scene || !bake) return nullptr;
+    twin->scene = std::move(*scene);
+    twin->bake = std::move(*bake);
+    auto rays = EmbreeScene::create(twin->scene);
+    EXPECT_TRUE(rays);
+    if (!rays) return nullptr;
+    twin->rays = std::move(*rays);
+    auto runtime = createCpuRuntime(twin->scene, *twin->rays, twin->bake, BounceParams{1});
+    EXPECT_TRUE(runtime);
+    if (!runtime) return nullptr;
+    twin->runtime = std::move(*runtime);
+    return twin;
 }
 
 struct Served {
@@ -478,18 +506,11 @@ TEST(Stream, ALoadRunsAFirstUpdateThatChangesNoResult) {
     const LightSet lights = pointLight(0.25f);
     ASSERT_TRUE((*served)->relight(lights, stats, frame));
 
-    auto bake = readBakeFile(bakePath());
-    ASSERT_TRUE(bake);
-    auto scene = loadScene(kScene);
-    ASSERT_TRUE(scene);
-    auto rays = EmbreeScene::create(*scene);
-    ASSERT_TRUE(rays);
-    auto fresh = createCpuRuntime(*scene, **rays, *bake, BounceParams{1});
-    ASSERT_TRUE(fresh);
-    ASSERT_TRUE((*fresh)->setLights(lights));
-    auto textures = (*fresh)->textures();
-    ASSERT_TRUE(textures);
-    EXPECT_TRUE(frame == halfFrameOf(**textures));
+    auto twin = cpuTwin();
+    ASSERT_TRUE(twin);
+    auto values = twin->runtime->setLights(lights);
+    ASSERT_TRUE(values);
+    EXPECT_TRUE(frame == halfFrameOf(**values));
 }
 
 TEST(Stream, HealthCheckSaysServing) {
@@ -695,30 +716,65 @@ TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     ASSERT_TRUE(again) << again.error().message;
     EXPECT_FALSE(downloaded);
     EXPECT_EQ(again->scene.hash, client->scene.hash);
-    fs::remove(fs::path(client->folder) / "layout" / "grid_coverage");
+    fs::remove(fs::path(client->folder) / "layout" / "grid_caches");
     again = served.connection->fetchScene("", cache.string(), &downloaded);
     ASSERT_TRUE(again) << again.error().message;
     EXPECT_TRUE(downloaded);
-    EXPECT_EQ(again->gridCoverage, client->gridCoverage);
-    auto bake = readBakeFile(bakePath());
-    ASSERT_TRUE(bake);
-    EXPECT_EQ(client->scene.hash, bake->sceneHash);
-    EXPECT_EQ(client->triangleUvs, bake->lightmap.triangleUvs);
-    ASSERT_EQ(client->gridCoverage.size(), bake->grid.cacheIndex.size());
-    for (size_t i = 0; i < client->gridCoverage.size(); ++i)
-        ASSERT_EQ(client->gridCoverage[i] != 0, bake->grid.cacheIndex[i] != kNoCache);
+    EXPECT_EQ(again->gridCaches, client->gridCaches);
+    {
+        // An index map that names a cache the bake does not have is refused, so the kept
+        // copy is downloaded again.
+        std::fstream map(fs::path(client->folder) / "layout" / "lightmap_caches",
+                         std::ios::in | std::ios::out | std::ios::binary);
+        const uint32_t beyond = client->header.caches();
+        map.write(reinterpret_cast<const char*>(&beyond), sizeof(beyond));
+    }
+    again = served.connection->fetchScene("", cache.string(), &downloaded);
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_TRUE(downloaded);
+    EXPECT_EQ(again->lightmapCaches, client->lightmapCaches);
+    auto twin = cpuTwin();
+    ASSERT_TRUE(twin);
+    const BakeData& bake = twin->bake;
+    EXPECT_EQ(client->scene.hash, bake.sceneHash);
+    EXPECT_EQ(client->triangleUvs, bake.lightmap.triangleUvs);
+    EXPECT_EQ(client->gridCaches, bake.grid.cacheIndex);
+    EXPECT_EQ(client->lightmapCaches, bake.lightmap.cacheIndex);
+    EXPECT_EQ(client->header.caches(), bake.caches.size());
     EXPECT_EQ(client->header.bands_y(), 3u);
     EXPECT_EQ(client->header.bands_c(), 2u);
 
-    // The textures of a streamed frame fit this layout.
+    // The textures the client makes from a streamed frame are the server's runtime's own,
+    // through halves: the scene's lights on the same bake, one bounce.
     auto session = served.connection->createSession();
     ASSERT_TRUE(session);
     Reader reader(*served.connection, session->session(), session->viewer_token());
     ASSERT_TRUE(reader.waitFor(1));
     auto textures = cacheTexturesOf(*client, reader.frame());
     ASSERT_TRUE(textures) << textures.error().message;
-    EXPECT_EQ(textures->grid[0].size(), 9 * client->gridCoverage.size());
-    EXPECT_EQ(textures->lightmap[1].size(), 4 * client->lightmapCoverage.size());
+    ASSERT_TRUE(twin->runtime->setLights(defaultLightSet(twin->scene)));
+    auto expected = twin->runtime->textures();
+    ASSERT_TRUE(expected);
+    const auto halved = [](const std::vector<float>& values) {
+        std::vector<float> out(values.size());
+        for (size_t i = 0; i < values.size(); ++i)
+            out[i] = halfToFloat(floatToHalfClamped(values[i]));
+        return out;
+    };
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_EQ(textures->grid[ch], halved((*expected)->grid[ch])) << ch;
+        EXPECT_EQ(textures->lightmap[ch], halved((*expected)->lightmap[ch])) << ch;
+    }
+    EXPECT_EQ(textures->gridCoverage, (*expected)->gridCoverage);
+    EXPECT_EQ(textures->lightmapCoverage, (*expected)->lightmapCoverage);
+
+    // A frame of another layout is refused, naming the plane.
+    HalfFrame shortFrame = reader.frame();
+    shortFrame.planes[1].pop_back();
+    auto refused = cacheTexturesOf(*client, shortFrame);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("cache_co"), std::string::npos)
+        << refused.error().message;
 
     auto missing = served.connection->fetchScene("0123456789abcdef", cache.string());
     ASSERT_FALSE(missing);
@@ -769,19 +825,13 @@ TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
     auto image = (*renderer)->render(lights, *camera, params);
     ASSERT_TRUE(image) << image.error().message;
 
-    // The CPU shading of the same caches: the CPU twin is deterministic, so relighting the
-    // same bake with the same set gives the server's caches.
-    auto bake = readBakeFile(bakePath());
-    ASSERT_TRUE(bake);
-    auto scene = loadScene(kScene);
-    ASSERT_TRUE(scene);
-    auto rays = EmbreeScene::create(*scene);
-    ASSERT_TRUE(rays);
-    auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{1});
-    ASSERT_TRUE(runtime);
-    auto values = (*runtime)->setLights(lights);
+    // The CPU shading of the same caches.
+    auto twin = cpuTwin();
+    ASSERT_TRUE(twin);
+    auto values = twin->runtime->setLights(lights);
     ASSERT_TRUE(values);
-    auto reference = shadeFromCaches(*scene, **rays, *bake, **values, lights, *camera, params);
+    auto reference =
+        shadeFromCaches(twin->scene, *twin->rays, twin->bake, **values, lights, *camera, params);
     ASSERT_TRUE(reference);
     auto error = compareImages(*image, *reference);
     ASSERT_TRUE(error);

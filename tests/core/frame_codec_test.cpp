@@ -16,7 +16,7 @@ namespace {
 /// there is no cache), `shift` moving the light a little.
 HalfFrame smoothFrame(uint32_t values, float shift) {
     HalfFrame frame;
-    for (int t = 0; t < kFrameTextures; ++t) {
+    for (int t = 0; t < kFramePlanes; ++t) {
         std::vector<uint16_t>& plane = frame.planes[t];
         plane.resize(values + 17 * t);
         for (size_t i = 0; i < plane.size(); ++i) {
@@ -32,7 +32,7 @@ HalfFrame smoothFrame(uint32_t values, float shift) {
 /// A frame of the same sizes as `like`, zero everywhere (what a receiver starts from).
 HalfFrame zerosLike(const HalfFrame& like) {
     HalfFrame frame;
-    for (int t = 0; t < kFrameTextures; ++t) frame.planes[t].assign(like.planes[t].size(), 0);
+    for (int t = 0; t < kFramePlanes; ++t) frame.planes[t].assign(like.planes[t].size(), 0);
     return frame;
 }
 
@@ -41,7 +41,7 @@ TEST(FrameCodec, KeyAndDeltaAreLosslessForEveryHalfPattern) {
     // shuffled order, then a delta to another shuffle.
     HalfFrame a, b;
     std::mt19937 rng(7);
-    for (int t = 0; t < kFrameTextures; ++t) {
+    for (int t = 0; t < kFramePlanes; ++t) {
         for (uint32_t h = 0; h < 65536; ++h) a.planes[t].push_back(uint16_t(h));
         b.planes[t] = a.planes[t];
         std::shuffle(a.planes[t].begin(), a.planes[t].end(), rng);
@@ -92,10 +92,10 @@ TEST(FrameCodec, SmoothFramesAreCompact) {
 TEST(FrameCodec, MismatchedSizesAreRefused) {
     const HalfFrame a = smoothFrame(100, 0.0f);
     HalfFrame shorter = a;
-    shorter.planes[4].pop_back();
+    shorter.planes[1].pop_back();
     auto bad = encodeFrame(a, &shorter);
     ASSERT_FALSE(bad);
-    EXPECT_NE(bad.error().message.find("lightmap_co"), std::string::npos) << bad.error().message;
+    EXPECT_NE(bad.error().message.find("cache_co"), std::string::npos) << bad.error().message;
 
     // A receiver whose layout differs refuses the frame and keeps its state.
     auto key = encodeFrame(a, nullptr);
@@ -105,7 +105,8 @@ TEST(FrameCodec, MismatchedSizesAreRefused) {
     auto decoded = decodeFrame(*key, received);
     ASSERT_FALSE(decoded);
     EXPECT_EQ(decoded.error().code, ErrorCode::Corrupt);
-    EXPECT_NE(decoded.error().message.find("lightmap_co"), std::string::npos) << decoded.error().message;
+    EXPECT_NE(decoded.error().message.find("cache_co"), std::string::npos)
+        << decoded.error().message;
     EXPECT_TRUE(received == before);
 }
 
@@ -118,7 +119,7 @@ TEST(FrameCodec, CorruptFramesAreRefusedWithoutTouchingTheState) {
     int refused = 0;
     for (int trial = 0; trial < 200; ++trial) {
         EncodedFrame broken = *key;
-        EncodedPlane& plane = broken.planes[trial % kFrameTextures];
+        EncodedPlane& plane = broken.planes[trial % kFramePlanes];
         switch (trial % 4) {
         case 0: plane.bytes.resize(plane.bytes.size() / 2); break;          // truncated
         case 1: plane.bytes[rng() % plane.bytes.size()] ^= uint8_t(1 + rng() % 255); break;  // flipped
@@ -133,6 +134,39 @@ TEST(FrameCodec, CorruptFramesAreRefusedWithoutTouchingTheState) {
         }
     }
     EXPECT_EQ(refused, 200);  // flipped bits too: every plane carries zstd's checksum
+}
+
+TEST(FrameCodec, CachePlanesAreCoefficientMajorAndGiveTheValuesBack) {
+    // Three caches, lY 2 (4 luma coefficients), lC 1; every value a distinct half.
+    CacheValues values = CacheValues::zeros(3, 2, 1);
+    for (size_t i = 0; i < values.y.size(); ++i) values.y[i] = 0.25f * float(i) - 1.0f;
+    for (size_t c = 0; c < 3; ++c) {
+        values.co[c] = 10.0f + float(c);
+        values.cg[c] = -20.0f - float(c);
+    }
+    values.y[5] = 1e6f;  // beyond half range: saturated, never infinite
+    const HalfFrame frame = halfFrameOf(values);
+    EXPECT_EQ(frameValues(frame), 3u * (4 + 1 + 1));
+    // Coefficient k of cache c at k·nC + c.
+    EXPECT_EQ(frame.planes[0][1 * 3 + 2], floatToHalf(values.y[2 * 4 + 1]));
+    EXPECT_EQ(frame.planes[2][1], floatToHalf(-21.0f));
+    EXPECT_EQ(halfToFloat(frame.planes[0][1 * 3 + 1]), 65504.0f);
+
+    auto back = cacheValuesOf(frame, 3, 2, 1);
+    ASSERT_TRUE(back) << back.error().message;
+    values.y[5] = 65504.0f;
+    EXPECT_EQ(back->y, values.y);
+    EXPECT_EQ(back->co, values.co);
+    EXPECT_EQ(back->cg, values.cg);
+
+    // A plane that does not hold the caches × coefficients is refused, naming it, and so are
+    // band counts no frame can have.
+    auto refused = cacheValuesOf(frame, 4, 2, 1);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("cache_y"), std::string::npos)
+        << refused.error().message;
+    EXPECT_FALSE(cacheValuesOf(frame, 3, 1, 2));
+    EXPECT_FALSE(cacheValuesOf(frame, 3, 0, 0));
 }
 
 }  // namespace
