@@ -282,6 +282,14 @@ int runRender(const Common& common, const RenderCommand& command) {
         }
         decodeMs = since(decodeStart);
     }
+    // Writing the caches into the textures the renderer samples ends the latency.
+    Result<CacheTextures> textures = fail(ErrorCode::Internal, "no frame decoded");
+    double texturesMs = 0.0;
+    if (decoder.version() >= wanted) {
+        const auto texturesStart = Clock::now();
+        textures = cacheTexturesOf(*client, decoder.frame());
+        texturesMs = since(texturesStart);
+    }
     const double latencyMs = since(pushStart);
     done = true;
     timer.join();
@@ -294,7 +302,6 @@ int runRender(const Common& common, const RenderCommand& command) {
                                  fmt::format("version {} did not arrive within {} s", wanted,
                                              command.waitSeconds)});
     }
-    auto textures = cacheTexturesOf(*client, decoder.frame());
     if (!textures) return reportError(textures.error());
 
     gpu::ContextOptions contextOptions;
@@ -323,10 +330,10 @@ int runRender(const Common& common, const RenderCommand& command) {
         passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", pass, ms);
     std::fprintf(stderr,
                  "picclient render: scene %s in %.0f ms (%s); version %llu: light change to decoded "
-                 "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms); "
+                 "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
                  "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
                  downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
-                 serverMs, bytes, decodeMs, size->x, size->y, command.component.c_str(),
+                 serverMs, bytes, decodeMs, texturesMs, size->x, size->y, command.component.c_str(),
                  (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
                  command.outPath.c_str());
     std::printf("%s\n", command.outPath.c_str());

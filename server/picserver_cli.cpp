@@ -104,7 +104,7 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--keyframe-interval", options.session.keyframeInterval,
                    "every N-th version is streamed as a key frame, the others as deltas")
         ->check(CLI::Range(1u, 100000u));
-    app.add_option("--zstd-level", options.session.zstdLevel, "zstd level of the frames")
+    app.add_option("--zstd-level", options.session.zstdLevel, "zstd level of the frames (default 1)")
         ->check(CLI::Range(1, 19));
     app.add_option("--max-sessions", options.maxSessions, "sessions the server holds at most")
         ->check(CLI::Range(size_t(1), size_t(100000)));
