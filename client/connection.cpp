@@ -8,7 +8,6 @@
 #include <iterator>
 #include <unistd.h>
 
-#include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/sh.h"
 #include "proto/wire.h"
@@ -221,7 +220,6 @@ Result<std::string> readAsset(const fs::path& folder, const std::string& name) {
     return std::string{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
 }
 
-/// Loads the scene and layout kept in `folder` for `header`.
 /// An index map asset: `entries` little-endian u32, each a cache below `caches` or kNoCache.
 Result<std::vector<uint32_t>> readIndexMap(const fs::path& folder, const std::string& name,
                                            uint64_t entries, uint32_t caches) {
@@ -238,6 +236,7 @@ Result<std::vector<uint32_t>> readIndexMap(const fs::path& folder, const std::st
     return map;
 }
 
+/// Loads the scene and layout kept in `folder` for `header`.
 Result<ClientScene> loadClientScene(const fs::path& folder, const v1::SceneHeader& header) {
     ClientScene client;
     client.header = header;

@@ -58,8 +58,9 @@ public:
     /// Milliseconds of the update run at load (see warmUp).
     double warmUpMs() const { return mWarmUpMs; }
 
-    /// Relights the scene with `lights` and copies the resulting textures as half floats, one
-    /// session at a time (the runtime keeps per-light state such as shadow maps).
+    /// Relights the scene with `lights` and gives the resulting caches as a frame's half
+    /// planes (core/frame_codec.h), one session at a time (the runtime keeps per-light state
+    /// such as shadow maps).
     Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame);
 
 private:
