@@ -95,7 +95,6 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeRadiance));
     PIC_TRY(mCacheLighting->bind(ctx, mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
     mLightmapCopyOnHost = options.lightmapCopyOnHost.value_or(ctx.isCpuDevice());
-    if (!mLightmapCopyOnHost) PIC_TRY(lightmapCopyPass());
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
     mTextures = makeCacheTextures(mBake);
@@ -168,16 +167,14 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         // No cache pass: the caches, and so the textures, hold no light.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         PIC_TRY(uploadCaches(mValues));
-        if (!mLightmapCopyOnHost)
-            PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mLightmapCopy->record(cmd); }));
         stats.totalMs = millisecondsSince(start);
         return &mValues;
     }
 
     // Each submission ends with a bounce's caches and, when another bounce may follow, the
-    // surfel flux that bounce would pull; the host reads the flux sums to decide. Copying the
-    // textures on the host, each one also reads its caches back, since only the host's look
-    // at the sums tells which bounce is the last.
+    // surfel flux that bounce would pull; the host reads the flux sums to decide. Each one
+    // also reads its caches back, since only the host's look at the sums tells which bounce
+    // is the last.
     const auto cacheBounce = [&](VkCommandBuffer cmd, bool another, uint32_t sumSlot) {
         mTimer.begin(cmd, "pull");
         mPull->record(cmd);
@@ -191,7 +188,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         }
         // Everything written before the next submission's first pass reads it.
         gpu::computeBarrier(cmd);
-        if (mLightmapCopyOnHost) recordCacheReadback(cmd);
+        recordCacheReadback(cmd);
     };
 
     PIC_TRY(submitTimed(
@@ -226,15 +223,6 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         stats.surfelFlux = total;
     }
 
-    if (!mLightmapCopyOnHost) {
-        PIC_TRY(submitTimed(
-            [&](VkCommandBuffer cmd) {
-                mTimer.begin(cmd, "lightmap_copy");
-                mLightmapCopy->record(cmd);
-                recordCacheReadback(cmd);
-            },
-            stats));
-    }
     readCaches(mValues);
     stats.totalMs = millisecondsSince(start);
     return &mValues;
@@ -242,10 +230,16 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
 
 Result<const CacheTextures*> GpuRuntime::textures() {
     if (!mTexturesCurrent) {
-        if (mLightmapCopyOnHost)
+        if (mLightmapCopyOnHost) {
             copyCachesToTextures(mBake, mValues, mTextures);
-        else
-            PIC_TRY(mLightmapCopy->read(*mContext, mTextures));
+        } else {
+            // From the values setLights returned: the single-pass entry points below reuse
+            // the cache buffers.
+            PIC_TRY_ASSIGN(gpu::LightmapCopyPass * pass, lightmapCopyPass());
+            PIC_TRY(uploadCaches(mValues));
+            PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd); }));
+            PIC_TRY(pass->read(*mContext, mTextures));
+        }
         mTexturesCurrent = true;
     }
     return &mTextures;

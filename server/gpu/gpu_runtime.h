@@ -47,10 +47,11 @@ struct GpuRuntimeOptions {
     /// device supports that divide a link the pass takes 4 or 2 words before 3. 1 reads a
     /// word at a time, as on a device with no wider uint texel buffers (tests).
     uint32_t maxLinkTexelWords = 4;
-    /// Where textures() gets the light-map copy (paper 000 Figure 2 step 5): true, on the
-    /// host from the caches setLights reads back anyway (server/cpu/lightmap_copy.h); false,
-    /// the LightmapCopyPass on the device, then the layers read back. Unset: the host on a
-    /// CPU device, whose memory is the host's, so the pass would only add a dispatch and a
+    /// Where textures() gets the light-map copy (paper 000 Figure 2 step 5), on demand after
+    /// each setLights (picserver streams the caches and never asks): true, on the host from
+    /// the caches setLights reads back anyway (server/cpu/lightmap_copy.h); false, the
+    /// LightmapCopyPass on the device, then the layers read back. Unset: the host on a CPU
+    /// device, whose memory is the host's, so the pass would only add a dispatch and a
     /// submission; the device on a GPU.
     std::optional<bool> lightmapCopyOnHost;
 };
@@ -131,8 +132,7 @@ private:
     Result<void> uploadCaches(const CacheValues& values);
     /// Records the copy of the caches into mCacheReadback when the host cannot map them.
     void recordCacheReadback(VkCommandBuffer cmd);
-    /// The light-map copy pass; when the host does the runtime's copy, made on first use
-    /// (runLightmapCopy).
+    /// The light-map copy pass, made on first use (textures() on the device, runLightmapCopy).
     Result<gpu::LightmapCopyPass*> lightmapCopyPass();
     /// The caches as the latest submission that recorded recordCacheReadback left them.
     void readCaches(CacheValues& values) const;
