@@ -262,6 +262,11 @@ Result<ClientScene> loadClientScene(const fs::path& folder, const v1::SceneHeade
     const uint64_t vertices =
         uint64_t(header.grid().dims_x()) * header.grid().dims_y() * header.grid().dims_z();
     const uint64_t texels = uint64_t(header.lightmap_width()) * header.lightmap_height();
+    // Every cache is held by a grid vertex or a light-map texel.
+    if (header.caches() > vertices + texels)
+        return fail(ErrorCode::Corrupt,
+                    "the header names {} caches for {} grid vertices and {} texels",
+                    header.caches(), vertices, texels);
     PIC_TRY_ASSIGN(client.gridCaches,
                    readIndexMap(folder, "layout/grid_caches", vertices, header.caches()));
     PIC_TRY_ASSIGN(client.lightmapCaches,

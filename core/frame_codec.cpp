@@ -158,16 +158,22 @@ Result<CacheValues> cacheValuesOf(const HalfFrame& frame, size_t caches, uint32_
     if (bandsY < 1 || bandsY > uint32_t(kMaxShBands) || bandsC > bandsY)
         return fail(ErrorCode::InvalidInput, "frame: {} luma and {} chroma bands are out of range",
                     bandsY, bandsC);
+    const auto countOf = [&](int ch) {
+        return ch == 0 ? size_t{bandsY} * bandsY : size_t{bandsC} * bandsC;
+    };
+    // Sizes first, so that nothing is allocated for a count the frame does not hold.
+    for (int ch = 0; ch < kFramePlanes; ++ch)
+        if (frame.planes[size_t(ch)].size() != caches * countOf(ch))
+            return fail(ErrorCode::InvalidInput,
+                        "frame plane {} holds {} values; {} caches × {} coefficients need {}",
+                        framePlaneName(ch), frame.planes[size_t(ch)].size(), caches, countOf(ch),
+                        caches * countOf(ch));
     CacheValues values = CacheValues::zeros(caches, bandsY, bandsC);
     std::array<std::vector<float>*, kFramePlanes> channels = {&values.y, &values.co, &values.cg};
     for (int ch = 0; ch < kFramePlanes; ++ch) {
         std::vector<float>& target = *channels[size_t(ch)];
         const std::vector<uint16_t>& plane = frame.planes[size_t(ch)];
-        const size_t count = ch == 0 ? size_t{bandsY} * bandsY : size_t{bandsC} * bandsC;
-        if (plane.size() != target.size())
-            return fail(ErrorCode::InvalidInput,
-                        "frame plane {} holds {} values; {} caches × {} coefficients need {}",
-                        framePlaneName(ch), plane.size(), caches, count, target.size());
+        const size_t count = countOf(ch);
         for (size_t c = 0; c < caches; ++c)
             for (size_t k = 0; k < count; ++k)
                 target[c * count + k] = halfToFloat(plane[k * caches + c]);
