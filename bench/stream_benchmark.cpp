@@ -125,7 +125,7 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::printf("%8s %8s %9s %9s %9s %9s %10s %10s %12s %11s %11s %10s %10s %8s\n", "clients",
                 "updates", "p50 ms", "p95 ms", "p99 ms", "max ms", "update ms", "encode ms",
-                "server CPU", "key KiB", "delta KiB", "key b/val", "dlt b/val", "errors");
+                "server CPU", "key KiB", "delta KiB", "key b/coef", "dlt b/coef", "errors");
     int exit = 0;
     for (uint32_t clients : params.clients) {
         LoadOptions load;
