@@ -327,12 +327,30 @@ std::unique_ptr<FrameStream> PicConnection::subscribe(const std::string& session
     return std::make_unique<FrameStream>(*mStub, request);
 }
 
+Result<v1::SceneHeader> PicConnection::sceneHeader(const std::string& bakeId) {
+    return getScene(bakeId, true, "");
+}
+
+void FrameDecoder::expect(const v1::SceneHeader& header) {
+    const size_t caches = header.caches();
+    const size_t y = size_t{header.bands_y()} * header.bands_y();
+    const size_t c = size_t{header.bands_c()} * header.bands_c();
+    mExpected = std::array<size_t, kFramePlanes>{caches * y, caches * c, caches * c};
+}
+
 Result<void> FrameDecoder::apply(v1::Frame& frame) {
     if (frame.base_version() != 0 && frame.base_version() != mVersion)
         return fail(ErrorCode::Corrupt,
                     "frame of version {} is a delta against version {}, but version {} is held",
                     frame.version(), frame.base_version(), mVersion);
     PIC_TRY_ASSIGN(EncodedFrame encoded, wire::planesFromProto(frame));
+    if (mExpected)
+        for (int t = 0; t < kFramePlanes; ++t)
+            if (encoded.planes[size_t(t)].values != (*mExpected)[size_t(t)])
+                return fail(ErrorCode::Corrupt,
+                            "frame of version {}: plane {} holds {} values, the scene's caches {}",
+                            frame.version(), framePlaneName(t), encoded.planes[size_t(t)].values,
+                            (*mExpected)[size_t(t)]);
     if (encoded.key()) {
         // A key frame sets the sizes; decode into a copy so a corrupt one changes nothing.
         HalfFrame decoded;

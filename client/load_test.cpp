@@ -36,9 +36,10 @@ struct Received {
     std::map<uint64_t, std::pair<double, double>> serverMs;  ///< version → update, encode ms
 };
 
-void subscribeLoop(FrameStream& stream, Received& received, std::atomic<uint32_t>& ready,
-                   std::mutex& mutex) {
+void subscribeLoop(FrameStream& stream, const v1::SceneHeader& header, Received& received,
+                   std::atomic<uint32_t>& ready, std::mutex& mutex) {
     FrameDecoder decoder;
+    decoder.expect(header);
     v1::Frame frame;
     bool first = true;
     while (stream.next(frame)) {
@@ -105,6 +106,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     if (options.updateRate > 0.0 && joined.role() != v1::EDITOR)
         return fail(ErrorCode::InvalidInput, "changing lights needs an editor token");
     PIC_TRY_ASSIGN(LightSet base, wire::fromProto(joined.lights()));
+    PIC_TRY_ASSIGN(const v1::SceneHeader header, connection.sceneHeader(joined.bake_id()));
     if (options.updateRate > 0.0 && base.lights.empty())
         return fail(ErrorCode::InvalidInput,
                     "session {} has no light to move; set one first (picclient lights)", session);
@@ -117,8 +119,8 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     std::vector<std::thread> threads;
     for (uint32_t i = 0; i < options.clients; ++i) {
         streams.push_back(connection.subscribe(session, editor));
-        threads.emplace_back(subscribeLoop, std::ref(*streams.back()), std::ref(received[i]),
-                             std::ref(ready), std::ref(mutex));
+        threads.emplace_back(subscribeLoop, std::ref(*streams.back()), std::cref(header),
+                             std::ref(received[i]), std::ref(ready), std::ref(mutex));
     }
     const auto waitStart = Clock::now();
     while (ready.load() < options.clients && Clock::now() - waitStart < std::chrono::seconds(60))

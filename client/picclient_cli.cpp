@@ -99,8 +99,13 @@ int runLights(const Common& common, const std::string& path) {
 
 int runWatch(const Common& common, uint64_t count, double seconds) {
     PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto joined = connection->joinSession(common.session, common.token);
+    if (!joined) return reportError(joined.error());
+    auto header = connection->sceneHeader(joined->bake_id());
+    if (!header) return reportError(header.error());
     auto stream = connection->subscribe(common.session, common.token);
     FrameDecoder decoder;
+    decoder.expect(*header);
     v1::Frame frame;
     uint64_t frames = 0;
     const auto start = Clock::now();
@@ -266,6 +271,7 @@ int runRender(const Common& common, const RenderCommand& command) {
         if (!done) stream->cancel();
     });
     FrameDecoder decoder;
+    decoder.expect(client->header);
     v1::Frame frame;
     double decodeMs = 0.0, serverMs = 0.0;
     size_t bytes = 0;

@@ -768,6 +768,30 @@ TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     EXPECT_EQ(textures->gridCoverage, (*expected)->gridCoverage);
     EXPECT_EQ(textures->lightmapCoverage, (*expected)->lightmapCoverage);
 
+    // A decoder told the scene's layout takes its frames, and refuses, before decoding, the
+    // frames of a bake with other caches.
+    auto header = served.connection->sceneHeader(client->header.bake_id());
+    ASSERT_TRUE(header) << header.error().message;
+    EXPECT_EQ(header->caches(), client->header.caches());
+    auto stream = served.connection->subscribe(session->session(), session->viewer_token());
+    v1::Frame wireFrame;
+    ASSERT_TRUE(stream->next(wireFrame));
+    v1::Frame copy = wireFrame;
+    FrameDecoder decoder;
+    decoder.expect(*header);
+    ASSERT_TRUE(decoder.apply(copy));
+    v1::SceneHeader other = *header;
+    other.set_caches(header->caches() + 1);
+    FrameDecoder refusing;
+    refusing.expect(other);
+    auto refusedFrame = refusing.apply(wireFrame);
+    ASSERT_FALSE(refusedFrame);
+    EXPECT_EQ(refusedFrame.error().code, ErrorCode::Corrupt);
+    EXPECT_NE(refusedFrame.error().message.find("cache_y"), std::string::npos)
+        << refusedFrame.error().message;
+    EXPECT_EQ(refusing.version(), 0u);
+    stream->cancel();
+
     // A frame of another layout is refused, naming the plane.
     HalfFrame shortFrame = reader.frame();
     shortFrame.planes[1].pop_back();
