@@ -331,11 +331,11 @@ Result<v1::SceneHeader> PicConnection::sceneHeader(const std::string& bakeId) {
     return getScene(bakeId, true, "");
 }
 
-void FrameDecoder::expect(const v1::SceneHeader& header) {
+FrameDecoder::FrameDecoder(const v1::SceneHeader& header) {
     const size_t caches = header.caches();
     const size_t y = size_t{header.bands_y()} * header.bands_y();
     const size_t c = size_t{header.bands_c()} * header.bands_c();
-    mExpected = std::array<size_t, kFramePlanes>{caches * y, caches * c, caches * c};
+    mExpected = {caches * y, caches * c, caches * c};
 }
 
 Result<void> FrameDecoder::apply(v1::Frame& frame) {
@@ -344,15 +344,14 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
                     "frame of version {} is a delta against version {}, but version {} is held",
                     frame.version(), frame.base_version(), mVersion);
     PIC_TRY_ASSIGN(EncodedFrame encoded, wire::planesFromProto(frame));
-    if (mExpected)
-        for (int t = 0; t < kFramePlanes; ++t)
-            if (encoded.planes[size_t(t)].values != (*mExpected)[size_t(t)])
-                return fail(ErrorCode::Corrupt,
-                            "frame of version {}: plane {} holds {} values, the scene's caches {}",
-                            frame.version(), framePlaneName(t), encoded.planes[size_t(t)].values,
-                            (*mExpected)[size_t(t)]);
+    for (int t = 0; t < kFramePlanes; ++t)
+        if (encoded.planes[size_t(t)].values != mExpected[size_t(t)])
+            return fail(ErrorCode::Corrupt,
+                        "frame of version {}: plane {} holds {} values, the scene's caches {}",
+                        frame.version(), framePlaneName(t), encoded.planes[size_t(t)].values,
+                        mExpected[size_t(t)]);
     if (encoded.key()) {
-        // A key frame sets the sizes; decode into a copy so a corrupt one changes nothing.
+        // Decode a key frame into a copy so that a corrupt one changes nothing.
         HalfFrame decoded;
         for (int t = 0; t < kFramePlanes; ++t)
             decoded.planes[size_t(t)].resize(encoded.planes[size_t(t)].values);

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,7 +83,7 @@ public:
     Result<ClientScene> fetchScene(const std::string& bakeId, const std::string& cacheDir,
                                    bool* downloaded = nullptr);
     /// The header of bake `bakeId`'s scene (GetScene, header only): what a client needs to
-    /// check the frames of a session on that bake (FrameDecoder::expect).
+    /// check the frames of a session on that bake (FrameDecoder).
     Result<v1::SceneHeader> sceneHeader(const std::string& bakeId);
     /// The session's counters (GetStats).
     Result<v1::SessionStats> stats(const std::string& session, const std::string& token);
@@ -105,10 +104,9 @@ private:
 /// version, delta frames apply to the version they were made from.
 class FrameDecoder {
 public:
-    /// Frames must then carry the caches of `header`'s bake: a frame with planes of other
-    /// sizes is refused before anything is allocated for it (a client that decodes frames
-    /// without knowing the layout takes the sizes a key frame announces).
-    void expect(const v1::SceneHeader& header);
+    /// A decoder for the frames of a session on `header`'s bake: a frame whose planes do not
+    /// hold that bake's caches is refused before anything is allocated for it.
+    explicit FrameDecoder(const v1::SceneHeader& header);
     /// Decodes `frame` (its bytes are moved out). Corrupt when it is a delta against a version
     /// other than the one held, or does not decode; the held version is then unchanged.
     Result<void> apply(v1::Frame& frame);
@@ -119,7 +117,7 @@ public:
 private:
     HalfFrame mFrame;
     uint64_t mVersion = 0;
-    std::optional<std::array<size_t, kFramePlanes>> mExpected;  ///< values per plane
+    std::array<size_t, kFramePlanes> mExpected{};  ///< values per plane
 };
 
 /// The textures of `frame` for `scene`: its caches, halves widened to floats, written into

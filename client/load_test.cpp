@@ -38,8 +38,7 @@ struct Received {
 
 void subscribeLoop(FrameStream& stream, const v1::SceneHeader& header, Received& received,
                    std::atomic<uint32_t>& ready, std::mutex& mutex) {
-    FrameDecoder decoder;
-    decoder.expect(header);
+    FrameDecoder decoder(header);
     v1::Frame frame;
     bool first = true;
     while (stream.next(frame)) {

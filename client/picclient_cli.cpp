@@ -104,8 +104,7 @@ int runWatch(const Common& common, uint64_t count, double seconds) {
     auto header = connection->sceneHeader(joined->bake_id());
     if (!header) return reportError(header.error());
     auto stream = connection->subscribe(common.session, common.token);
-    FrameDecoder decoder;
-    decoder.expect(*header);
+    FrameDecoder decoder(*header);
     v1::Frame frame;
     uint64_t frames = 0;
     const auto start = Clock::now();
@@ -270,8 +269,7 @@ int runRender(const Common& common, const RenderCommand& command) {
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
         if (!done) stream->cancel();
     });
-    FrameDecoder decoder;
-    decoder.expect(client->header);
+    FrameDecoder decoder(client->header);
     v1::Frame frame;
     double decodeMs = 0.0, serverMs = 0.0;
     size_t bytes = 0;

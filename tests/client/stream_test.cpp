@@ -140,11 +140,20 @@ LightSet pointLight(float x) {
     return lights;
 }
 
+/// The header of the served bake, for the decoders.
+v1::SceneHeader sceneHeaderOf(PicConnection& connection) {
+    auto header = connection.sceneHeader("");
+    EXPECT_TRUE(header) << (header ? "" : header.error().message);
+    return header ? *header : v1::SceneHeader{};
+}
+
 /// Reads frames on its own thread, decoding each, until cancelled.
 class Reader {
 public:
     Reader(PicConnection& connection, const std::string& session, const std::string& token)
-        : mStream(connection.subscribe(session, token)), mThread([this] { run(); }) {}
+        : mDecoder(sceneHeaderOf(connection)),
+          mStream(connection.subscribe(session, token)),
+          mThread([this] { run(); }) {}
     ~Reader() {
         mStream->cancel();
         mThread.join();
@@ -193,9 +202,9 @@ private:
         }
     }
 
+    FrameDecoder mDecoder;
     std::unique_ptr<FrameStream> mStream;
     std::mutex mMutex;
-    FrameDecoder mDecoder;
     std::vector<uint64_t> versions;
     std::vector<bool> keyFrames;
     std::vector<std::string> mErrors;
@@ -334,7 +343,7 @@ TEST(Stream, StalledSubscriberDoesNotDelayTheOthersAndSkipsToTheLast) {
     // The stalled subscriber now reads: it gets what gRPC had buffered, then the last version,
     // never all of them.
     v1::Frame frame;
-    FrameDecoder decoder;
+    FrameDecoder decoder(sceneHeaderOf(*served.connection));
     int frames = 0;
     while (decoder.version() < last && stalled->next(frame)) {
         ASSERT_TRUE(decoder.apply(frame)) << "version " << frame.version();
@@ -777,13 +786,11 @@ TEST(Stream, SceneDownloadLoadsTheSameSceneAndLayout) {
     v1::Frame wireFrame;
     ASSERT_TRUE(stream->next(wireFrame));
     v1::Frame copy = wireFrame;
-    FrameDecoder decoder;
-    decoder.expect(*header);
+    FrameDecoder decoder(*header);
     ASSERT_TRUE(decoder.apply(copy));
     v1::SceneHeader other = *header;
     other.set_caches(header->caches() + 1);
-    FrameDecoder refusing;
-    refusing.expect(other);
+    FrameDecoder refusing(other);
     auto refusedFrame = refusing.apply(wireFrame);
     ASSERT_FALSE(refusedFrame);
     EXPECT_EQ(refusedFrame.error().code, ErrorCode::Corrupt);
