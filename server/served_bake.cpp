@@ -126,8 +126,7 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
 
 Result<void> ServedBake::warmUp() {
     const auto start = std::chrono::steady_clock::now();
-    UpdateStats stats;
-    PIC_TRY(mRuntime->setLights(defaultLightSet(mScene), &stats));
+    PIC_TRY(mRuntime->setLights(defaultLightSet(mScene)));
     mWarmUpMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return {};
