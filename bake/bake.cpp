@@ -6,13 +6,13 @@
 #include <cstdio>
 #include <fstream>
 
-#include "bake/embree_scene.h"
 #include "bake/grid_caches.h"
 #include "bake/lightmap_caches.h"
 #include "bake/lightmap_charts.h"
 #include "bake/surfel_hierarchy.h"
 #include "bake/surfel_placement.h"
 #include "core/sh.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

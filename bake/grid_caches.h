@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "bake/embree_scene.h"
 #include "core/bake_data.h"
 #include "core/error.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "bake/embree_scene.h"
 #include "bake/lightmap_charts.h"
 #include "core/bake_data.h"
 #include "core/error.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

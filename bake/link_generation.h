@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "bake/embree_scene.h"
 #include "core/bake_data.h"
 #include "core/error.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

@@ -8,7 +8,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/embree_scene.h"
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
 #include "bench/bench_common.h"
@@ -17,8 +16,9 @@
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/light_set.h"
-#include "server/cpu/cache_shading.h"
-#include "server/cpu/cpu_runtime.h"
+#include "rays/embree_scene.h"
+#include "render/cpu/cache_shading.h"
+#include "render/cpu_runtime.h"
 
 namespace pic {
 

@@ -10,10 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_common.h"
 #include "core/bake_file.h"
 #include "core/gltf_loader.h"
 #include "core/parallel.h"
-#include "bench/bench_common.h"
 
 namespace pic {
 

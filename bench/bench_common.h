@@ -10,11 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
-#include "bake/embree_scene.h"
 #include "core/chart.h"
 #include "core/error.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

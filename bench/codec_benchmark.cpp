@@ -5,8 +5,8 @@
 
 #include "bench/bench_common.h"
 #include "core/frame_codec.h"
-#include "server/cpu/cpu_runtime.h"
-#include "server/gpu/gpu_runtime.h"
+#include "render/cpu_runtime.h"
+#include "render/gpu_runtime.h"
 
 namespace pic {
 namespace {

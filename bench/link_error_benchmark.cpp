@@ -8,7 +8,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/embree_scene.h"
 #include "bake/link_generation.h"
 #include "bake/ref/path_tracer.h"
 #include "core/color.h"
@@ -18,9 +17,10 @@
 #include "core/progress.h"
 #include "core/sampling.h"
 #include "core/sh.h"
-#include "server/cpu/cache_lighting.h"
-#include "server/cpu/pull.h"
-#include "server/cpu/surfel_lighting.h"
+#include "rays/embree_scene.h"
+#include "render/cpu/cache_lighting.h"
+#include "render/cpu/pull.h"
+#include "render/cpu/surfel_lighting.h"
 
 namespace pic {
 

@@ -4,11 +4,11 @@
 
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
-#include "bench/codec_benchmark.h"
-#include "bench/stream_benchmark.h"
-#include "bench/runtime_benchmark.h"
 #include "bench/bake_benchmark.h"
+#include "bench/codec_benchmark.h"
 #include "bench/link_error_benchmark.h"
+#include "bench/runtime_benchmark.h"
+#include "bench/stream_benchmark.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 

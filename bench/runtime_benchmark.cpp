@@ -14,11 +14,11 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/bench_common.h"
-#include "server/cpu/cpu_runtime.h"
-#include "server/cpu/pull.h"
-#include "server/cpu/surfel_lighting.h"
-#include "server/gpu/copy_probe.h"
-#include "server/gpu/gpu_runtime.h"
+#include "render/copy_probe.h"
+#include "render/cpu/pull.h"
+#include "render/cpu/surfel_lighting.h"
+#include "render/cpu_runtime.h"
+#include "render/gpu_runtime.h"
 
 namespace pic {
 namespace {

@@ -15,10 +15,10 @@
 #include "core/error.h"
 #include "core/frame_codec.h"
 #include "core/light_set.h"
-#include "client/renderer.h"
 #include "core/scene.h"
 #include "proto/pic.grpc.pb.h"
-#include "server/cpu/lightmap_copy.h"
+#include "render/cpu/lightmap_copy.h"
+#include "render/renderer.h"
 
 namespace pic {
 
@@ -121,12 +121,12 @@ private:
 };
 
 /// The textures of `frame` for `scene`: its caches, halves widened to floats, written into
-/// every grid vertex and light-map texel that holds them (server/cpu/lightmap_copy.h), with
+/// every grid vertex and light-map texel that holds them (render/cpu/lightmap_copy.h), with
 /// coverage from the index maps. InvalidInput when the frame's planes do not hold the
 /// scene's caches and band counts.
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);
 
-/// The renderer's layout (client/renderer.h) of a downloaded scene.
+/// The renderer's layout (render/renderer.h) of a downloaded scene.
 ClientLayout clientLayoutOf(const ClientScene& scene);
 
 /// The default folder for downloaded scenes: $XDG_CACHE_HOME/pic, else ~/.cache/pic, else

@@ -15,10 +15,10 @@
 
 #include "client/connection.h"
 #include "client/load_test.h"
-#include "client/renderer.h"
 #include "core/camera.h"
 #include "core/image.h"
 #include "proto/wire.h"
+#include "render/renderer.h"
 
 namespace pic {
 

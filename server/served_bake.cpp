@@ -11,8 +11,8 @@
 #include "core/gltf_loader.h"
 #include "core/hash.h"
 #include "core/light_set.h"
-#include "server/cpu/cpu_runtime.h"
-#include "server/gpu/gpu_runtime.h"
+#include "render/cpu_runtime.h"
+#include "render/gpu_runtime.h"
 
 namespace pic {
 

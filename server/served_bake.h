@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "bake/embree_scene.h"
 #include "core/bake_data.h"
 #include "core/error.h"
 #include "core/frame_codec.h"
 #include "core/scene.h"
 #include "proto/pic.pb.h"
-#include "server/runtime.h"
+#include "rays/embree_scene.h"
+#include "render/runtime.h"
 
 namespace pic {
 

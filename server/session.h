@@ -28,7 +28,7 @@
 #include "core/frame_codec.h"
 #include "core/light_set.h"
 #include "proto/pic.pb.h"
-#include "server/runtime.h"
+#include "render/runtime.h"
 
 namespace pic {
 

@@ -1,7 +1,7 @@
 #version 460
 // Cache lighting (paper 000 Figure 2 step 4, eq. 3): per cache, L = Σ over its nL links of
 // the node's radiance Φ / (π·A) (RGBE8, §4.7) times its transport, in YCoCg, Y with lY bands
-// and Co, Cg with lC bands, stored as half floats. The CPU twin (server/cpu/cache_lighting.cpp)
+// and Co, Cg with lC bands, stored as half floats. The CPU twin (render/cpu/cache_lighting.cpp)
 // takes Φ times the bake's factor V / (π·A): the same product.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require

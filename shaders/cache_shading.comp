@@ -1,6 +1,6 @@
 #version 460
-// Cache shading (client/cache_shading_pass.h): each pixel of the G-buffer lit like the CPU
-// twin server/cpu/cache_shading.cpp lights a ray hit. Direct: Σ ρ/π·E_light·V with V from the
+// Cache shading (render/passes/cache_shading_pass.h): each pixel of the G-buffer lit like the CPU
+// twin render/cpu/cache_shading.cpp lights a ray hit. Direct: Σ ρ/π·E_light·V with V from the
 // shadow maps; indirect: ρ/π·max(0, E_SH(n)) from the caches interpolated around the point
 // (light map: 4 texels bilinearly; grid: 8 vertices trilinearly; texels and vertices without
 // a cache take no weight and the others are renormalised, core/cache_values.h), plus the
@@ -27,7 +27,7 @@ layout(binding = 3) uniform sampler2D gbufferEmission;
 layout(std430, binding = 4) readonly buffer Lights { GpuLight lights[]; };
 layout(std430, binding = 5) readonly buffer ShadowLayers { GpuShadowLayer shadowLayers[]; };
 layout(binding = 6) uniform sampler2DArray shadowMaps;
-// Cache textures (server/cpu/lightmap_copy.h layout), half floats, coefficient-major layers.
+// Cache textures (render/cpu/lightmap_copy.h layout), half floats, coefficient-major layers.
 layout(std430, binding = 7) readonly buffer GridY { float16_t gridY[]; };
 layout(std430, binding = 8) readonly buffer GridCo { float16_t gridCo[]; };
 layout(std430, binding = 9) readonly buffer GridCg { float16_t gridCg[]; };

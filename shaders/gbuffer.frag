@@ -1,6 +1,6 @@
 #version 460
-// G-buffer (client/gbuffer_pass.h): what shading needs of the surface a pixel centre sees,
-// computed as the CPU twin (server/cpu/cache_shading.cpp) computes it at a ray hit: the
+// G-buffer (render/passes/gbuffer_pass.h): what shading needs of the surface a pixel centre sees,
+// computed as the CPU twin (render/cpu/cache_shading.cpp) computes it at a ray hit: the
 // geometric normal facing the camera, Scene::albedoAt (baseColorFactor × vertex colour ×
 // bilinear base-colour texture), Scene::emissionAt × the light set's emissive scale on front
 // faces, and the light-map UV of light-mapped triangles. Layout in shared/gbuffer.h.

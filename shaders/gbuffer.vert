@@ -1,5 +1,5 @@
 #version 460
-// G-buffer (client/gbuffer_pass.h): scene triangles, 3 unshared corners each, seen by the
+// G-buffer (render/passes/gbuffer_pass.h): scene triangles, 3 unshared corners each, seen by the
 // camera. Attributes are interpolated perspective-correctly, so that the fragment at a pixel
 // centre gets them at the point its camera ray hits: b0·a0 + b1·a1 + b2·a2 as the CPU twin
 // computes them from the hit's barycentrics.

@@ -2,7 +2,7 @@
 // Pull (paper 000 Figure 2 step 3, §4.1): every node of one level gets the sum of its two
 // children's flux, and its radiance Φ / (π·A) as RGBE8 for cache lighting (§4.7). Dispatched
 // level by level, lowest first, then the small upper levels in one workgroup
-// (shared/pull.h). CPU twin: server/cpu/pull.cpp.
+// (shared/pull.h). CPU twin: render/cpu/pull.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/pull.h"
 #include "lib/rgbe8.glsl"

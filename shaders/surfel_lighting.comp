@@ -5,7 +5,7 @@
 // bounce mode: Φ = Φ_direct + ρ·A·max(0, E) with E the irradiance the previous bounce's caches
 // deliver at the surfel (its precomputed interpolation stencil). Each workgroup also writes
 // its summed flux for the progressive stop, in one of two slots so that consecutive passes
-// of one submission keep both sums. CPU twin: server/cpu/surfel_lighting.cpp.
+// of one submission keep both sums. CPU twin: render/cpu/surfel_lighting.cpp.
 //
 // The mode is a specialization constant, not a push constant: lavapipe runs both sides of a
 // branch under a lane mask, so a uniform branch on a push constant cost the direct pass the

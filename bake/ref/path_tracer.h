@@ -14,13 +14,13 @@
 
 #include <glm/glm.hpp>
 
-#include "bake/embree_scene.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/sampling.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

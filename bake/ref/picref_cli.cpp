@@ -13,7 +13,6 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "bake/embree_scene.h"
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
 #include "core/bake_file.h"
@@ -23,6 +22,7 @@
 #include "core/light_set.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

@@ -9,7 +9,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "bake/embree_scene.h"
 #include "core/bake_file.h"
 #include "core/camera.h"
 #include "core/gltf_loader.h"
@@ -17,9 +16,10 @@
 #include "core/light_set.h"
 #include "core/parallel.h"
 #include "core/progress.h"
-#include "server/cpu/cache_shading.h"
-#include "server/cpu/cpu_runtime.h"
-#include "server/gpu/gpu_runtime.h"
+#include "rays/embree_scene.h"
+#include "render/cpu/cache_shading.h"
+#include "render/cpu_runtime.h"
+#include "render/gpu_runtime.h"
 
 namespace pic {
 namespace {

@@ -6,13 +6,13 @@
 
 #include <cstdint>
 
-#include "bake/embree_scene.h"
 #include "bake/ref/path_tracer.h"
 #include "core/bake_data.h"
 #include "core/cache_values.h"
 #include "core/error.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 

@@ -1,7 +1,7 @@
 #ifndef PIC_SHADERS_SHARED_CACHE_SHADING_H
 #define PIC_SHADERS_SHARED_CACHE_SHADING_H
-// Shading a G-buffer from the caches on the GPU (client/cache_shading_pass.h; CPU twin
-// server/cpu/cache_shading.cpp): direct light through the shadow maps, the cache term from
+// Shading a G-buffer from the caches on the GPU (render/passes/cache_shading_pass.h; CPU twin
+// render/cpu/cache_shading.cpp): direct light through the shadow maps, the cache term from
 // the light map (bilinear) or the grid (trilinear), emission. Specialization constants:
 // 0 lY, 1 lC.
 #include "glue.h"

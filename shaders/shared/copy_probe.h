@@ -1,7 +1,7 @@
 #ifndef PIC_SHADERS_SHARED_COPY_PROBE_H
 #define PIC_SHADERS_SHARED_COPY_PROBE_H
 // Copy probe: the device memory bandwidth a compute shader sees, the floor the benchmark
-// compares cache lighting with on a GPU (server/gpu/copy_probe.cpp).
+// compares cache lighting with on a GPU (render/copy_probe.cpp).
 #include "glue.h"
 
 PIC_NAMESPACE_BEGIN

@@ -1,6 +1,6 @@
 #ifndef PIC_SHADERS_SHARED_GBUFFER_H
 #define PIC_SHADERS_SHARED_GBUFFER_H
-// The thin client's G-buffer (client/gbuffer_pass.h): the scene's triangles as the rasteriser
+// The thin client's G-buffer (render/passes/gbuffer_pass.h): the scene's triangles as the rasteriser
 // reads them, their materials and textures, and the four RGBA32F targets it writes per pixel:
 //   0: world position (metres), light-map u (kNotLightmappedUv: grid-shaded or missed)
 //   1: unit geometric normal facing the camera, light-map v

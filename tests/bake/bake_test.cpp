@@ -9,13 +9,13 @@
 #include <numbers>
 
 #include "bake/bake.h"
-#include "bake/embree_scene.h"
 #include "bake/grid_caches.h"
 #include "bake/link_generation.h"
 #include "bake/surfel_placement.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/sh.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 namespace {

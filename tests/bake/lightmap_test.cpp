@@ -7,10 +7,10 @@
 
 #include <gtest/gtest.h>
 
-#include "bake/embree_scene.h"
 #include "bake/lightmap_caches.h"
 #include "bake/lightmap_charts.h"
 #include "core/parallel.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 namespace {

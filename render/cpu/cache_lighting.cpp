@@ -1,0 +1,194 @@
+#include "render/cpu/cache_lighting.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+#include "core/color.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/sh.h"
+
+namespace pic {
+namespace {
+
+/// Caches per task: a cache costs nL links.
+constexpr size_t kCacheGrain = 16;
+
+/// Every binary16 pattern as float. The GPU reads half links natively; on the CPU one 256 KiB
+/// table lookup per coefficient is cheaper than converting bits in the inner loop.
+const float* halfTable() {
+    static const std::vector<float> table = [] {
+        std::vector<float> values(size_t{1} << 16);
+        for (size_t bits = 0; bits < values.size(); ++bits)
+            values[bits] = halfToFloat(static_cast<uint16_t>(bits));
+        return values;
+    }();
+    return table.data();
+}
+
+/// Calls body(std::integral_constant<int, B>{}) with B = bands ∈ [1, kMaxShBands]: the cache
+/// kernels take lY as a template argument so that their coefficient loops unroll and the
+/// accumulators stay in registers.
+template <class Body>
+void withBands(uint32_t bands, Body&& body) {
+    switch (bands) {
+    case 1: return body(std::integral_constant<int, 1>{});
+    case 2: return body(std::integral_constant<int, 2>{});
+    case 3: return body(std::integral_constant<int, 3>{});
+    case 4: return body(std::integral_constant<int, 4>{});
+    case 5: return body(std::integral_constant<int, 5>{});
+    case 6: return body(std::integral_constant<int, 6>{});
+    case 7: return body(std::integral_constant<int, 7>{});
+    case 8: return body(std::integral_constant<int, 8>{});
+    default: PIC_CHECK(bands >= 1 && bands <= uint32_t(kMaxShBands));
+    }
+}
+
+/// Incident radiance of one cache with lY = BandsY, accumulated locally and stored once.
+template <int BandsY>
+struct CacheSh {
+    static constexpr int kCountY = shCount(BandsY);
+    std::array<float, kCountY> y{};
+    std::array<float, kCountY> co{};  // only the first lC² are used
+    std::array<float, kCountY> cg{};
+
+    /// Stores cache c (lC² chroma coefficients) into out.
+    void store(size_t c, int countC, CacheValues& out) const {
+        float* dstY = out.y.data() + c * kCountY;
+        float* dstCo = out.co.data() + c * countC;
+        float* dstCg = out.cg.data() + c * countC;
+        for (int i = 0; i < kCountY; ++i) {
+            PIC_DCHECK(std::isfinite(y[i]));
+            dstY[i] = y[i];
+        }
+        for (int i = 0; i < countC; ++i) {
+            PIC_DCHECK(std::isfinite(co[i]) && std::isfinite(cg[i]));
+            dstCo[i] = co[i];
+            dstCg[i] = cg[i];
+        }
+    }
+};
+
+/// Eq. 3 with SH-projected links: L = Σ Φ_node · c_link.
+template <int BandsY>
+void lightCachesSh(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg, CacheValues& out) {
+    constexpr int countY = shCount(BandsY);
+    const int countC = shCount(int(out.bandsC));
+    const LinkSet& links = bake.links;
+    const size_t nL = links.linksPerCache;
+    const float* half = halfTable();
+    parallelFor(0, bake.caches.size(), [&](size_t c) {
+        CacheSh<BandsY> sh;
+        for (size_t slot = c * nL; slot < (c + 1) * nL; ++slot) {
+            // Padding links hold zero coefficients; the file format also allows kNoNode there.
+            const uint32_t node = links.shNodes[slot];
+            if (node == kNoNode) continue;
+            const glm::vec3 flux = fluxYCoCg[node];
+            const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
+            // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
+            for (int i = 0; i < countY; ++i) {
+                const float k = half[coefficients[i]];
+                sh.y[i] += flux.x * k;
+                if (i < countC) {
+                    sh.co[i] += flux.y * k;
+                    sh.cg[i] += flux.z * k;
+                }
+            }
+        }
+        sh.store(c, countC, out);
+    }, kCacheGrain);
+}
+
+/// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · factor · K_l(α) · y_lm(direction).
+template <int BandsY>
+void lightCachesRtp(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg,
+                    const RtpLinkTable& table, CacheValues& out) {
+    const int bandsC = int(out.bandsC);
+    const LinkSet& links = bake.links;
+    const size_t nL = links.linksPerCache;
+    parallelFor(0, bake.caches.size(), [&](size_t c) {
+        CacheSh<BandsY> sh;
+        std::array<float, shCount(BandsY)> basis;
+        for (size_t slot = c * nL; slot < (c + 1) * nL; ++slot) {
+            const float* w = table.weights.data() + slot * BandsY;
+            // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
+            if (w[0] == 0.0f) continue;
+            const glm::vec3 flux = fluxYCoCg[links.rtp[slot].node];
+            shEvaluate(BandsY, table.directions[slot], basis.data());
+            for (int l = 0; l < BandsY; ++l) {
+                const float fluxY = flux.x * w[l];
+                for (int i = l * l; i < (l + 1) * (l + 1); ++i) sh.y[i] += fluxY * basis[i];
+                if (l < bandsC) {
+                    const float fluxCo = flux.y * w[l], fluxCg = flux.z * w[l];
+                    for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
+                        sh.co[i] += fluxCo * basis[i];
+                        sh.cg[i] += fluxCg * basis[i];
+                    }
+                }
+            }
+        }
+        sh.store(c, shCount(bandsC), out);
+    }, kCacheGrain);
+}
+
+}  // namespace
+
+RtpLinkTable unpackRtpLinks(const LinkSet& links, uint32_t bandsY) {
+    PIC_CHECK(links.mode == LinkMode::Rtp);
+    PIC_CHECK(bandsY >= 1 && bandsY <= uint32_t(kMaxShBands));
+    RtpLinkTable table;
+    table.bands = bandsY;
+    table.directions.resize(links.rtp.size());
+    table.weights.resize(links.rtp.size() * bandsY);
+    parallelFor(0, links.rtp.size(), [&](size_t slot) {
+        const RtpLink& link = links.rtp[slot];
+        table.directions[slot] = decodeOctahedral(link.directionOct);
+        std::array<double, kMaxShBands> cone;
+        coneZonalBands(int(bandsY), double(link.oneMinusCosAlpha), cone.data());
+        for (uint32_t l = 0; l < bandsY; ++l)
+            table.weights[slot * bandsY + l] = float(double(link.factor) * cone[l]);
+    }, 1024);
+    return table;
+}
+
+void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
+                 const RtpLinkTable& rtp, CacheValues& out) {
+    PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
+    const uint32_t bandsY = bake.params.bandsY, bandsC = bake.params.bandsC;
+    const size_t nC = bake.caches.size();
+    if (out.bandsY != bandsY || out.bandsC != bandsC || out.cacheCount() != nC)
+        out = CacheValues::zeros(nC, bandsY, bandsC);
+
+    // Links are monochromatic, so one YCoCg conversion per node serves all its links.
+    std::vector<glm::vec3> fluxYCoCg(nodeFlux.size());
+    parallelFor(0, nodeFlux.size(), [&](size_t n) { fluxYCoCg[n] = rgbToYCoCg(nodeFlux[n]); },
+                4096);
+
+    const size_t nLinks = nC * bake.links.linksPerCache;
+    if (bake.links.mode == LinkMode::Sh) {
+        PIC_CHECK_EQ(bake.links.bands, bandsY);
+        PIC_CHECK_EQ(bake.links.shNodes.size(), nLinks);
+        PIC_CHECK_EQ(bake.links.shCoefficients.size(), nLinks * bandsY * bandsY);
+        withBands(bandsY, [&](auto bands) {
+            lightCachesSh<decltype(bands)::value>(bake, fluxYCoCg, out);
+        });
+    } else {
+        PIC_CHECK_EQ(bake.links.rtp.size(), nLinks);
+        PIC_CHECK_EQ(rtp.bands, bandsY);
+        PIC_CHECK_EQ(rtp.directions.size(), nLinks);
+        withBands(bandsY, [&](auto bands) {
+            lightCachesRtp<decltype(bands)::value>(bake, fluxYCoCg, rtp, out);
+        });
+    }
+}
+
+void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux, CacheValues& out) {
+    const RtpLinkTable rtp = bake.links.mode == LinkMode::Rtp
+                                 ? unpackRtpLinks(bake.links, bake.params.bandsY)
+                                 : RtpLinkTable{};
+    lightCaches(bake, nodeFlux, rtp, out);
+}
+
+}  // namespace pic

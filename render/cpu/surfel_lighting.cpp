@@ -1,0 +1,113 @@
+#include "render/cpu/surfel_lighting.h"
+
+#include <algorithm>
+#include <numbers>
+#include <vector>
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "core/parallel.h"
+
+namespace pic {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+/// Surfels per task: a surfel costs one shadow ray per light or one cache lookup.
+constexpr size_t kSurfelGrain = 256;
+
+/// E_light·V at `surfel`: the light's irradiance there, or zero where the surfel faces away,
+/// lies outside the cone or range (no ray is cast) or the ray to the light is occluded. Rays
+/// start just above the surface so that they do not hit the surfel's own triangle.
+glm::vec3 visibleIrradiance(const EmbreeScene& rays, const Surfel& surfel, const Light& light) {
+    glm::vec3 toLight;
+    float distance = 0.0f;
+    const glm::vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
+    if (!(e.r > 0.0f || e.g > 0.0f || e.b > 0.0f)) return glm::vec3(0.0f);
+    const float epsilon = rays.epsilon();
+    const glm::vec3 origin = surfel.position + epsilon * surfel.normal;
+    return rays.occluded(origin, toLight, 0.0f, distance - epsilon) ? glm::vec3(0.0f) : e;
+}
+
+}  // namespace
+
+void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
+                      const LightSet& lights, std::span<glm::vec3> directFlux) {
+    PIC_CHECK_EQ(directFlux.size(), bake.surfels.size());
+    // The light set scales emission per material name; resolve the names once, not per surfel.
+    std::vector<float> emissiveScale(scene.materials.size());
+    for (size_t m = 0; m < scene.materials.size(); ++m)
+        emissiveScale[m] = lights.emissiveScaleOf(scene.materials[m].name);
+
+    parallelFor(0, bake.surfels.size(), [&](size_t i) {
+        const Surfel& surfel = bake.surfels[i];
+        PIC_DCHECK(surfel.material < emissiveScale.size());
+        glm::vec3 irradiance(0.0f);
+        for (const Light& light : lights.lights)
+            irradiance += visibleIrradiance(rays, surfel, light);
+        // Lambertian reflection of the direct light plus the material's own emission, both as
+        // flux leaving the disc: B·A with B = ρ·E and B = π·L_e.
+        glm::vec3 flux = surfel.albedo * (surfel.area * irradiance);
+        flux += (kPi * surfel.area * emissiveScale[surfel.material]) * surfel.emission;
+        directFlux[i] = flux;
+    }, kSurfelGrain);
+}
+
+void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
+                      std::span<uint32_t> bits) {
+    const size_t nS = bake.surfels.size();
+    PIC_CHECK_EQ(bits.size(), visibilityWords(nS));
+    // White and of unit strength: where E > 0 for it, E > 0 for any colour and intensity.
+    Light unit = light;
+    unit.color = glm::vec3(1.0f);
+    unit.intensity = 1.0f;
+    // A task per word, so that no two tasks write one word.
+    parallelFor(
+        0, bits.size(),
+        [&](size_t word) {
+            uint32_t mask = 0;
+            const size_t end = std::min(nS, 32 * word + 32);
+            for (size_t i = 32 * word; i < end; ++i) {
+                const glm::vec3 e = visibleIrradiance(rays, bake.surfels[i], unit);
+                if (e.r > 0.0f) mask |= 1u << (i - 32 * word);
+            }
+            bits[word] = mask;
+        },
+        kSurfelGrain / 32);
+}
+
+void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
+                      std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
+                      std::span<glm::vec3> surfelFlux) {
+    PIC_CHECK_EQ(directFlux.size(), bake.surfels.size());
+    PIC_CHECK_EQ(surfelFlux.size(), bake.surfels.size());
+    PIC_CHECK(directFlux.data() != surfelFlux.data());
+
+    parallelFor(0, bake.surfels.size(), [&](size_t i) {
+        const Surfel& surfel = bake.surfels[i];
+        PIC_DCHECK(surfel.triangle < scene.triangles.size());
+        // The renderer's lookup wants the point's barycentrics on its triangle.
+        const Triangle& triangle = scene.triangles[surfel.triangle];
+        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
+                                        scene.vertices[triangle.v[1]].position,
+                                        scene.vertices[triangle.v[2]].position);
+        const RadianceSh radiance = lookupSurfaceRadiance(bake, previousBounce, surfel.triangle,
+                                                          b.y, b.z, surfel.position);
+        // Truncated SH ring: the clamped-cosine convolution can dip below zero on the dark
+        // side of a bright cache. Irradiance is never negative, and negative flux would carry
+        // negative light into the next bounce, so it is cut at zero.
+        const glm::vec3 e = glm::max(irradiance(radiance, surfel.normal), glm::vec3(0.0f));
+        surfelFlux[i] = directFlux[i] + surfel.albedo * (surfel.area * e);
+    }, kSurfelGrain);
+}
+
+void lightSurfels(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
+                  const LightSet& lights, const CacheValues* previousBounce,
+                  std::span<glm::vec3> surfelFlux) {
+    if (!previousBounce) return directSurfelFlux(scene, rays, bake, lights, surfelFlux);
+    std::vector<glm::vec3> direct(bake.surfels.size());
+    directSurfelFlux(scene, rays, bake, lights, direct);
+    bounceSurfelFlux(scene, bake, direct, *previousBounce, surfelFlux);
+}
+
+}  // namespace pic

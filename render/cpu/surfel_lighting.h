@@ -1,0 +1,54 @@
+#pragma once
+/// Surfel lighting, CPU twin (paper 000 Figure 2 step 2, §3 and §4.1): the outgoing flux of
+/// every leaf surfel, Φ = ρ·A·(E_direct + E_indirect) + π·L_e·A·emissiveScale, in W per RGB
+/// channel, written in leaf order (index i = surfel i = hierarchy node i).
+///
+/// The pass is split in two so that bounces do not recast shadow rays: the direct part depends
+/// on the light set only, the bounce part adds ρ·A·E_indirect read from the previous bounce's
+/// caches.
+
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "core/bake_data.h"
+#include "core/cache_values.h"
+#include "core/light_set.h"
+#include "core/scene.h"
+#include "rays/embree_scene.h"
+
+namespace pic {
+
+/// Direct flux of every surfel: ρ·A·Σ_lights E_light·V + π·L_e·A·emissiveScale(material),
+/// with V the Embree visibility from the surfel (offset by rays.epsilon() along its normal) to
+/// the light. `directFlux` must hold nS entries.
+void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
+                      const LightSet& lights, std::span<glm::vec3> directFlux);
+
+/// Words of a visibility mask over nS surfels (surfelVisibility): one bit per surfel.
+inline size_t visibilityWords(size_t surfels) {
+    return (surfels + 31) / 32;
+}
+
+/// The V of directSurfelFlux for one light, as bits: bit i % 32 of `bits[i / 32]` is set where
+/// the surfel faces the light within its cone and range and the ray to it is unoccluded. The
+/// light's colour and intensity do not matter. `bits` must hold visibilityWords(nS) words.
+void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
+                      std::span<uint32_t> bits);
+
+/// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
+/// irradiance that the interpolated caches of `previousBounce` deliver at the surfel
+/// (lookupSurfaceRadiance at its barycentrics, clamped-cosine about its normal), per channel
+/// cut at zero where SH ringing makes it negative.
+/// `directFlux` and `surfelFlux` hold nS entries; they may not alias.
+void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
+                      std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
+                      std::span<glm::vec3> surfelFlux);
+
+/// Both parts at once: direct flux, plus the bounce from `previousBounce` when it is not null
+/// (null for the first pass). `surfelFlux` must hold nS entries.
+void lightSurfels(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
+                  const LightSet& lights, const CacheValues* previousBounce,
+                  std::span<glm::vec3> surfelFlux);
+
+}  // namespace pic

@@ -1,0 +1,140 @@
+#include "render/cpu_runtime.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "core/color.h"
+#include "core/sh.h"
+#include "render/cpu/cache_lighting.h"
+#include "render/cpu/pull.h"
+#include "render/cpu/surfel_lighting.h"
+
+namespace pic {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Luminance of the summed flux (W); summed in double so that 10⁵ small terms keep their
+/// digits, and in index order so that the result does not depend on threads.
+double totalLuminance(std::span<const glm::vec3> flux) {
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (const glm::vec3& f : flux)
+        for (int c = 0; c < 3; ++c) sum[c] += f[c];
+    return luminance(glm::vec3(float(sum[0]), float(sum[1]), float(sum[2])));
+}
+
+/// The CPU backend: every pass of paper 000 Figure 2 but shadow maps (visibility comes from
+/// Embree rays). Not thread-safe: one update at a time.
+class CpuRuntime final : public Runtime {
+public:
+    CpuRuntime(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
+               const BounceParams& bounces)
+        : mScene(scene),
+          mRays(rays),
+          mBake(bake),
+          mBounces(bounces),
+          mDirectFlux(bake.surfels.size()),
+          mNodeFlux(bake.nodes.size()),
+          mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)) {
+        // RTP links' directions and cone factors do not depend on the lights: unpacked once.
+        if (bake.links.mode == LinkMode::Rtp) mRtp = unpackRtpLinks(bake.links, bake.params.bandsY);
+    }
+
+    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
+    Result<const CacheTextures*> textures() override;
+    const char* name() const override { return "cpu"; }
+
+private:
+    const Scene& mScene;
+    const EmbreeScene& mRays;
+    const BakeData& mBake;
+    BounceParams mBounces;
+    RtpLinkTable mRtp;                  ///< RTP bakes only
+    std::vector<glm::vec3> mDirectFlux; ///< nS: flux from lights and emission, per update
+    std::vector<glm::vec3> mNodeFlux;   ///< 2nS − 1: leaves hold the current bounce's surfel flux
+    CacheValues mValues;
+    CacheTextures mTextures;         ///< filled on demand from mValues
+    bool mTexturesCurrent = false;
+};
+
+Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateStats* stats) {
+    PIC_TRY(checkRuntimeLights(lights, mScene));
+    mTexturesCurrent = false;
+
+    const Clock::time_point start = Clock::now();
+    UpdateStats local;
+    UpdateStats& s = stats ? *stats : local;
+    s = UpdateStats{};
+    double& surfelMs = s.passMs["surfel_lighting"];
+    double& pullMs = s.passMs["pull"];
+    double& cacheMs = s.passMs["cache_lighting"];
+
+    const bool progressive = mBounces.bounces < 0;
+    const int passes = progressive ? mBounces.maxBounces : mBounces.bounces;
+    if (passes == 0) {
+        // No cache pass: the caches hold no light and no surfel needs lighting.
+        mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+        s.totalMs = millisecondsSince(start);
+        return &mValues;
+    }
+
+    const std::span<glm::vec3> leaves(mNodeFlux.data(), mBake.surfels.size());
+    Clock::time_point t = Clock::now();
+    directSurfelFlux(mScene, mRays, mBake, lights, mDirectFlux);
+    std::copy(mDirectFlux.begin(), mDirectFlux.end(), leaves.begin());
+    double total = totalLuminance(leaves);
+    surfelMs += millisecondsSince(t);
+
+    for (int bounce = 1;; ++bounce) {
+        t = Clock::now();
+        pullFlux(mBake, mNodeFlux);
+        pullMs += millisecondsSince(t);
+
+        t = Clock::now();
+        lightCaches(mBake, mNodeFlux, mRtp, mValues);
+        cacheMs += millisecondsSince(t);
+        s.bounces = bounce;
+        s.surfelFlux = total;
+        if (bounce == passes) break;
+
+        // The next bounce: direct flux plus what the surfels receive from these caches.
+        t = Clock::now();
+        bounceSurfelFlux(mScene, mBake, mDirectFlux, mValues, leaves);
+        const double next = totalLuminance(leaves);
+        surfelMs += millisecondsSince(t);
+        // Progressive: a bounce that adds less than `convergence` of the flux is not worth
+        // its cache pass (`<=` also stops a scene without light at once).
+        if (progressive && next - total <= double(mBounces.convergence) * next) break;
+        total = next;
+    }
+    s.totalMs = millisecondsSince(start);
+    return &mValues;
+}
+
+Result<const CacheTextures*> CpuRuntime::textures() {
+    if (!mTexturesCurrent) {
+        if (mTextures.bandsY == 0) mTextures = makeCacheTextures(mBake);
+        copyCachesToTextures(mBake, mValues, mTextures);
+        mTexturesCurrent = true;
+    }
+    return &mTextures;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Runtime>> createCpuRuntime(const Scene& scene, const EmbreeScene& rays,
+                                                  const BakeData& bake,
+                                                  const BounceParams& bounces) {
+    PIC_TRY(checkRuntimeBake(scene, bake));
+    PIC_TRY(checkBounceParams(bounces));
+    return std::unique_ptr<Runtime>(new CpuRuntime(scene, rays, bake, bounces));
+}
+
+}  // namespace pic

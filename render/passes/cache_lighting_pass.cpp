@@ -1,0 +1,190 @@
+#include "render/passes/cache_lighting_pass.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "core/color.h"
+#include "core/parallel.h"
+#include "shaders/shared/cache_lighting.h"
+#include "spirv/cache_lighting_comp.h"
+
+namespace pic::gpu {
+namespace {
+
+/// Chunks hold a multiple of this many caches, so that every chunk's offset into the link
+/// buffer is a multiple of 256 bytes (the largest minTexelBufferOffsetAlignment in use).
+constexpr uint32_t kChunkAlignment = 256;
+
+/// Node radiance, links, caches Y, Co, Cg, SH tables.
+constexpr uint32_t kBindingCount = 6;
+
+/// The uint texel format of `words` 32-bit components.
+VkFormat uintTexelFormat(uint32_t words) {
+    constexpr std::array<VkFormat, 4> kFormats = {VK_FORMAT_R32_UINT, VK_FORMAT_R32G32_UINT,
+                                                  VK_FORMAT_R32G32B32_UINT,
+                                                  VK_FORMAT_R32G32B32A32_UINT};
+    return kFormats[words - 1];
+}
+
+/// The texel (in words, at most `maxWords`) to read a link of `linkWords` words in: of those
+/// that divide it and that the device reads as a uniform texel buffer, 4 or 2 words before 3,
+/// and a word (R32_UINT, which every device reads) if none does. Lavapipe loads a 2- or
+/// 4-word texel with one load per lane but a 3-word one with two and more shuffles: read as
+/// three 2-word texels, SH links of lY = 3 (6 words) light the moderate atrium's caches in
+/// 0.89 of the time that two 3-word texels take (61 alternated passes). A GPU's loads favour
+/// powers of two as well.
+uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t maxWords) {
+    for (uint32_t words : {4u, 2u, 3u})
+        if (words <= maxWords && linkWords % words == 0 &&
+            context.canReadTexels(uintTexelFormat(words)))
+            return words;
+    return 1;
+}
+
+}  // namespace
+
+GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea) {
+    // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
+    const double visible =
+        std::clamp(double(link.factor) * std::numbers::pi * double(nodeArea), 0.0, 1.0);
+    auto unorm = uint32_t(std::lround(visible * 65535.0));
+    // A real link too faint for unorm16 would read as padding; it keeps the smallest step.
+    if (unorm == 0 && link.factor > 0.0f) unorm = 1;
+    const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
+    return {link.node, link.directionOct, unorm | (cone << 16)};
+}
+
+uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
+    return floatToHalfClamped(
+        float(double(halfToFloat(coefficient)) * std::numbers::pi * double(nodeArea)));
+}
+
+Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
+                                                                     const BakeData& bake,
+                                                                     bool cachePerSubgroup,
+                                                                     uint32_t maxTexelWords) {
+    std::unique_ptr<CacheLightingPass> pass(new CacheLightingPass());
+    // Per subgroup: as many caches per workgroup as it has subgroups of the default size (the
+    // shader strides over any the device leaves, should it launch fewer).
+    pass->mCachesPerGroup = cachePerSubgroup
+        ? std::max<uint32_t>(kCacheLightingGroup / context.subgroupSize(), 1)
+        : kCacheLightingGroup;
+    const LinkSet& links = bake.links;
+    pass->mRtpForm = links.mode == LinkMode::Rtp;
+    pass->mCacheCount = uint32_t(bake.caches.size());
+    pass->mLinksPerCache = links.linksPerCache;
+    pass->mCountY = bake.params.bandsY * bake.params.bandsY;
+    const VkDeviceSize nLinks = VkDeviceSize{pass->mCacheCount} * links.linksPerCache;
+
+    // A chunk's links fill at most one texel view.
+    const uint32_t linkWords =
+        pass->mRtpForm ? sizeof(GpuRtpLink) / sizeof(uint32_t) : shLinkWords(pass->mCountY);
+    pass->mTexelWords = linkTexelWords(context, linkWords, maxTexelWords);
+    const VkDeviceSize texelsPerCache = std::max<VkDeviceSize>(
+        VkDeviceSize{linkWords / pass->mTexelWords} * links.linksPerCache, 1);
+    const VkDeviceSize maxTexels = context.properties().limits.maxTexelBufferElements;
+    const VkDeviceSize chunk = (maxTexels / texelsPerCache) / kChunkAlignment * kChunkAlignment;
+    if (chunk == 0)
+        return fail(ErrorCode::Unsupported,
+                    "{} links per cache need {} texels per cache, too many for {} caches within "
+                    "one texel view of {} texels",
+                    links.linksPerCache, texelsPerCache, kChunkAlignment, maxTexels);
+    for (uint32_t first = 0; first < pass->mCacheCount; first += uint32_t(chunk)) {
+        pass->mChunkFirst.push_back(first);
+        pass->mChunkCount.push_back(std::min<uint32_t>(uint32_t(chunk), pass->mCacheCount - first));
+    }
+
+    KernelLayout layout;
+    layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings[0] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // node radiance
+    layout.bindings[1] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // links
+    layout.bindings[kBindingCount - 1] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
+    layout.pushBytes = sizeof(CacheLightingPush);
+    layout.specialization = {bake.params.bandsY,
+                             bake.params.bandsC,
+                             links.linksPerCache,
+                             pass->mRtpForm ? kLinkFormRtp : kLinkFormSh,
+                             cachePerSubgroup ? kCachePerSubgroup : kCachePerInvocation,
+                             pass->mTexelWords};
+    layout.maxSets = std::max<uint32_t>(uint32_t(pass->mChunkFirst.size()), 1);
+    PIC_TRY_ASSIGN(pass->mKernel,
+                   Kernel::create(context, kSpirvCacheLightingComp, layout, "cache_lighting"));
+
+    constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+    // The links take the node's radiance Φ / (π·A) rather than its flux (§4.7).
+    if (pass->mRtpForm) {
+        std::vector<GpuRtpLink> rtp(links.rtp.size());
+        parallelFor(
+            0, rtp.size(),
+            [&](size_t i) {
+                const RtpLink& link = links.rtp[i];
+                // Padding (factor 0) may name any node; V = 0 marks it.
+                rtp[i] = link.factor > 0.0f ? packRtpLink(link, bake.nodes[link.node].area)
+                                            : GpuRtpLink{0, 0, 0};
+            },
+            4096);
+        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const GpuRtpLink>(rtp),
+                                                              kTexels, "RTP links"));
+    } else {
+        const uint32_t countY = pass->mCountY;
+        const size_t words = shLinkWords(countY);
+        std::vector<uint32_t> sh(links.shNodes.size() * words, 0u);
+        parallelFor(
+            0, links.shNodes.size(),
+            [&](size_t slot) {
+                const uint32_t node = links.shNodes[slot];
+                const float area = node == kNoNode ? 0.0f : bake.nodes[node].area;
+                uint32_t* record = sh.data() + slot * words;
+                record[0] = node;
+                const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
+                for (uint32_t i = 0; i < countY; ++i)
+                    record[1 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
+                                         << (16 * (i % 2));
+            },
+            4096);
+        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const uint32_t>(sh),
+                                                              kTexels, "SH links"));
+    }
+    pass->mLinkBytes = nLinks * linkWords * sizeof(uint32_t);
+    const VkFormat format = uintTexelFormat(pass->mTexelWords);
+    const VkDeviceSize texelBytes = VkDeviceSize{pass->mTexelWords} * sizeof(uint32_t);
+    for (size_t k = 0; k < pass->mChunkFirst.size(); ++k) {
+        const VkDeviceSize first = VkDeviceSize{pass->mChunkFirst[k]} * texelsPerCache;
+        PIC_TRY_ASSIGN(TexelView view,
+                       context.createTexelView(pass->mLinks, format, first * texelBytes,
+                                               pass->mChunkCount[k] * texelsPerCache, "links"));
+        pass->mLinkViews.push_back(std::move(view));
+    }
+    return pass;
+}
+
+Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeRadiance,
+                                     const Buffer& cacheY, const Buffer& cacheCo,
+                                     const Buffer& cacheCg, const Buffer& shTables) {
+    mSets.clear();
+    PIC_TRY(mKernel.resetSets());
+    PIC_TRY_ASSIGN(mRadianceView,
+                   context.createTexelView(nodeRadiance, VK_FORMAT_R32_UINT, "node radiance"));
+    for (size_t k = 0; k < mChunkFirst.size(); ++k) {
+        const std::array<BindingResource, kBindingCount> resources = {
+            BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),
+            BindingResource::storage(2, cacheY),       BindingResource::storage(3, cacheCo),
+            BindingResource::storage(4, cacheCg),      BindingResource::storage(5, shTables),
+        };
+        PIC_TRY_ASSIGN(VkDescriptorSet set, mKernel.makeSet(resources));
+        mSets.push_back(set);
+    }
+    return {};
+}
+
+void CacheLightingPass::record(VkCommandBuffer cmd) {
+    // Chunks write disjoint caches: no barrier between them.
+    for (size_t k = 0; k < mSets.size(); ++k) {
+        const CacheLightingPush push{mChunkFirst[k], mChunkCount[k], 0, 0};
+        mKernel.dispatch(cmd, mSets[k], &push, groupsFor(push.cacheCount, mCachesPerGroup));
+    }
+}
+
+}  // namespace pic::gpu

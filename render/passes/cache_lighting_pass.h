@@ -1,0 +1,66 @@
+#pragma once
+/// Cache lighting on the GPU (paper 000 Figure 2 step 4, eq. 3, §4.6, §4.8): each cache's
+/// incident radiance from its nL links, YCoCg with lY / lC bands, half floats. Links stay in
+/// the bake's order, sequential per cache, and are read as uniform texel buffers in chunks of
+/// caches so that no view exceeds the device's maxTexelBufferElements (2^27 on lavapipe).
+/// CPU twin: render/cpu/cache_lighting.h.
+
+#include <memory>
+#include <vector>
+
+#include "core/bake_data.h"
+#include "gpu/kernel.h"
+#include "shaders/shared/cache_lighting.h"
+
+namespace pic::gpu {
+
+/// The GPU's 12-byte form of a runtime-projected link whose node has area `nodeArea`:
+/// V = factor·π·A as unorm16 (at least one step for a link with factor > 0) and 1 − cos α as
+/// binary16 (shaders/shared/cache_lighting.h).
+GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea);
+/// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
+/// c·π·A, clamped to ±65504.
+uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
+
+class CacheLightingPass {
+public:
+    /// Uploads the links (RTP: 12 bytes each, packRtpLink; SH: node index + lY² half
+    /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
+    /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
+    /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
+    /// in uint texels of up to `maxTexelWords` words that the device supports and that divide
+    /// a link: 4 or 2 words before 3, else one.
+    static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
+                                                             bool cachePerSubgroup,
+                                                             uint32_t maxTexelWords = 4);
+    /// Binds the node radiance (RGBE8 per node; its usage must allow uniform texel buffers),
+    /// the output caches (half) and the SH tables.
+    Result<void> bind(Context& context, const Buffer& nodeRadiance, const Buffer& cacheY,
+                      const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& shTables);
+    void record(VkCommandBuffer cmd);
+    /// Link bytes read per update.
+    VkDeviceSize linkBytes() const { return mLinkBytes; }
+    VkDeviceSize bytes() const { return mLinks.size(); }
+    /// 32-bit words per texel the links are read in (1 to 4).
+    uint32_t texelWords() const { return mTexelWords; }
+    uint32_t chunks() const { return uint32_t(mChunkFirst.size()); }
+
+private:
+    CacheLightingPass() = default;
+    Kernel mKernel;
+    bool mRtpForm = true;
+    uint32_t mCachesPerGroup = 1;  ///< caches one workgroup lights
+    uint32_t mCacheCount = 0;
+    uint32_t mLinksPerCache = 0;
+    uint32_t mCountY = 0;
+    VkDeviceSize mLinkBytes = 0;
+    uint32_t mTexelWords = 1;
+    Buffer mLinks;            ///< RTP: GpuRtpLink per link; SH: shLinkWords(lY²) words per link
+    TexelView mRadianceView;  ///< node radiance as uint texels
+    std::vector<TexelView> mLinkViews;  ///< per chunk: its links, mTexelWords words per texel
+    std::vector<uint32_t> mChunkFirst;
+    std::vector<uint32_t> mChunkCount;
+    std::vector<VkDescriptorSet> mSets;
+};
+
+}  // namespace pic::gpu

@@ -1,0 +1,269 @@
+#pragma once
+/// Shadow maps (paper 000 Figure 2 step 1): depth maps of the scene from every light, in one
+/// 2D-array depth image: 6 cube faces for point lights and spots wider than
+/// kMaxPerspectiveSpot, one perspective layer for narrower spots and one orthographic layer
+/// over the scene for directional lights. A light whose position, direction, type and cone
+/// did not change since the previous set keeps its layers: only changed lights re-render.
+/// Three things let lavapipe rasterise fewer triangles: coplanar triangles are merged into
+/// larger ones; the closed surfaces of the scene (core/solids.h) that a light sees from outside
+/// are drawn without the faces that look away from it; and layers whose texels are wide draw a
+/// simplified level of detail whose measured distance from the scene stays within half a
+/// texel (which the shadow test's offsets already absorb).
+/// Perspective layers may also be smaller than the image's layers (ShadowMapOptions::
+/// equalFootprint): each light then renders and samples the top-left side × side texels.
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/light_set.h"
+#include "core/scene.h"
+#include "core/solids.h"
+#include "gpu/context.h"
+#include "shaders/shared/shadow_map.h"
+
+namespace pic::gpu {
+
+/// Spots with a wider outer half-angle get a cube map (a single perspective layer would
+/// need a field of view near 180°). Radians.
+inline constexpr float kMaxPerspectiveSpot = 1.0472f;  // 60°
+
+/// Spatially close triangles, consecutive in the pass's index buffer: the unit of frustum
+/// culling, so that a cube face rasterises only the part of the scene it can see.
+struct TriangleCluster {
+    uint32_t firstTriangle = 0;
+    uint32_t triangleCount = 0;
+    Aabb bounds;
+    /// The union of the bounds of the solids its triangles belong to; empty when they are
+    /// open (a cluster never mixes the two).
+    Aabb solidBounds;
+};
+
+/// Triangles per cluster: small enough that a cube face skips most of a room, large enough
+/// that one layer needs few draws.
+inline constexpr uint32_t kShadowClusterTriangles = 128;
+
+/// The faces the one-sided pipeline skips. Solids wind counter-clockwise seen from outside;
+/// the light-space matrices are right-handed with y up in clip space, which Vulkan's
+/// framebuffer (y down) mirrors, so a face that looks at the light winds clockwise there:
+/// Vulkan's back face under VK_FRONT_FACE_COUNTER_CLOCKWISE. Skipped are the front ones.
+inline constexpr VkCullModeFlags kCullAwayFromLight = VK_CULL_MODE_FRONT_BIT;
+
+/// Relative error (of the scene's extent) up to which mergeShadowCasters collapses edges: float
+/// rounding, so that only coplanar triangles merge.
+inline constexpr float kCasterMergeError = 1e-6f;
+
+/// The scene's triangles as shadow casters (positions only): corners welded by position and
+/// runs of coplanar triangles merged into fewer, larger ones by meshoptimizer's edge-collapse
+/// simplifier at kCasterMergeError, with open borders locked. The same surfaces.
+Scene mergeShadowCasters(const Scene& scene);
+
+/// `casters` (welded, as mergeShadowCasters returns them) simplified by edge collapses whose
+/// error stays within `error` metres, open borders locked: a coarser level of detail.
+Scene simplifyShadowCasters(const Scene& casters, float error);
+
+/// How far the surface of `fine` strays from that of `coarse`, metres: the largest distance
+/// from a sample of `fine` (its corners and centroids) to the nearest point of `coarse`,
+/// found with Embree's point queries; +∞ when a sample has nothing of `coarse` within `limit`.
+float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit);
+
+/// How far (in texels of the layer, at the caster's depth) a level of detail may move a
+/// caster's surface. surfel lighting's shadow test moves the receiver one texel along its
+/// normal and allows half a texel more, so a surface moved by half a texel neither shadows
+/// itself nor moves a shadow's edge by more than the map's own resolution does.
+inline constexpr float kCasterErrorPerTexel = 0.5f;
+
+/// Coarser levels of detail are kept only when they have at most this fraction of the
+/// triangles of the previous level (otherwise they would cost memory for nothing).
+inline constexpr float kCasterLevelReduction = 0.75f;
+
+/// Area-weighted points on the scene's surfaces from which a perspective light's typical
+/// receiver distance is taken (ShadowMapOptions::equalFootprint).
+inline constexpr uint32_t kFootprintSamples = 4096;
+/// Smallest side of a layer, and the step sides are rounded up to (texels).
+inline constexpr uint32_t kMinShadowSide = 16;
+
+/// The GpuLight record of `light` as lightIrradiance (shaders/lib/lights.glsl) reads it:
+/// type, position, direction, range, radiant intensity and cone; the shadow fields zero.
+GpuLight gpuLightRecord(const Light& light);
+
+/// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
+/// (median splits of their centroids); `order` receives the triangle indices in cluster order.
+/// With `solids`, the triangles of solids come first and share no cluster with open ones.
+std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
+                                                   std::vector<uint32_t>& order,
+                                                   const Solids* solids = nullptr);
+
+/// Where a layer's light sits, as far as solids are concerned.
+struct ShadowEye {
+    bool atInfinity = true;    ///< a directional light: outside every solid
+    glm::vec3 position{0.0f};  ///< a point or spot light's position, metres
+    /// Metres: solids closer to the light than this keep both faces, because the near plane
+    /// may clip the faces where the light's rays enter them.
+    float margin = 0.0f;
+
+    /// Whether the light lies outside every solid within `solidBounds`.
+    bool outside(const Aabb& solidBounds) const;
+};
+
+/// A run of triangles to draw: [firstTriangle, firstTriangle + triangleCount).
+struct TriangleRange {
+    uint32_t firstTriangle = 0;
+    uint32_t triangleCount = 0;
+    /// Triangles of solids the light sees from outside: their faces that look away from the
+    /// light may be skipped.
+    bool oneSided = false;
+};
+
+/// The clusters whose bounds can intersect the clip volume of `clipFromWorld` (Vulkan's:
+/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w), adjacent ones with the same sidedness merged into one range.
+/// Conservative: a cluster is dropped only when its box lies wholly outside one of the six
+/// planes.
+std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
+                                                 const glm::mat4& clipFromWorld,
+                                                 const ShadowEye& eye = {});
+
+/// The nearest view depth (metres; w of clip space) of the clusters whose bounds can meet
+/// the clip volume of `clipFromWorld`, +∞ when none can.
+float nearestClusterDepth(std::span<const TriangleCluster> clusters, const glm::mat4& clipFromWorld);
+
+/// How the pass draws the scene. The caster options are on by default; off only to measure
+/// what they save and to test what they change. The first two store the same depths; levels
+/// of detail move surfaces by at most kCasterErrorPerTexel texels of the layer that draws them.
+struct ShadowMapOptions {
+    bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
+    bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
+    bool levelsOfDetail = true;  ///< layers whose texels are coarse draw simplified casters
+    /// Every layer `size` texels wide (false), or each perspective layer only as wide as
+    /// needed for texels, at the median distance from the light of the scene's surfaces that
+    /// layer holds (within the light's range and cone), as wide as an orthographic layer's
+    /// over the scene (at most `size`).
+    /// Off for pixels (a camera may look at the nearest surfaces); on for surfels, which are
+    /// spread over the surfaces by area.
+    bool equalFootprint = false;
+};
+
+/// The side (texels) of a perspective layer whose texels are `footprint` metres wide at
+/// `distance` metres, for a layer `slopeAtOneTexel` wide per metre of depth (2·tan(fov/2)):
+/// rounded up to a multiple of kMinShadowSide, within [kMinShadowSide, maxSide].
+uint32_t footprintSide(float slopeAtOneTexel, float distance, float footprint, uint32_t maxSide);
+
+/// One level of detail of the casters: its clusters, consecutive in the pass's cluster list.
+struct CasterLevel {
+    /// Metres the scene's surfaces moved, measured (surfaceDeviation; for level 0, the
+    /// merged casters, float rounding where only coplanar triangles merged).
+    float error = 0.0f;
+    uint32_t firstCluster = 0;
+    uint32_t clusterCount = 0;
+    uint32_t triangles = 0;
+};
+
+class ShadowMapPass {
+public:
+    /// Uploads the scene's casters and builds the depth-only pipelines. `size` is the side of
+    /// one layer in texels.
+    static Result<std::unique_ptr<ShadowMapPass>> create(Context& context, const Scene& scene,
+                                                         uint32_t size,
+                                                         const ShadowMapOptions& options = {});
+    ~ShadowMapPass();
+
+    /// Lays out `lights` on layers, writes their GpuLight records and matrices and marks the
+    /// lights whose maps must be rendered. `reallocated` tells whether the depth image was
+    /// replaced (descriptor sets that sample it must be rebuilt).
+    Result<void> prepare(const LightSet& lights, bool& reallocated);
+    /// Renders the layers of the lights prepare() marked, leaving every layer readable by
+    /// compute shaders.
+    void record(VkCommandBuffer cmd);
+
+    /// Lights rendered by the last record().
+    uint32_t renderedLights() const { return mRenderedLights; }
+    /// Triangles drawn by the last record(), over all layers (after frustum culling).
+    uint64_t drawnTriangles() const { return mDrawnTriangles; }
+    /// Texels of the layers the last record() rendered (side² each).
+    uint64_t renderedTexels() const { return mRenderedTexels; }
+    /// Of drawnTriangles(), those drawn with faces looking away from the light skipped.
+    uint64_t oneSidedTriangles() const { return mOneSidedTriangles; }
+    /// Caster triangles (the scene's, coplanar ones merged) and those of them in solids, at
+    /// level of detail 0.
+    uint32_t casterTriangles() const { return mLevels.front().triangles; }
+    uint32_t solidTriangles() const { return mSolidTriangles; }
+    /// The levels of detail, finest (level 0) first.
+    std::span<const CasterLevel> levels() const { return mLevels; }
+    /// The level each layer was last rendered with.
+    std::span<const uint32_t> layerLevels() const { return mLayerLevels; }
+    /// The GpuLight records of the lights prepare() laid out, in order.
+    std::vector<GpuLight> lightRecords() const;
+    /// The records of the layers prepare() laid out (GpuLight::firstLayer indexes them).
+    std::span<const GpuShadowLayer> layerRecords() const { return mLayers; }
+    uint32_t size() const { return mSize; }
+    const DepthArray& depth() const { return mDepth; }
+    const Buffer& lightBuffer() const { return mLights; }     ///< GpuLight[kMaxLights]
+    const Buffer& layerBuffer() const { return mLayerBuffer; }  ///< GpuShadowLayer[6·kMaxLights]
+    uint32_t lightCount() const { return uint32_t(mCurrent.size()); }
+    /// Bytes of GPU memory held (geometry, depth image, light records).
+    VkDeviceSize bytes() const;
+
+private:
+    /// What a light's depth layers depend on.
+    struct LightSlot {
+        std::string id;
+        GpuLight gpu{};
+        glm::vec3 position{0.0f};
+        glm::vec3 direction{0.0f};
+        float outerConeAngle = 0.0f;
+        LightType type = LightType::Point;
+        uint32_t layers = 0;
+        std::array<uint32_t, 6> sides{};  ///< of its layers, in texels
+        ShadowEye eye;
+        bool dirty = true;
+    };
+
+    ShadowMapPass(Context& context) : mContext(context) {}
+    /// Binds `pipeline` with layer `layer`'s matrix and geometry and a side × side viewport.
+    void bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint32_t layer, uint32_t side) const;
+    /// The sides of `light`'s perspective layers (a spot's one layer first; slopeAtOneTexel:
+    /// 2·tan(fov/2)): with equalFootprint, each the one whose texels, at the median distance
+    /// of the surface samples the light reaches on that layer, are as wide as an
+    /// orthographic layer's (kMinShadowSide for a layer that holds none); otherwise mSize.
+    std::array<uint32_t, 6> perspectiveSides(const Light& light, float slopeAtOneTexel) const;
+    /// Metres per texel of an orthographic layer: its box spans the scene's bounding sphere
+    /// with a 1 % margin.
+    float orthographicTexel() const { return 1.01f * std::max(mBounds.diagonal(), 1e-3f) / float(mSize); }
+    LightSlot describe(const Light& light, uint32_t firstLayer,
+                       std::vector<GpuShadowLayer>& layers) const;
+    /// The coarsest level whose error layer `layer` of `slot` allows everywhere it looks.
+    uint32_t levelFor(const LightSlot& slot, uint32_t layer) const;
+    std::span<const TriangleCluster> clustersOf(uint32_t level) const {
+        return std::span(mClusters).subspan(mLevels[level].firstCluster, mLevels[level].clusterCount);
+    }
+
+    Context& mContext;
+    uint32_t mSize = 0;
+    Aabb mBounds;
+    std::vector<glm::vec3> mSurfaceSamples;  ///< kFootprintSamples (equalFootprint), else none
+    std::vector<TriangleCluster> mClusters;  ///< every level's, level by level
+    std::vector<CasterLevel> mLevels;
+    std::vector<uint32_t> mLayerLevels;
+    Buffer mVertices;
+    Buffer mIndices;
+    Buffer mLights;
+    Buffer mLayerBuffer;
+    DepthArray mDepth;
+    VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
+    VkPipeline mPipeline = VK_NULL_HANDLE;         ///< both faces
+    VkPipeline mOneSidedPipeline = VK_NULL_HANDLE;  ///< faces looking towards the light
+    uint32_t mSolidTriangles = 0;
+    std::vector<LightSlot> mCurrent;
+    std::vector<GpuShadowLayer> mLayers;
+    uint32_t mRenderedLights = 0;
+    uint64_t mDrawnTriangles = 0;
+    uint64_t mRenderedTexels = 0;
+    uint64_t mOneSidedTriangles = 0;
+};
+
+}  // namespace pic::gpu

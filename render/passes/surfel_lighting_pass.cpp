@@ -1,0 +1,198 @@
+#include "render/passes/surfel_lighting_pass.h"
+
+#include <array>
+
+#include "core/cache_values.h"
+#include "core/geometry.h"
+#include "core/parallel.h"
+#include "shaders/shared/surfel_lighting.h"
+#include "spirv/surfel_lighting_comp.h"
+
+namespace pic::gpu {
+namespace {
+
+constexpr uint32_t kBindingCount = 16;
+constexpr uint32_t kSamplerBinding = 4;
+constexpr uint32_t kShTablesBinding = 11;
+/// Bindings read as uniform texel buffers (shaders/surfel_lighting.comp says why).
+constexpr std::array<uint32_t, 9> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15};
+constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+
+}  // namespace
+
+const char* directVisibilityName(DirectVisibility visibility) {
+    return visibility == DirectVisibility::Rays ? "rays" : "shadow-maps";
+}
+
+Result<std::optional<DirectVisibility>> parseDirectVisibility(std::string_view text) {
+    if (text == "auto") return std::nullopt;
+    if (text == "shadow-maps") return DirectVisibility::ShadowMaps;
+    if (text == "rays") return DirectVisibility::Rays;
+    return fail(ErrorCode::InvalidInput,
+                "direct visibility \"{}\" is none of auto, shadow-maps, rays", text);
+}
+
+Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
+    Context& context, const Scene& scene, const BakeData& bake, float epsilon,
+    DirectVisibility visibility) {
+    std::unique_ptr<SurfelLightingPass> pass(new SurfelLightingPass(context, scene));
+    pass->mSurfelCount = uint32_t(bake.surfels.size());
+    pass->mEpsilon = epsilon;
+    pass->mVisibility = visibility;
+    const bool rays = visibility == DirectVisibility::Rays;
+
+    KernelLayout layout;
+    layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    layout.bindings[kSamplerBinding] = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    for (uint32_t b : kTexelBindings) layout.bindings[b] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    layout.bindings[kShTablesBinding] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    layout.pushBytes = sizeof(SurfelLightingPush);
+    layout.specialization = {bake.params.bandsY, bake.params.bandsC,
+                             rays ? kSurfelModeDirectRays : kSurfelModeDirect};
+    PIC_TRY_ASSIGN(pass->mDirect, Kernel::create(context, kSpirvSurfelLightingComp, layout,
+                                                 "surfel_lighting (direct)"));
+    layout.specialization.back() = kSurfelModeBounce;
+    PIC_TRY_ASSIGN(pass->mBounce, Kernel::create(context, kSpirvSurfelLightingComp, layout,
+                                                 "surfel_lighting (bounce)"));
+
+    // The bounce reads the caches at fixed points: each surfel's stencil is computed once.
+    const size_t nS = bake.surfels.size();
+    std::vector<SurfelStencil> stencils(nS);
+    parallelFor(0, nS, [&](size_t i) {
+        const pic::Surfel& surfel = bake.surfels[i];
+        const Triangle& triangle = scene.triangles[surfel.triangle];
+        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
+                                        scene.vertices[triangle.v[1]].position,
+                                        scene.vertices[triangle.v[2]].position);
+        const CacheStencil s = surfaceStencil(bake, surfel.triangle, b.y, b.z, surfel.position);
+        SurfelStencil& out = stencils[i];
+        out = SurfelStencil{};
+        for (int k = 0; k < s.count; ++k) {
+            if (k < 4) {
+                out.cacheLow[k] = s.cache[k];
+                out.weightLow[k] = s.weight[k];
+            } else {
+                out.cacheHigh[k - 4] = s.cache[k];
+                out.weightHigh[k - 4] = s.weight[k];
+            }
+        }
+    }, 1024);
+
+    PIC_TRY_ASSIGN(pass->mSurfels,
+                   context.createBufferWith(bake.surfels.data(), nS * sizeof(pic::Surfel), kTexels,
+                                            "surfels"));
+    PIC_TRY_ASSIGN(pass->mStencils,
+                   context.createBufferWith(std::span<const SurfelStencil>(stencils), kTexels,
+                                            "surfel stencils"));
+    PIC_TRY_ASSIGN(pass->mEmissiveScale,
+                   context.createBuffer(std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
+                                        kTexels, MemoryUse::Device, "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFlux, context.createBuffer(nS * sizeof(glm::vec4), kTexels,
+                                                           MemoryUse::Device, "direct flux"));
+    // Records as RGBA32UI texels (their floats bit casts), flux as RGBA32F.
+    PIC_TRY_ASSIGN(pass->mSurfelView,
+                   context.createTexelView(pass->mSurfels, VK_FORMAT_R32G32B32A32_UINT, "surfels"));
+    PIC_TRY_ASSIGN(
+        pass->mStencilView,
+        context.createTexelView(pass->mStencils, VK_FORMAT_R32G32B32A32_UINT, "surfel stencils"));
+    PIC_TRY_ASSIGN(
+        pass->mEmissiveView,
+        context.createTexelView(pass->mEmissiveScale, VK_FORMAT_R32_SFLOAT, "emissive scales"));
+    PIC_TRY_ASSIGN(
+        pass->mDirectFluxView,
+        context.createTexelView(pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT, "direct flux"));
+    PIC_TRY_ASSIGN(pass->mGroupFlux,
+                   context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
+                                        MemoryUse::Readback, "surfel flux sums"));
+    // Both modes share one shader, which declares both sources: the one not in use is bound to
+    // a placeholder.
+    if (rays) {
+        PIC_TRY_ASSIGN(pass->mUnusedLayers, context.createBuffer(sizeof(GpuShadowLayer), 0,
+                                                                 MemoryUse::Device, "unused"));
+        PIC_TRY_ASSIGN(pass->mUnusedDepth, context.createDepthArray(kMinShadowSide, 1));
+    } else {
+        PIC_TRY_ASSIGN(pass->mUnusedVisibility, context.createBuffer(sizeof(uint32_t), kTexels,
+                                                                     MemoryUse::Device, "unused"));
+    }
+    return pass;
+}
+
+Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
+    const bool rays = mVisibility == DirectVisibility::Rays;
+    PIC_CHECK(rays ? r.rays != nullptr : r.shadows != nullptr);
+    PIC_CHECK(r.nodeFlux && r.nodeRadiance && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    PIC_TRY(mDirect.resetSets());
+    PIC_TRY(mBounce.resetSets());
+    const Buffer& lights = rays ? r.rays->lightBuffer() : r.shadows->lightBuffer();
+    const Buffer& visibility = rays ? r.rays->visibilityBuffer() : mUnusedVisibility;
+    PIC_TRY_ASSIGN(mLightView,
+                   mContext.createTexelView(lights, VK_FORMAT_R32G32B32A32_UINT, "lights"));
+    PIC_TRY_ASSIGN(mVisibilityView,
+                   mContext.createTexelView(visibility, VK_FORMAT_R32_UINT, "visibility"));
+    const std::array<const Buffer*, 3> caches = {r.cacheY, r.cacheCo, r.cacheCg};
+    for (size_t c = 0; c < caches.size(); ++c) {
+        PIC_TRY_ASSIGN(mCacheViews[c],
+                       mContext.createTexelView(*caches[c], VK_FORMAT_R16_SFLOAT, "caches"));
+    }
+    const std::array<BindingResource, kBindingCount> resources = {
+        BindingResource::texels(0, mSurfelView),
+        BindingResource::texels(1, mLightView),
+        BindingResource::storage(2, rays ? mUnusedLayers : r.shadows->layerBuffer()),
+        BindingResource::texels(3, mEmissiveView),
+        BindingResource::image(4, (rays ? mUnusedDepth : r.shadows->depth()).arrayView(),
+                               mContext.nearestSampler()),
+        BindingResource::storage(5, mDirectFlux),
+        BindingResource::storage(6, *r.nodeFlux),
+        BindingResource::texels(7, mStencilView),
+        BindingResource::texels(8, mCacheViews[0]),
+        BindingResource::texels(9, mCacheViews[1]),
+        BindingResource::texels(10, mCacheViews[2]),
+        BindingResource::storage(11, *r.shTables),
+        BindingResource::storage(12, mGroupFlux),
+        BindingResource::texels(13, mVisibilityView),
+        BindingResource::storage(14, *r.nodeRadiance),
+        BindingResource::texels(15, mDirectFluxView),
+    };
+    PIC_TRY_ASSIGN(mDirectSet, mDirect.makeSet(resources));
+    PIC_TRY_ASSIGN(mBounceSet, mBounce.makeSet(resources));
+    return {};
+}
+
+Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
+    std::vector<float> scales(std::max<size_t>(mScene.materials.size(), 1), 1.0f);
+    for (size_t m = 0; m < mScene.materials.size(); ++m)
+        scales[m] = lights.emissiveScaleOf(mScene.materials[m].name);
+    return mContext.uploadWithNextSubmit(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
+}
+
+void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
+                                uint32_t sumSlot) {
+    PIC_CHECK(sumSlot < 2);
+    PIC_CHECK(mDirectSet != VK_NULL_HANDLE && mBounceSet != VK_NULL_HANDLE);
+    SurfelLightingPush push{};
+    push.surfelCount = mSurfelCount;
+    push.lightCount = lightCount;
+    push.epsilon = mEpsilon;
+    push.sumSlot = sumSlot;
+    const Kernel& kernel = bounce ? mBounce : mDirect;
+    kernel.dispatch(cmd, bounce ? mBounceSet : mDirectSet, &push,
+                    groupsFor(mSurfelCount, kSurfelLightingGroup));
+}
+
+Result<glm::dvec3> SurfelLightingPass::totalFlux(uint32_t sumSlot) {
+    PIC_CHECK(sumSlot < 2);
+    const uint32_t groups = groupsFor(mSurfelCount, kSurfelLightingGroup);
+    std::vector<glm::vec4> sums(groups);
+    PIC_TRY(mContext.download(mGroupFlux, sums.data(), groups * sizeof(glm::vec4),
+                              sumSlot * groups * sizeof(glm::vec4)));
+    glm::dvec3 total(0.0);
+    for (const glm::vec4& s : sums) total += glm::dvec3(s);
+    return total;
+}
+
+VkDeviceSize SurfelLightingPass::bytes() const {
+    return mSurfels.size() + mStencils.size() + mEmissiveScale.size() + mDirectFlux.size() +
+           mGroupFlux.size() + mUnusedLayers.size() + mUnusedVisibility.size();
+}
+
+}  // namespace pic::gpu

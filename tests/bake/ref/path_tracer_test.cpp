@@ -1,0 +1,619 @@
+// The reference path tracer against analytic answers: a white furnace (components and bounce
+// limits), lamps near the wall of a closed sphere (uniform indirect light), point, spot and
+// directional lights over a plane, a square emitter's view factor, determinism, and the
+// ideal caches of a furnace.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "bake/ref/path_tracer.h"
+#include "bake/ref/probes.h"
+#include "core/color.h"
+#include "core/geometry.h"
+#include "core/gltf_loader.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/sh.h"
+#include "rays/embree_scene.h"
+
+namespace pic {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+using Component = PathTraceParams::Component;
+
+/// Builds small scenes directly as Scene structs.
+class SceneBuilder {
+public:
+    /// A material with albedo `albedo` and emitted radiance `emission`; returns its index.
+    uint32_t material(const std::string& name, glm::vec3 albedo,
+                      glm::vec3 emission = glm::vec3(0.0f)) {
+        Material m;
+        m.name = name;
+        m.baseColorFactor = glm::vec4(albedo, 1.0f);
+        m.emission = emission;
+        mScene.materials.push_back(m);
+        return uint32_t(mScene.materials.size() - 1);
+    }
+
+    /// A square of side 2·halfSize centred at `center` whose counter-clockwise normal (its
+    /// emitting side) is `normal`.
+    void square(glm::vec3 center, glm::vec3 normal, float halfSize, uint32_t material) {
+        glm::vec3 u, v;
+        orthonormalBasis(normal, u, v);
+        if (glm::dot(glm::cross(u, v), normal) < 0.0f) std::swap(u, v);
+        u *= halfSize;
+        v *= halfSize;
+        uint32_t base = uint32_t(mScene.vertices.size());
+        for (glm::vec3 corner : {center - u - v, center + u - v, center + u + v, center - u + v}) {
+            Vertex vertex;
+            vertex.position = corner;
+            vertex.normal = normal;
+            mScene.vertices.push_back(vertex);
+            mScene.bounds.extend(corner);
+        }
+        mScene.triangles.push_back({{base, base + 1, base + 2}, material, 0});
+        mScene.triangles.push_back({{base, base + 2, base + 3}, material, 0});
+    }
+
+    /// One triangle, counter-clockwise as given.
+    void triangle(glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material) {
+        uint32_t base = uint32_t(mScene.vertices.size());
+        for (glm::vec3 corner : {a, b, c}) {
+            Vertex vertex;
+            vertex.position = corner;
+            mScene.vertices.push_back(vertex);
+            mScene.bounds.extend(corner);
+        }
+        mScene.triangles.push_back({{base, base + 1, base + 2}, material, 0});
+    }
+
+    Scene build() {
+        for (uint32_t t = 0; t < mScene.triangles.size(); ++t)
+            mScene.totalArea += mScene.triangleArea(t);
+        mScene.sourcePath = "hand-built";
+        return std::move(mScene);
+    }
+
+private:
+    Scene mScene;
+};
+
+/// White furnace: a closed cube [−1, 1]³ whose inner faces all have albedo ρ and emit L_e.
+constexpr glm::vec3 kFurnaceAlbedo{0.5f, 0.6f, 0.3f};
+constexpr glm::vec3 kFurnaceEmission{1.0f, 0.5f, 2.0f};
+
+Scene furnaceScene() {
+    SceneBuilder builder;
+    uint32_t wall = builder.material("wall", kFurnaceAlbedo, kFurnaceEmission);
+    for (int axis = 0; axis < 3; ++axis)
+        for (float side : {-1.0f, 1.0f}) {
+            glm::vec3 center(0.0f);
+            center[axis] = side;
+            builder.square(center, -center, 1.0f, wall);  // facing inwards
+        }
+    return builder.build();
+}
+
+/// Radiance the furnace delivers to any point by paths of k reflections, k in [minK, maxK].
+glm::dvec3 furnaceRadiance(int minK, int maxK) {
+    glm::dvec3 sum(0.0);
+    for (int k = minK; k <= maxK; ++k)
+        sum += glm::dvec3(kFurnaceEmission) * glm::pow(glm::dvec3(kFurnaceAlbedo), glm::dvec3(k));
+    return sum;
+}
+/// All of it: Σ_k ρ^k L_e = L_e / (1 − ρ).
+glm::dvec3 furnaceRadianceTotal() {
+    return glm::dvec3(kFurnaceEmission) / (1.0 - glm::dvec3(kFurnaceAlbedo));
+}
+
+/// Mean and standard error of the mean over an image's pixels, per channel. Every pixel of
+/// the analytic set-ups has the same expectation, so pixels are independent samples of it.
+struct PixelStatistics {
+    glm::dvec3 mean{0.0};
+    glm::dvec3 standardError{0.0};
+};
+PixelStatistics pixelStatistics(const Image& image) {
+    PixelStatistics s;
+    glm::dvec3 sum(0.0), sumSquares(0.0);
+    for (const glm::vec3& p : image.pixels) {
+        sum += glm::dvec3(p);
+        sumSquares += glm::dvec3(p) * glm::dvec3(p);
+    }
+    double n = double(image.pixels.size());
+    s.mean = sum / n;
+    glm::dvec3 variance =
+        glm::max(sumSquares / n - s.mean * s.mean, glm::dvec3(0.0)) * (n / (n - 1.0));
+    s.standardError = glm::sqrt(variance / n);
+    return s;
+}
+
+/// The estimate lies within 4.5 standard errors of the truth, and is precise to `precision`
+/// (relative) so that the check means something.
+void expectConverged(const PixelStatistics& s, const glm::dvec3& expected, double precision,
+                     const std::string& what) {
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_LT(s.standardError[c], precision * expected[c]) << what << " channel " << c;
+        EXPECT_NEAR(s.mean[c], expected[c], 4.5 * s.standardError[c] + 1e-6)
+            << what << " channel " << c;
+    }
+}
+
+void expectValid(const Image& image) {
+    for (const glm::vec3& p : image.pixels)
+        ASSERT_TRUE(isValidRadiance(p)) << p.x << " " << p.y << " " << p.z;
+}
+
+Camera furnaceCamera() {
+    Camera camera;
+    camera.eye = {0.1f, -0.2f, 0.3f};
+    camera.target = {0.6f, 0.3f, -1.0f};
+    camera.up = {0.0f, 1.0f, 0.0f};
+    camera.fovyDegrees = 100.0f;
+    return camera;
+}
+
+class PathTracerTest : public ::testing::Test {
+protected:
+    void SetUp() override { Progress::setEnabled(false); }
+
+    /// Renders `scene` and checks the image has no invalid pixel and no sample was rejected.
+    Image render(const Scene& scene, const LightSet& lights, const Camera& camera,
+                 PathTraceParams params) {
+        auto rays = EmbreeScene::create(scene);
+        EXPECT_TRUE(rays.has_value());
+        if (!rays) return {};
+        PathTraceStats stats;
+        auto image = pathTrace(scene, **rays, lights, camera, params, &stats);
+        EXPECT_TRUE(image.has_value()) << image.error().message;
+        if (!image) return {};
+        EXPECT_EQ(stats.samples, uint64_t(params.width) * params.height * params.spp);
+        EXPECT_EQ(stats.rejected, 0u);
+        expectValid(*image);
+        return std::move(*image);
+    }
+
+    static PathTraceParams params(uint32_t size, uint32_t spp, Component component,
+                                  int bounces = -1) {
+        PathTraceParams p;
+        p.width = size;
+        p.height = size;
+        p.spp = spp;
+        p.component = component;
+        p.bounces = bounces;
+        p.seed = 7;
+        return p;
+    }
+};
+
+TEST_F(PathTracerTest, WhiteFurnaceConvergesToEmissionOverOneMinusAlbedo) {
+    // Full: Σ_k ρ^k L_e = L_e / (1 − ρ) wherever one looks in a closed furnace.
+    Scene scene = furnaceScene();
+    Image image = render(scene, LightSet{}, furnaceCamera(), params(32, 64, Component::Full));
+    expectConverged(pixelStatistics(image), furnaceRadianceTotal(), 0.005, "full");
+}
+
+TEST_F(PathTracerTest, WhiteFurnaceComponentsSplitByReflectionCount) {
+    // Direct: exactly one reflection, ρ·L_e. Indirect: two or more, L_e/(1 − ρ) − L_e − ρ·L_e
+    // = ρ²·L_e/(1 − ρ). Neither sees the emitting walls themselves.
+    Scene scene = furnaceScene();
+    Image direct = render(scene, LightSet{}, furnaceCamera(), params(32, 32, Component::Direct));
+    expectConverged(pixelStatistics(direct), furnaceRadiance(1, 1), 0.005, "direct");
+    Image indirect =
+        render(scene, LightSet{}, furnaceCamera(), params(32, 64, Component::Indirect));
+    glm::dvec3 expected = furnaceRadianceTotal() - glm::dvec3(kFurnaceEmission) -
+                          glm::dvec3(kFurnaceAlbedo) * glm::dvec3(kFurnaceEmission);
+    expectConverged(pixelStatistics(indirect), expected, 0.01, "indirect");
+}
+
+TEST_F(PathTracerTest, BounceLimitKeepsPathsOfAtMostBPlusOneReflections) {
+    // --bounces B: the camera-visible surface's reflection plus up to B more.
+    Scene scene = furnaceScene();
+    for (int bounces : {0, 1, 3}) {
+        Image full =
+            render(scene, LightSet{}, furnaceCamera(), params(24, 32, Component::Full, bounces));
+        expectConverged(pixelStatistics(full), furnaceRadiance(0, bounces + 1), 0.005,
+                        "full, bounces " + std::to_string(bounces));
+    }
+    Image indirect =
+        render(scene, LightSet{}, furnaceCamera(), params(24, 32, Component::Indirect, 1));
+    expectConverged(pixelStatistics(indirect), furnaceRadiance(2, 2), 0.01, "indirect, bounces 1");
+    // With no bounce there is no indirect light at all: exactly zero, not just small.
+    Image none = render(scene, LightSet{}, furnaceCamera(), params(8, 4, Component::Indirect, 0));
+    for (const glm::vec3& p : none.pixels) EXPECT_EQ(p, glm::vec3(0.0f));
+}
+
+Light pointLight(glm::vec3 position, float intensity, glm::vec3 color) {
+    Light light;
+    light.id = "lamp";
+    light.type = LightType::Point;
+    light.position = position;
+    light.intensity = intensity;
+    light.color = color;
+    return light;
+}
+
+/// A closed sphere of radius 1 about the origin (an icosahedron subdivided `levels` times,
+/// vertices pushed onto the sphere) of albedo ρ.
+constexpr glm::vec3 kSphereAlbedo{0.5f, 0.7f, 0.3f};
+Scene sphereScene(int levels) {
+    SceneBuilder builder;
+    uint32_t wall = builder.material("wall", kSphereAlbedo);
+    const float g = (1.0f + std::sqrt(5.0f)) / 2.0f;
+    std::vector<glm::vec3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+    for (glm::vec3& p : v) p = glm::normalize(p);
+    std::vector<glm::uvec3> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                     {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                     {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                     {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    std::vector<std::array<glm::vec3, 3>> triangles;
+    for (const glm::uvec3& f : faces) triangles.push_back({v[f.x], v[f.y], v[f.z]});
+    for (int level = 0; level < levels; ++level) {
+        std::vector<std::array<glm::vec3, 3>> finer;
+        for (const auto& [a, b, c] : triangles) {
+            // Midpoints depend only on the (commutative) sum, so shared edges stay watertight.
+            glm::vec3 ab = glm::normalize(a + b), bc = glm::normalize(b + c),
+                      ca = glm::normalize(c + a);
+            finer.push_back({a, ab, ca});
+            finer.push_back({ab, b, bc});
+            finer.push_back({ca, bc, c});
+            finer.push_back({ab, bc, ca});
+        }
+        triangles = std::move(finer);
+    }
+    for (const auto& [a, b, c] : triangles) builder.triangle(a, b, c, wall);
+    return builder.build();
+}
+
+TEST_F(PathTracerTest, LampNearTheWallOfASphereGivesUniformIndirectLight) {
+    // Inside a sphere of radius R every surface element sees any other with the form factor
+    // dA'/(4πR²), so light reflected once is spread evenly whatever its first distribution:
+    // a light of flux Φ anywhere inside gives every wall point the indirect radiance (paths of
+    // ≥ 2 reflections) ρ²·Φ / (4π²·R²·(1 − ρ)). With the lamps 5 cm under the wall their
+    // bright spots test the light-vertex strategy and its MIS weights.
+    Scene scene = sphereScene(4);  // 5120 facets: within 0.1 % of a sphere's answer (3: 0.5 %)
+    Camera camera;
+    camera.eye = {0.2f, -0.3f, 0.1f};
+    camera.target = {0.0f, 0.5f, -1.0f};
+    camera.fovyDegrees = 120.0f;
+    glm::dvec3 rho(kSphereAlbedo);
+
+    // A point light: Φ = 4π·I.
+    LightSet point;
+    point.lights.push_back(pointLight({0.0f, 0.95f, 0.0f}, 2.0f, glm::vec3(1.0f)));
+    Image pointImage = render(scene, point, camera, params(32, 64, Component::Indirect));
+    expectConverged(pixelStatistics(pointImage), rho * rho * 2.0 / (kPi * (1.0 - rho)), 0.01,
+                    "point");
+
+    // A tilted spot with cones 20° / 40°: Φ = 2π·I·((1 − cos inner) + (cos inner − cos outer)/3)
+    // with the squared linear ramp of the falloff.
+    const double inner = 20.0 * kPi / 180.0, outer = 40.0 * kPi / 180.0;
+    LightSet spot;
+    Light light = pointLight({0.0f, 0.9f, 0.0f}, 3.0f, glm::vec3(1.0f, 0.5f, 0.25f));
+    light.type = LightType::Spot;
+    light.direction = glm::normalize(glm::vec3(0.3f, 1.0f, 0.0f));
+    light.innerConeAngle = float(inner);
+    light.outerConeAngle = float(outer);
+    spot.lights.push_back(light);
+    double flux =
+        2.0 * kPi * 3.0 * ((1.0 - std::cos(inner)) + (std::cos(inner) - std::cos(outer)) / 3.0);
+    glm::dvec3 expected =
+        glm::dvec3(light.color) * rho * rho * flux / (4.0 * kPi * kPi * (1.0 - rho));
+    Image spotImage = render(scene, spot, camera, params(32, 64, Component::Indirect));
+    expectConverged(pixelStatistics(spotImage), expected, 0.01, "spot");
+}
+
+/// A 200 m square plane of albedo ρ at y = 0 facing +y.
+constexpr glm::vec3 kPlaneAlbedo{0.6f, 0.4f, 0.8f};
+Scene planeScene(SceneBuilder builder = {}) {
+    uint32_t floor = builder.material("floor", kPlaneAlbedo);
+    builder.square(glm::vec3(0.0f), glm::vec3(0.0f, 1.0f, 0.0f), 100.0f, floor);
+    return builder.build();
+}
+
+TEST_F(PathTracerTest, PointLightAbovePlaneGivesAlbedoIntensityOverPiDistanceSquared) {
+    // Radiance straight below a point light of intensity I at height d: ρ·I / (π·d²).
+    constexpr float kIntensity = 5.0f, kHeight = 2.0f;
+    const glm::vec3 color{1.0f, 0.8f, 0.5f};
+    Scene scene = planeScene();
+    LightSet lights;
+    lights.lights.push_back(pointLight({0.0f, kHeight, 0.0f}, kIntensity, color));
+    // A 0.1° view of the point below the light from 5 m above: the pixels see it within 7 mm,
+    // where cos³θ (θ < 0.0035 rad from the light's axis) differs from 1 by less than 2e-5.
+    Camera camera;
+    camera.eye = {0.0f, 5.0f, 0.0f};
+    camera.target = {0.0f, 0.0f, 0.0f};
+    camera.up = {0.0f, 0.0f, -1.0f};
+    camera.fovyDegrees = 0.1f;
+    glm::dvec3 expected =
+        glm::dvec3(kPlaneAlbedo * color) * double(kIntensity) / (kPi * kHeight * kHeight);
+    for (Component component : {Component::Full, Component::Direct}) {
+        Image image = render(scene, lights, camera, params(3, 4, component));
+        for (const glm::vec3& p : image.pixels)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], expected[c], 1e-4 * expected[c]);
+    }
+    // A lone plane reflects nothing back onto itself.
+    Image indirect = render(scene, lights, camera, params(3, 16, Component::Indirect));
+    for (const glm::vec3& p : indirect.pixels) EXPECT_EQ(p, glm::vec3(0.0f));
+}
+
+TEST_F(PathTracerTest, OccluderCastsAShadow) {
+    // A 0.4 m square halfway between the lamp and the floor: the point below gets no direct
+    // light, while a point far outside the shadow gets ρ·I·cos³θ/(π·d²).
+    SceneBuilder builder;
+    uint32_t blocker = builder.material("blocker", glm::vec3(0.5f));
+    builder.square({0.0f, 1.0f, 0.0f}, {0.0f, -1.0f, 0.0f}, 0.2f, blocker);
+    Scene scene = planeScene(builder);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    LightSet lights;
+    lights.lights.push_back(pointLight({0.0f, 2.0f, 0.0f}, 3.0f, glm::vec3(1.0f)));
+    PathTracer tracer(scene, **rays, lights);
+    Rng rng(1);
+    glm::vec3 down(0.0f, -1.0f, 0.0f);
+    glm::vec3 shadowed = tracer.traceRadiance({0.0f, 0.5f, 0.0f}, down, -1, Component::Direct, rng);
+    EXPECT_EQ(shadowed, glm::vec3(0.0f));
+    glm::vec3 lit = tracer.traceRadiance({2.0f, 0.5f, 0.0f}, down, -1, Component::Direct, rng);
+    double cosTheta = 2.0 / std::sqrt(8.0);
+    double expected = 3.0 * std::pow(cosTheta, 3) / (kPi * 4.0);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(lit[c], kPlaneAlbedo[c] * expected, 1e-5);
+}
+
+TEST_F(PathTracerTest, SpotLightFollowsItsConeAndSmoothFalloff) {
+    // Spot at height d pointing down, cones 20° / 30°: inside the inner cone it is a point
+    // light, outside the outer one dark, in between the KHR_lights_punctual falloff
+    // ((cosθ − cos outer)/(cos inner − cos outer))².
+    constexpr double kHeight = 1.0, kIntensity = 4.0;
+    const double inner = 20.0 * kPi / 180.0, outer = 30.0 * kPi / 180.0;
+    Scene scene = planeScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    LightSet lights;
+    Light spot = pointLight({0.0f, float(kHeight), 0.0f}, float(kIntensity), glm::vec3(1.0f));
+    spot.type = LightType::Spot;
+    spot.direction = {0.0f, -1.0f, 0.0f};
+    spot.innerConeAngle = float(inner);
+    spot.outerConeAngle = float(outer);
+    lights.lights.push_back(spot);
+    PathTracer tracer(scene, **rays, lights);
+    Rng rng(3);
+    for (double degrees : {0.0, 10.0, 19.0, 22.0, 25.0, 28.0, 31.0, 40.0}) {
+        double theta = degrees * kPi / 180.0;
+        double cosTheta = std::cos(theta);
+        double ramp = std::clamp((cosTheta - std::cos(outer)) / (std::cos(inner) - std::cos(outer)),
+                                 0.0, 1.0);
+        double expected =
+            kIntensity * std::pow(cosTheta, 3) / (kPi * kHeight * kHeight) * ramp * ramp;
+        glm::vec3 origin(float(kHeight * std::tan(theta)), 0.5f, 0.0f);
+        glm::vec3 radiance =
+            tracer.traceRadiance(origin, {0.0f, -1.0f, 0.0f}, -1, Component::Full, rng);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(radiance[c], kPlaneAlbedo[c] * expected, 2e-4 * expected + 1e-7)
+                << degrees << "° channel " << c;
+    }
+}
+
+TEST_F(PathTracerTest, DirectionalLightGivesAlbedoIrradianceCosineOverPi) {
+    // Sun of irradiance E at 60° from the zenith: ρ·E·cos60°/π on the lit side; the plane's
+    // back is shaded with its normal flipped towards the viewer, which faces away from the sun.
+    constexpr double kIrradiance = 3.0;
+    const double zenith = 60.0 * kPi / 180.0;
+    Scene scene = planeScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    LightSet lights;
+    Light sun;
+    sun.id = "sun";
+    sun.type = LightType::Directional;
+    sun.direction =
+        glm::normalize(glm::vec3(float(std::sin(zenith)), -float(std::cos(zenith)), 0.0f));
+    sun.intensity = float(kIrradiance);
+    lights.lights.push_back(sun);
+    PathTracer tracer(scene, **rays, lights);
+    Rng rng(5);
+    glm::vec3 above = tracer.traceRadiance(
+        {1.0f, 3.0f, 2.0f}, glm::normalize(glm::vec3(0.3f, -1.0f, 0.1f)), -1, Component::Full, rng);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(above[c], kPlaneAlbedo[c] * kIrradiance * std::cos(zenith) / kPi, 1e-5);
+    glm::vec3 below =
+        tracer.traceRadiance({1.0f, -3.0f, 2.0f}, {0.0f, 1.0f, 0.0f}, -1, Component::Full, rng);
+    EXPECT_EQ(below, glm::vec3(0.0f));
+}
+
+TEST_F(PathTracerTest, SquareEmitterLightsThePlaneByItsViewFactor) {
+    // A black square emitter of side s at height h facing down over the plane: the point below
+    // its centre receives E = π·L·F with the view factor F of four s/2 × s/2 rectangles sharing
+    // the corner above the point, so its radiance is ρ·L·F. This checks next-event estimation
+    // of emitters and its MIS pairing with BSDF sampling.
+    constexpr double kSide = 0.5, kHeight = 1.0, kEmission = 4.0;
+    SceneBuilder builder;
+    uint32_t panel = builder.material("panel", glm::vec3(0.0f), glm::vec3(float(kEmission)));
+    builder.square({0.0f, float(kHeight), 0.0f}, {0.0f, -1.0f, 0.0f}, float(kSide / 2), panel);
+    Scene scene = planeScene(builder);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    PathTracer tracer(scene, **rays, LightSet{});
+    ASSERT_EQ(tracer.emitterCount(), 2u);
+
+    double a = kSide / 2 / kHeight;  // both sides of each corner rectangle, over h
+    double root = std::sqrt(1.0 + a * a);
+    double cornerFactor = (2.0 * a / root * std::atan(a / root)) / (2.0 * kPi);
+    double expected = kEmission * 4.0 * cornerFactor;
+
+    constexpr int kSamples = 40000;
+    glm::dvec3 sum(0.0), sumSquares(0.0);
+    glm::vec3 origin(0.0f, 0.5f, 0.0f), down(0.0f, -1.0f, 0.0f);
+    for (int i = 0; i < kSamples; ++i) {
+        Rng rng(11, uint64_t(i));
+        glm::dvec3 radiance(tracer.traceRadiance(origin, down, -1, Component::Direct, rng));
+        sum += radiance;
+        sumSquares += radiance * radiance;
+    }
+    glm::dvec3 mean = sum / double(kSamples);
+    glm::dvec3 standardError =
+        glm::sqrt((sumSquares / double(kSamples) - mean * mean) / double(kSamples));
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_LT(standardError[c], 0.01 * kPlaneAlbedo[c] * expected);
+        EXPECT_NEAR(mean[c], kPlaneAlbedo[c] * expected, 4.5 * standardError[c]) << "channel " << c;
+    }
+
+    // The panel emits from its front only, reflects nothing, and is seen only in `full`.
+    Rng rng(2);
+    glm::vec3 up(0.0f, 1.0f, 0.0f);
+    EXPECT_EQ(tracer.traceRadiance(origin, up, -1, Component::Full, rng),
+              glm::vec3(float(kEmission)));
+    EXPECT_EQ(tracer.traceRadiance(origin, up, -1, Component::Direct, rng), glm::vec3(0.0f));
+    EXPECT_EQ(tracer.traceRadiance({0.0f, 2.0f, 0.0f}, down, -1, Component::Full, rng),
+              glm::vec3(0.0f));
+}
+
+TEST_F(PathTracerTest, ImagesDependOnTheSeedOnlyNotOnThreads) {
+    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf");
+    ASSERT_TRUE(scene) << scene.error().message;
+    auto camera = sceneCamera(*scene, 0);
+    ASSERT_TRUE(camera) << camera.error().message;
+    LightSet lights = defaultLightSet(*scene);
+    PathTraceParams p = params(24, 4, Component::Full);
+    setWorkerCount(1);
+    Image one = render(*scene, lights, *camera, p);
+    setWorkerCount(2);
+    Image two = render(*scene, lights, *camera, p);
+    p.seed += 1;
+    Image other = render(*scene, lights, *camera, p);
+    setWorkerCount(0);
+    ASSERT_EQ(one.pixels.size(), two.pixels.size());
+    EXPECT_TRUE(one.pixels == two.pixels);
+    EXPECT_FALSE(one.pixels == other.pixels);
+    double sum = 0.0;
+    for (const glm::vec3& px : one.pixels) sum += luminance(px);
+    EXPECT_GT(sum, 0.0);
+}
+
+TEST_F(PathTracerTest, RejectsEmptySizesAndBadBounces) {
+    Scene scene = furnaceScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    PathTraceParams p = params(0, 1, Component::Full);
+    EXPECT_FALSE(pathTrace(scene, **rays, LightSet{}, furnaceCamera(), p));
+    p = params(4, 0, Component::Full);
+    EXPECT_FALSE(pathTrace(scene, **rays, LightSet{}, furnaceCamera(), p));
+    p = params(4, 1, Component::Full, -2);
+    auto bad = pathTrace(scene, **rays, LightSet{}, furnaceCamera(), p);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(bad.error().message.find("-2"), std::string::npos);
+}
+
+/// A bake holding only caches, enough for pathTraceProbes.
+BakeData cachesOnly(const std::vector<Cache>& caches, uint32_t bandsY, uint32_t bandsC) {
+    BakeData bake;
+    bake.params.bandsY = bandsY;
+    bake.params.bandsC = bandsC;
+    bake.caches = caches;
+    return bake;
+}
+
+TEST_F(PathTracerTest, FurnaceProbesHoldTheConstantRadiance) {
+    // Constant radiance L over the sphere projects to L·4π·y_0^0 = 2√π·L in band 0 and zero
+    // above. Over the upper hemisphere around n (lower half zero): √π·L in band 0,
+    // π·sqrt(3/(4π))·L on band 1's component along n, and zero in band 2 (∫₀¹ P₂ = 0).
+    Scene scene = furnaceScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    std::vector<Cache> caches;
+    for (glm::vec3 p :
+         {glm::vec3(0.0f), glm::vec3(0.5f, -0.3f, 0.2f), glm::vec3(-0.7f, 0.6f, -0.8f)})
+        caches.push_back(Cache{p, gpu::kCacheKindGrid, glm::vec3(0.0f), 0});
+    const float lift = 10.0f * (*rays)->epsilon();
+    caches.push_back(
+        Cache{{0.2f, -1.0f + lift, 0.1f}, gpu::kCacheKindLightmap, {0.0f, 1.0f, 0.0f}, 0});
+    BakeData bake = cachesOnly(caches, 3, 2);
+    ProbeParams params;
+    params.samples = 4096;
+    PathTraceStats stats;
+    auto values = pathTraceProbes(scene, **rays, bake, LightSet{}, params, &stats);
+    ASSERT_TRUE(values) << values.error().message;
+    ASSERT_EQ(values->cacheCount(), caches.size());
+    EXPECT_EQ(stats.samples, caches.size() * params.samples);
+    EXPECT_EQ(stats.rejected, 0u);
+
+    const glm::vec3 radiance = rgbToYCoCg(glm::vec3(furnaceRadianceTotal()));
+    const double sqrtPi = std::sqrt(kPi);
+    // Measured over 32 caches at 4096 directions: band 0 scatters by 0.4 % (Y) to 0.5 % (Co)
+    // relative, the other coefficients by at most 1.5 % of band 0; the tolerances are 5σ+.
+    constexpr double kBand0Tolerance = 0.025, kTolerance = 0.03;
+    for (size_t c = 0; c < caches.size(); ++c) {
+        const bool hemisphere = caches[c].kind == gpu::kCacheKindLightmap;
+        const float* y = &values->y[c * 9];
+        const float* co = &values->co[c * 4];
+        const float* cg = &values->cg[c * 4];
+        const double band0 = hemisphere ? sqrtPi : 2.0 * sqrtPi;
+        std::string what = "cache " + std::to_string(c);
+        EXPECT_NEAR(y[0], band0 * radiance.x, kBand0Tolerance * band0 * radiance.x) << what;
+        EXPECT_NEAR(co[0], band0 * radiance.y, kBand0Tolerance * band0 * std::abs(radiance.y))
+            << what;
+        EXPECT_NEAR(cg[0], band0 * radiance.z, kBand0Tolerance * band0 * std::abs(radiance.z))
+            << what;
+        // Index 1 is band 1's y component (core/sh.h), the hemisphere's axis.
+        const double band1AlongNormal = hemisphere ? kPi * std::sqrt(3.0 / (4.0 * kPi)) : 0.0;
+        for (int j : {1, 2, 3}) {
+            const double factor = j == 1 ? band1AlongNormal : 0.0;
+            EXPECT_NEAR(y[j], factor * radiance.x, kTolerance * band0 * radiance.x)
+                << what << " y " << j;
+            EXPECT_NEAR(co[j], factor * radiance.y, kTolerance * band0 * std::abs(radiance.y))
+                << what << " co " << j;
+            EXPECT_NEAR(cg[j], factor * radiance.z, kTolerance * band0 * std::abs(radiance.z))
+                << what << " cg " << j;
+        }
+        for (int j : {4, 5, 6, 7, 8})
+            EXPECT_NEAR(y[j], 0.0, kTolerance * band0 * radiance.x) << what << " coefficient " << j;
+    }
+}
+
+TEST_F(PathTracerTest, ProbesWithPunctualLightsAddTheirDeltas) {
+    // Over the lone plane with a point light straight above a grid cache: with the lights
+    // included the SH gains E·y(ω_light) with E = I/d², on top of the floor's reflection.
+    Scene scene = planeScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    LightSet lights;
+    lights.lights.push_back(pointLight({0.0f, 2.0f, 0.0f}, 8.0f, glm::vec3(1.0f)));
+    BakeData bake =
+        cachesOnly({Cache{{0.0f, 1.0f, 0.0f}, gpu::kCacheKindGrid, glm::vec3(0.0f), 0}}, 2, 1);
+    ProbeParams params;
+    params.samples = 256;
+    auto surfacesOnly = pathTraceProbes(scene, **rays, bake, lights, params);
+    params.indirectOnly = false;
+    auto withLights = pathTraceProbes(scene, **rays, bake, lights, params);
+    ASSERT_TRUE(surfacesOnly && withLights);
+    float basis[4];
+    shEvaluate(2, {0.0f, 1.0f, 0.0f}, basis);
+    const double irradiance = 8.0 / 1.0;  // I / d², d = 1 m
+    for (int j = 0; j < 4; ++j)
+        EXPECT_NEAR(withLights->y[j] - surfacesOnly->y[j], irradiance * basis[j], 1e-4) << j;
+    // Sanity of the reflected part: the floor sits below, so the lower half dominates.
+    EXPECT_LT(surfacesOnly->y[1], 0.0f);
+}
+
+TEST_F(PathTracerTest, ProbesRefuseABakeOfAnotherScene) {
+    Scene scene = furnaceScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    BakeData bake =
+        cachesOnly({Cache{glm::vec3(0.0f), gpu::kCacheKindGrid, glm::vec3(0.0f), 0}}, 3, 3);
+    bake.sceneHash = 0x1234;
+    auto values = pathTraceProbes(scene, **rays, bake, LightSet{}, ProbeParams{});
+    ASSERT_FALSE(values);
+    EXPECT_NE(values.error().message.find("1234"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pic
