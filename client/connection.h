@@ -12,12 +12,12 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include "core/cache_textures.h"
 #include "core/error.h"
 #include "core/frame_codec.h"
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "proto/pic.grpc.pb.h"
-#include "render/cpu/lightmap_copy.h"
 #include "render/renderer.h"
 
 namespace pic {
@@ -121,7 +121,7 @@ private:
 };
 
 /// The textures of `frame` for `scene`: its caches, halves widened to floats, written into
-/// every grid vertex and light-map texel that holds them (render/cpu/lightmap_copy.h), with
+/// every grid vertex and light-map texel that holds them (core/cache_textures.h), with
 /// coverage from the index maps. InvalidInput when the frame's planes do not hold the
 /// scene's caches and band counts.
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);

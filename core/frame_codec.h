@@ -5,7 +5,7 @@
 ///
 /// A frame holds the unique caches, not the textures renderers sample: the thin client
 /// writes them into its textures through the index maps it downloaded with the scene
-/// (render/cpu/lightmap_copy.h), which hold most caches more than once. Each of the three
+/// (core/cache_textures.h), which hold most caches more than once. Each of the three
 /// planes (Y, Co, Cg) is coefficient-major, coefficient k of cache c at k·nC + c, so that
 /// neighbouring values are the same coefficient of neighbouring caches; each is coded on
 /// its own:

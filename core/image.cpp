@@ -19,8 +19,6 @@ namespace pic {
 
 namespace {
 
-constexpr uint32_t kMaxImageSide = 16384;
-
 /// The exact sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
 double srgbFromLinear(double linear) {
     return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;

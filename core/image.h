@@ -12,6 +12,9 @@
 
 namespace pic {
 
+/// Largest image side any program renders or accepts, texels.
+inline constexpr uint32_t kMaxImageSide = 16384;
+
 /// A linear RGB float image, row 0 at the top.
 struct Image {
     uint32_t width = 0;
@@ -31,7 +34,7 @@ Result<void> writeImage(const std::string& path, const Image& image, float expos
 /// Reads an image as linear RGB (PNG/JPEG are converted from sRGB).
 Result<Image> readImage(const std::string& path);
 
-/// Parses "WxH" (e.g. "640x480"); InvalidInput naming the text otherwise, sizes 1..16384.
+/// Parses "WxH" (e.g. "640x480"); InvalidInput naming the text otherwise, sizes 1..kMaxImageSide.
 Result<glm::uvec2> parseImageSize(const std::string& text);
 
 /// Image comparison metrics against a reference (same size required).

@@ -9,6 +9,7 @@
 #include "core/color.h"
 #include "core/sh.h"
 #include "render/cpu/cache_lighting.h"
+#include "render/cpu/lightmap_copy.h"
 #include "render/cpu/pull.h"
 #include "render/cpu/surfel_lighting.h"
 

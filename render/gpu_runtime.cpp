@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/color.h"
+#include "render/cpu/lightmap_copy.h"
 #include "render/passes/cache_lighting_pass.h"
 #include "render/passes/lightmap_copy_pass.h"
 #include "render/passes/pull_pass.h"

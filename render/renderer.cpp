@@ -16,9 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Largest image side accepted (render/cpu/cache_shading.cpp and parseImageSize agree).
-constexpr uint32_t kMaxImageSide = 16384;
-
 /// Timestamp pairs one frame may hold: shadow maps, G-buffer, shading.
 constexpr uint32_t kTimedPasses = 4;
 
@@ -126,22 +123,13 @@ Result<void> checkTextures(const CacheTextures& t, const ClientLayout& layout) {
     return check(t.lightmapCoverage, texels, "light-map", "coverage", true);
 }
 
-/// Shading parameters this renderer handles.
+/// Shading parameters this renderer handles: any checkShadeParams accepts, at pixel centres.
 Result<void> checkParams(const ShadeParams& params) {
-    if (params.width == 0 || params.height == 0 || params.width > kMaxImageSide ||
-        params.height > kMaxImageSide)
-        return fail(ErrorCode::InvalidInput, "image size {}x{} is outside 1..{} per side",
-                    params.width, params.height, kMaxImageSide);
+    PIC_TRY(checkShadeParams(params));
     if (params.samplesPerPixel != 1)
         return fail(ErrorCode::InvalidInput,
                     "samples per pixel {}: the renderer shades pixel centres only (1)",
                     params.samplesPerPixel);
-    if (!(std::isfinite(params.glossyExponent) && params.glossyExponent >= 0.0f))
-        return fail(ErrorCode::InvalidInput, "glossy exponent {} is not a finite number ≥ 0",
-                    params.glossyExponent);
-    if (!(std::isfinite(params.glossyWeight) && params.glossyWeight >= 0.0f))
-        return fail(ErrorCode::InvalidInput, "glossy weight {} is not a finite number ≥ 0",
-                    params.glossyWeight);
     return {};
 }
 

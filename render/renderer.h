@@ -17,13 +17,13 @@
 #include <glm/glm.hpp>
 
 #include "core/bake_data.h"
+#include "core/cache_textures.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "core/shade_params.h"
 #include "gpu/context.h"
-#include "render/cpu/cache_shading.h"
-#include "render/cpu/lightmap_copy.h"
 
 namespace pic {
 
@@ -34,7 +34,7 @@ class CacheShadingPass;
 }  // namespace gpu
 
 /// What a thin client knows of a bake besides the scene: enough to place and sample the cache
-/// textures (layout in render/cpu/lightmap_copy.h). Plain numbers and vectors, so that the
+/// textures (layout in core/cache_textures.h). Plain numbers and vectors, so that the
 /// wire can carry it.
 struct ClientLayout {
     uint64_t sceneHash = 0;              ///< Scene::hash of the scene the bake was made for

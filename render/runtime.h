@@ -7,11 +7,11 @@
 #include <string>
 
 #include "core/bake_data.h"
+#include "core/cache_textures.h"
 #include "core/cache_values.h"
 #include "core/error.h"
 #include "core/light_set.h"
 #include "core/scene.h"
-#include "render/cpu/lightmap_copy.h"
 
 namespace pic {
 
@@ -41,7 +41,7 @@ public:
     /// Relights the scene with `lights` and returns the caches' incident radiance.
     virtual Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats = nullptr) = 0;
     /// The last update's caches as the grid and light-map textures renderers sample
-    /// (render/cpu/lightmap_copy.h layout), made on demand: `picref shade` shades from them;
+    /// (core/cache_textures.h layout), made on demand: `picref shade` shades from them;
     /// picserver streams the caches themselves and never asks.
     virtual Result<const CacheTextures*> textures() = 0;
     /// Backend name for logs ("cpu", "gpu").

@@ -17,10 +17,6 @@ namespace {
 
 constexpr float kInvPi = std::numbers::inv_pi_v<float>;
 
-/// Largest image side and subsample count accepted (the sizes of parseImageSize).
-constexpr uint32_t kMaxImageSide = 16384;
-constexpr uint32_t kMaxSamplesPerPixel = 4096;
-
 /// Checks that `indices` only name caches below `caches` (or kNoCache).
 Result<void> checkCacheIndices(const std::vector<uint32_t>& indices, size_t caches,
                                const char* what) {
@@ -35,19 +31,7 @@ Result<void> checkCacheIndices(const std::vector<uint32_t>& indices, size_t cach
 /// Rejects parameters, bakes and cache values that shading cannot index safely.
 Result<void> validate(const Scene& scene, const BakeData& bake, const CacheValues& values,
                       const ShadeParams& params) {
-    if (params.width == 0 || params.height == 0 || params.width > kMaxImageSide ||
-        params.height > kMaxImageSide)
-        return fail(ErrorCode::InvalidInput, "image size {}x{} is outside 1..{} per side",
-                    params.width, params.height, kMaxImageSide);
-    if (params.samplesPerPixel == 0 || params.samplesPerPixel > kMaxSamplesPerPixel)
-        return fail(ErrorCode::InvalidInput, "samples per pixel {} is outside 1..{}",
-                    params.samplesPerPixel, kMaxSamplesPerPixel);
-    if (!(std::isfinite(params.glossyExponent) && params.glossyExponent >= 0.0f))
-        return fail(ErrorCode::InvalidInput, "glossy exponent {} is not a finite number ≥ 0",
-                    params.glossyExponent);
-    if (!(std::isfinite(params.glossyWeight) && params.glossyWeight >= 0.0f))
-        return fail(ErrorCode::InvalidInput, "glossy weight {} is not a finite number ≥ 0",
-                    params.glossyWeight);
+    PIC_TRY(checkShadeParams(params));
     if (bake.sceneHash != scene.hash)
         return fail(ErrorCode::InvalidInput,
                     "the bake was made for a different scene (hash {:016x}, scene {:016x})",

@@ -11,26 +11,10 @@
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "core/shade_params.h"
 #include "rays/embree_scene.h"
 
 namespace pic {
-
-/// Which part of the outgoing radiance an image holds (the `--component` values).
-enum class ShadeComponent {
-    Full,      ///< directly visible emission + direct + indirect
-    Direct,    ///< punctual lights reflected once, with exact visibility
-    Indirect,  ///< the cache term (it holds the emitters' light too, paper 000 §4.4)
-};
-
-/// What to shade and how.
-struct ShadeParams {
-    uint32_t width = 0;
-    uint32_t height = 0;
-    ShadeComponent component = ShadeComponent::Full;
-    float glossyExponent = 0.0f;   ///< Phong exponent n of the glossy lobe; 0 = diffuse only
-    float glossyWeight = 0.0f;     ///< factor on the glossy lobe's radiance
-    uint32_t samplesPerPixel = 1;  ///< 1: pixel centre; more: fixed stratified subsamples, averaged
-};
 
 /// Renders `camera`'s view of `scene` lit by `lights` and shaded from cache radiance `values`
 /// of `bake`. Per pixel: a primary ray; at the hit, the geometric normal facing the camera,

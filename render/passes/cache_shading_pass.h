@@ -10,8 +10,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/cache_textures.h"
 #include "gpu/kernel.h"
-#include "render/cpu/lightmap_copy.h"
 #include "render/passes/gbuffer_pass.h"
 #include "render/passes/shadow_map_pass.h"
 #include "shaders/shared/cache_shading.h"

@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "core/bake_data.h"
+#include "core/cache_textures.h"
 #include "gpu/kernel.h"
-#include "render/cpu/lightmap_copy.h"
 
 namespace pic::gpu {
 

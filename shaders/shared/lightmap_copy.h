@@ -1,7 +1,7 @@
 #ifndef PIC_SHADERS_SHARED_LIGHTMAP_COPY_H
 #define PIC_SHADERS_SHARED_LIGHTMAP_COPY_H
 // Light-map copy (paper 000 Figure 2 step 5): caches → coefficient-major texture layers
-// (render/cpu/lightmap_copy.h describes the layout). Specialization constants: 0 lY, 1 lC.
+// (core/cache_textures.h describes the layout). Specialization constants: 0 lY, 1 lC.
 #include "glue.h"
 
 PIC_NAMESPACE_BEGIN

@@ -19,6 +19,8 @@
 #include "core/camera.h"
 #include "core/gltf_loader.h"
 #include "rays/embree_scene.h"
+#include "render/cpu/cache_shading.h"
+#include "render/cpu/lightmap_copy.h"
 #include "render/cpu_runtime.h"
 #include "render/passes/gbuffer_pass.h"
 #include "render/renderer.h"
