@@ -21,7 +21,9 @@
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/resources.h"
+#include "gpu/timers.h"
 #include "render/cpu/cache_shading.h"
 #include "render/cpu/lightmap_copy.h"
 

@@ -10,7 +10,9 @@
 
 #include <glm/glm.hpp>
 
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 #include "render/cpu/lightmap_copy.h"
 #include "render/passes/gbuffer_pass.h"
 #include "render/passes/shadow_map_pass.h"

@@ -7,7 +7,9 @@
 #include <memory>
 
 #include "core/bake_data.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 #include "render/cpu/lightmap_copy.h"
 
 namespace pic::gpu {
