@@ -7,9 +7,12 @@
 #include <span>
 #include <vector>
 
-#include "gpu/context.h"
+#include "gpu/handle.h"
+#include "gpu/resources.h"
 
 namespace pic::gpu {
+
+class Context;
 
 /// One resource bound to a binding of a kernel's set.
 struct BindingResource {
@@ -45,13 +48,10 @@ struct KernelLayout {
 /// A compute shader ready to dispatch.
 class Kernel {
 public:
+    /// The compute pipeline of `spirv` with the bindings, push constants and specialization of
+    /// `layout`, and a descriptor pool for its sets; `name` names it in errors.
     static Result<Kernel> create(Context& context, std::span<const uint32_t> spirv,
                                  const KernelLayout& layout, const char* name);
-    Kernel() = default;
-    Kernel(Kernel&& other) noexcept { *this = std::move(other); }
-    Kernel& operator=(Kernel&& other) noexcept;
-    ~Kernel() { reset(); }
-
     /// A descriptor set binding `resources` (every binding of the layout exactly once).
     Result<VkDescriptorSet> makeSet(std::span<const BindingResource> resources);
     /// Frees every set makeSet created (before binding new resources).
@@ -60,16 +60,18 @@ public:
     void dispatch(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t groups) const;
 
 private:
-    void reset();
-    VkDevice mDevice = VK_NULL_HANDLE;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
-    VkPipeline mPipeline = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    DescriptorSetLayout mSetLayout;
+    DescriptorPool mPool;  ///< frees the sets makeSet created
+    PipelineLayout mPipelineLayout;
+    Pipeline mPipeline;
     std::vector<VkDescriptorType> mBindings;
     uint32_t mPushBytes = 0;
     const char* mName = "";
 };
+
+/// A full memory barrier between compute work (and transfers) recorded before and after it:
+/// every shader or transfer write before is visible to every shader or transfer access after.
+void computeBarrier(VkCommandBuffer cmd);
 
 /// Workgroups of `groupSize` that cover `count` invocations.
 inline uint32_t groupsFor(uint64_t count, uint32_t groupSize) {

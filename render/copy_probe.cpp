@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
+#include "gpu/timers.h"
 #include "shaders/shared/copy_probe.h"
 #include "spirv/copy_probe_comp.h"
 
@@ -26,17 +28,17 @@ Result<double> computeCopyBandwidth(Context& context, const CopyProbeParams& par
     layout.pushBytes = sizeof(CopyProbePush);
     PIC_TRY_ASSIGN(Kernel kernel,
                    Kernel::create(context, kSpirvCopyProbeComp, layout, "copy probe"));
-    PIC_TRY_ASSIGN(Buffer source,
-                   context.createBuffer(params.bytes, 0, MemoryUse::Device, "copy probe source"));
-    PIC_TRY_ASSIGN(Buffer target,
-                   context.createBuffer(params.bytes, 0, MemoryUse::Device, "copy probe target"));
+    PIC_TRY_ASSIGN(Buffer source, Buffer::create(context, params.bytes, 0, MemoryUse::Device,
+                                                 "copy probe source"));
+    PIC_TRY_ASSIGN(Buffer target, Buffer::create(context, params.bytes, 0, MemoryUse::Device,
+                                                 "copy probe target"));
     std::vector<uint32_t> words(params.bytes / 4);
     for (size_t i = 0; i < words.size(); ++i) words[i] = uint32_t(i * 2654435761u);
     PIC_TRY(context.upload(source, words.data(), params.bytes));
     const std::array<BindingResource, 2> resources = {BindingResource::storage(0, source),
                                                       BindingResource::storage(1, target)};
     PIC_TRY_ASSIGN(VkDescriptorSet set, kernel.makeSet(resources));
-    PIC_TRY_ASSIGN(PassTimer timer, context.createPassTimer(1));
+    PIC_TRY_ASSIGN(PassTimer timer, PassTimer::create(context, 1));
 
     const CopyProbePush push{uint32_t(params.bytes / 16), 0, 0, 0};
     // By default enough groups to fill any GPU, few enough for the dispatch limit.

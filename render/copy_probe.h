@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "gpu/context.h"
+#include "gpu/device.h"
 
 namespace pic::gpu {
 

@@ -56,25 +56,25 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     // The pull reads the node flux, cache lighting the node radiance, and the bounce's surfel
     // lighting the caches as uniform texel buffers.
     constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-    PIC_TRY_ASSIGN(mNodeFlux, ctx.createBuffer(mBake.nodes.size() * sizeof(glm::vec4), kTexels,
-                                               MemoryUse::Device, "node flux"));
-    PIC_TRY_ASSIGN(mNodeRadiance, ctx.createBuffer(mBake.nodes.size() * sizeof(uint32_t), kTexels,
-                                                   MemoryUse::Device, "node radiance"));
+    PIC_TRY_ASSIGN(mNodeFlux, Buffer::create(ctx, mBake.nodes.size() * sizeof(glm::vec4), kTexels,
+                                             MemoryUse::Device, "node flux"));
+    PIC_TRY_ASSIGN(mNodeRadiance, Buffer::create(ctx, mBake.nodes.size() * sizeof(uint32_t),
+                                                 kTexels, MemoryUse::Device, "node radiance"));
     PIC_TRY_ASSIGN(mCacheY,
-                   ctx.createBuffer(2 * nC * countY, kTexels, MemoryUse::Device, "caches Y"));
+                   Buffer::create(ctx, 2 * nC * countY, kTexels, MemoryUse::Device, "caches Y"));
     PIC_TRY_ASSIGN(mCacheCo,
-                   ctx.createBuffer(2 * nC * countC, kTexels, MemoryUse::Device, "caches Co"));
+                   Buffer::create(ctx, 2 * nC * countC, kTexels, MemoryUse::Device, "caches Co"));
     PIC_TRY_ASSIGN(mCacheCg,
-                   ctx.createBuffer(2 * nC * countC, kTexels, MemoryUse::Device, "caches Cg"));
+                   Buffer::create(ctx, 2 * nC * countC, kTexels, MemoryUse::Device, "caches Cg"));
     if (!mCacheY.mapped() || !mCacheCo.mapped() || !mCacheCg.mapped()) {
         const VkDeviceSize bytes = mCacheY.size() + mCacheCo.size() + mCacheCg.size();
         PIC_TRY_ASSIGN(mCacheReadback,
-                       ctx.createBuffer(bytes, 0, MemoryUse::Readback, "cache readback"));
+                       Buffer::create(ctx, bytes, 0, MemoryUse::Readback, "cache readback"));
     }
     const ShTables tables = makeShTables();
-    PIC_TRY_ASSIGN(mShTables, ctx.createBufferWith(&tables, sizeof(tables),
-                                                     VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
-    PIC_TRY_ASSIGN(mTimer, ctx.createPassTimer(kTimedPasses));
+    PIC_TRY_ASSIGN(mShTables, Buffer::createWith(ctx, &tables, sizeof(tables),
+                                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
+    PIC_TRY_ASSIGN(mTimer, PassTimer::create(ctx, kTimedPasses));
 
     mVisibility = options.directVisibility.value_or(
         ctx.isCpuDevice() ? DirectVisibility::Rays : DirectVisibility::ShadowMaps);

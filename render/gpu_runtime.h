@@ -13,7 +13,9 @@
 
 #include <glm/glm.hpp>
 
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/resources.h"
+#include "gpu/timers.h"
 #include "rays/embree_scene.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/runtime.h"

@@ -174,10 +174,9 @@ Result<void> Renderer::init(const RendererOptions& options) {
                                  mContext, mLayout.bandsY, mLayout.bandsC, mLayout.gridDims,
                                  {mLayout.lightmapWidth, mLayout.lightmapHeight}));
     const ShTables tables = makeShTables();
-    PIC_TRY_ASSIGN(mShTables,
-                   mContext.createBufferWith(&tables, sizeof(tables),
-                                             VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
-    PIC_TRY_ASSIGN(mTimer, mContext.createPassTimer(kTimedPasses));
+    PIC_TRY_ASSIGN(mShTables, Buffer::createWith(mContext, &tables, sizeof(tables),
+                                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
+    PIC_TRY_ASSIGN(mTimer, PassTimer::create(mContext, kTimedPasses));
     return {};
 }
 
@@ -205,8 +204,9 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     const VkDeviceSize radianceBytes =
         VkDeviceSize{params.width} * params.height * sizeof(glm::vec4);
     if (mRadiance.size() != radianceBytes) {
-        PIC_TRY_ASSIGN(mRadiance, mContext.createBuffer(radianceBytes, 0, gpu::MemoryUse::Readback,
-                                                        "rendered radiance"));
+        PIC_TRY_ASSIGN(mRadiance,
+                       gpu::Buffer::create(mContext, radianceBytes, 0, gpu::MemoryUse::Readback,
+                                           "rendered radiance"));
         resized = true;
     }
     // New images or buffers invalidate the set that names the old ones.

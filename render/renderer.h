@@ -23,7 +23,9 @@
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "core/shade_params.h"
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/resources.h"
+#include "gpu/timers.h"
 
 namespace pic {
 

@@ -125,8 +125,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                                             : GpuRtpLink{0, 0, 0};
             },
             4096);
-        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const GpuRtpLink>(rtp),
-                                                              kTexels, "RTP links"));
+        PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const GpuRtpLink>(rtp),
+                                                        kTexels, "RTP links"));
     } else {
         const uint32_t countY = pass->mCountY;
         const size_t words = shLinkWords(countY);
@@ -144,8 +144,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                                          << (16 * (i % 2));
             },
             4096);
-        PIC_TRY_ASSIGN(pass->mLinks, context.createBufferWith(std::span<const uint32_t>(sh),
-                                                              kTexels, "SH links"));
+        PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const uint32_t>(sh),
+                                                        kTexels, "SH links"));
     }
     pass->mLinkBytes = nLinks * linkWords * sizeof(uint32_t);
     const VkFormat format = uintTexelFormat(pass->mTexelWords);
@@ -153,8 +153,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     for (size_t k = 0; k < pass->mChunkFirst.size(); ++k) {
         const VkDeviceSize first = VkDeviceSize{pass->mChunkFirst[k]} * texelsPerCache;
         PIC_TRY_ASSIGN(TexelView view,
-                       context.createTexelView(pass->mLinks, format, first * texelBytes,
-                                               pass->mChunkCount[k] * texelsPerCache, "links"));
+                       TexelView::create(context, pass->mLinks, format, first * texelBytes,
+                                         pass->mChunkCount[k] * texelsPerCache, "links"));
         pass->mLinkViews.push_back(std::move(view));
     }
     return pass;
@@ -166,7 +166,7 @@ Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeRadianc
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
     PIC_TRY_ASSIGN(mRadianceView,
-                   context.createTexelView(nodeRadiance, VK_FORMAT_R32_UINT, "node radiance"));
+                   TexelView::create(context, nodeRadiance, VK_FORMAT_R32_UINT, "node radiance"));
     for (size_t k = 0; k < mChunkFirst.size(); ++k) {
         const std::array<BindingResource, kBindingCount> resources = {
             BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),

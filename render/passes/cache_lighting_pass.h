@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "core/bake_data.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 #include "shaders/shared/cache_lighting.h"
 
 namespace pic::gpu {

@@ -50,7 +50,7 @@ Result<std::unique_ptr<CacheShadingPass>> CacheShadingPass::create(Context& cont
                         "buffer of \"{}\" holds",
                         what, double(bytes) / (1 << 20), double(range) / (1 << 20),
                         context.deviceName());
-        PIC_TRY_ASSIGN(buffer, context.createBuffer(bytes, 0, MemoryUse::Device, what));
+        PIC_TRY_ASSIGN(buffer, Buffer::create(context, bytes, 0, MemoryUse::Device, what));
         // Zero: no cache anywhere until the first setCaches.
         const std::vector<uint16_t> zeros(bytes / 2, 0);
         if (bytes > 0) PIC_TRY(context.upload(buffer, zeros.data(), bytes));

@@ -11,7 +11,9 @@
 #include <glm/glm.hpp>
 
 #include "core/cache_textures.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 #include "render/passes/gbuffer_pass.h"
 #include "render/passes/shadow_map_pass.h"
 #include "shaders/shared/cache_shading.h"

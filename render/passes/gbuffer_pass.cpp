@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "core/bake_data.h"
+#include "gpu/pipelines.h"
+#include "gpu/vk_error.h"
 #include "spirv/gbuffer_frag.h"
 #include "spirv/gbuffer_vert.h"
 
@@ -140,23 +142,24 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
                         what, scene.sourcePath, double(bytes) / (1 << 20),
                         double(range) / (1 << 20), context.deviceName());
 
-    PIC_TRY_ASSIGN(pass->mVertices, context.createBufferWith(
-                                        std::span<const GbufferVertex>(vertices),
-                                        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "G-buffer vertices"));
+    PIC_TRY_ASSIGN(pass->mVertices,
+                   Buffer::createWith(context, std::span<const GbufferVertex>(vertices),
+                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "G-buffer vertices"));
     PIC_TRY_ASSIGN(pass->mTriangles,
-                   context.createBufferWith(std::span<const GbufferTriangle>(triangles), 0,
-                                            "G-buffer triangles"));
+                   Buffer::createWith(context, std::span<const GbufferTriangle>(triangles), 0,
+                                      "G-buffer triangles"));
     PIC_TRY_ASSIGN(
         pass->mMaterials,
-        context.createBufferWith(std::span<const GbufferMaterial>(materials), 0, "materials"));
-    PIC_TRY_ASSIGN(
-        pass->mTextures,
-        context.createBufferWith(std::span<const GbufferTexture>(textures), 0, "texture records"));
+        Buffer::createWith(context, std::span<const GbufferMaterial>(materials), 0, "materials"));
+    PIC_TRY_ASSIGN(pass->mTextures,
+                   Buffer::createWith(context, std::span<const GbufferTexture>(textures), 0,
+                                      "texture records"));
     PIC_TRY_ASSIGN(pass->mTexels,
-                   context.createBufferWith(std::span<const glm::vec4>(texels), 0, "texels"));
-    PIC_TRY_ASSIGN(pass->mEmissiveScale,
-                   context.createBuffer(std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
-                                        0, MemoryUse::Device, "emissive scales"));
+                   Buffer::createWith(context, std::span<const glm::vec4>(texels), 0, "texels"));
+    PIC_TRY_ASSIGN(
+        pass->mEmissiveScale,
+        Buffer::create(context, std::max<size_t>(scene.materials.size(), 1) * sizeof(float), 0,
+                       MemoryUse::Device, "emissive scales"));
     PIC_TRY(pass->createPipeline());
     return pass;
 }
@@ -165,24 +168,16 @@ Result<void> GbufferPass::createPipeline() {
     VkDevice device = mContext.device();
 
     // One set of storage buffers for the fragment shader; it never changes.
-    std::vector<VkDescriptorSetLayoutBinding> bindings;
-    for (uint32_t b = 0; b < kBindingCount; ++b)
-        bindings.push_back(
-            {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr});
-    VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    setInfo.bindingCount = kBindingCount;
-    setInfo.pBindings = bindings.data();
-    PIC_VK_TRY(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &mSetLayout));
-    const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount};
-    VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    poolInfo.maxSets = 1;
-    poolInfo.poolSizeCount = 1;
-    poolInfo.pPoolSizes = &poolSize;
-    PIC_VK_TRY(vkCreateDescriptorPool(device, &poolInfo, nullptr, &mPool));
+    std::array<VkDescriptorType, kBindingCount> bindings;
+    bindings.fill(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    PIC_TRY_ASSIGN(mSetLayout,
+                   createDescriptorSetLayout(mContext, bindings, VK_SHADER_STAGE_FRAGMENT_BIT));
+    PIC_TRY_ASSIGN(mPool, createDescriptorPool(mContext, bindings, 1));
     VkDescriptorSetAllocateInfo allocInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    allocInfo.descriptorPool = mPool;
+    allocInfo.descriptorPool = mPool.get();
     allocInfo.descriptorSetCount = 1;
-    allocInfo.pSetLayouts = &mSetLayout;
+    const VkDescriptorSetLayout setLayout = mSetLayout.get();
+    allocInfo.pSetLayouts = &setLayout;
     PIC_VK_TRY(vkAllocateDescriptorSets(device, &allocInfo, &mSet));
     const Buffer* buffers[kBindingCount] = {&mTriangles, &mMaterials, &mTextures, &mTexels,
                                             &mEmissiveScale};
@@ -199,14 +194,10 @@ Result<void> GbufferPass::createPipeline() {
     }
     vkUpdateDescriptorSets(device, kBindingCount, writes.data(), 0, nullptr);
 
-    const VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                   sizeof(GbufferPush)};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.setLayoutCount = 1;
-    layoutInfo.pSetLayouts = &mSetLayout;
-    layoutInfo.pushConstantRangeCount = 1;
-    layoutInfo.pPushConstantRanges = &push;
-    PIC_VK_TRY(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &mPipelineLayout));
+    PIC_TRY_ASSIGN(mPipelineLayout,
+                   createPipelineLayout(mContext, setLayout,
+                                        {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                                         0, sizeof(GbufferPush)}));
 
     const VkVertexInputAttributeDescription attributes[] = {
         {0, 0, VK_FORMAT_R32G32B32_SFLOAT, uint32_t(offsetof(GbufferVertex, position))},
@@ -226,17 +217,9 @@ Result<void> GbufferPass::createPipeline() {
     desc.attributes = attributes;
     desc.depthCompare = VK_COMPARE_OP_GREATER;  // reversed depth: nearer is larger
     desc.colorFormats = formats;
-    desc.layout = mPipelineLayout;
-    PIC_TRY_ASSIGN(mPipeline, mContext.createRasterPipeline(desc));
+    desc.layout = mPipelineLayout.get();
+    PIC_TRY_ASSIGN(mPipeline, createRasterPipeline(mContext, desc));
     return {};
-}
-
-GbufferPass::~GbufferPass() {
-    VkDevice device = mContext.device();
-    if (mPipeline) vkDestroyPipeline(device, mPipeline, nullptr);
-    if (mPipelineLayout) vkDestroyPipelineLayout(device, mPipelineLayout, nullptr);
-    if (mPool) vkDestroyDescriptorPool(device, mPool, nullptr);
-    if (mSetLayout) vkDestroyDescriptorSetLayout(device, mSetLayout, nullptr);
 }
 
 Result<void> GbufferPass::prepare(uint32_t width, uint32_t height, const LightSet& lights,
@@ -246,11 +229,11 @@ Result<void> GbufferPass::prepare(uint32_t width, uint32_t height, const LightSe
         // Forget the old size first, so that a failed allocation leaves no half-sized set.
         mWidth = mHeight = 0;
         for (uint32_t i = 0; i < kGbufferTargets; ++i) {
-            PIC_TRY_ASSIGN(mTargets[i], mContext.createRenderTarget(width, height, kGbufferFormat,
-                                                                    kTargetNames[i]));
+            PIC_TRY_ASSIGN(mTargets[i], RenderTarget::create(mContext, width, height,
+                                                             kGbufferFormat, kTargetNames[i]));
         }
-        PIC_TRY_ASSIGN(mDepth, mContext.createRenderTarget(width, height, VK_FORMAT_D32_SFLOAT,
-                                                           "G-buffer depth"));
+        PIC_TRY_ASSIGN(mDepth, RenderTarget::create(mContext, width, height, VK_FORMAT_D32_SFLOAT,
+                                                    "G-buffer depth"));
         mWidth = width;
         mHeight = height;
         reallocated = true;
@@ -313,14 +296,14 @@ void GbufferPass::record(VkCommandBuffer cmd, const GbufferPush& push) {
     rendering.pColorAttachments = colors.data();
     rendering.pDepthAttachment = &depth;
     vkCmdBeginRendering(cmd, &rendering);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipelineLayout, 0, 1, &mSet, 0,
-                            nullptr);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipeline.get());
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mPipelineLayout.get(), 0, 1,
+                            &mSet, 0, nullptr);
     const VkViewport viewport{0.0f, 0.0f, float(mWidth), float(mHeight), 0.0f, 1.0f};
     const VkRect2D scissor{{0, 0}, {mWidth, mHeight}};
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
-    vkCmdPushConstants(cmd, mPipelineLayout,
+    vkCmdPushConstants(cmd, mPipelineLayout.get(),
                        VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(push),
                        &push);
     const VkBuffer vertices = mVertices.handle();

@@ -14,7 +14,9 @@
 
 #include "core/light_set.h"
 #include "core/scene.h"
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/handle.h"
+#include "gpu/resources.h"
 #include "shaders/shared/gbuffer.h"
 
 namespace pic::gpu {
@@ -38,7 +40,6 @@ public:
     /// storage buffer.
     static Result<std::unique_ptr<GbufferPass>> create(Context& context, const Scene& scene,
                                                        std::span<const glm::vec2> triangleUvs);
-    ~GbufferPass();
 
     /// Sizes the targets for width × height (new images when the size changed: `reallocated`
     /// says so, and descriptor sets that sample them must be rebuilt) and writes the emissive
@@ -72,11 +73,11 @@ private:
     RenderTarget mDepth;
     uint32_t mWidth = 0;
     uint32_t mHeight = 0;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
-    VkDescriptorSet mSet = VK_NULL_HANDLE;
-    VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
-    VkPipeline mPipeline = VK_NULL_HANDLE;
+    DescriptorSetLayout mSetLayout;
+    DescriptorPool mPool;
+    VkDescriptorSet mSet = VK_NULL_HANDLE;  ///< from mPool
+    PipelineLayout mPipelineLayout;
+    Pipeline mPipeline;
 };
 
 }  // namespace pic::gpu

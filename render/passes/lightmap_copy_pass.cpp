@@ -20,17 +20,19 @@ Result<std::unique_ptr<LightmapCopyPass>> LightmapCopyPass::create(Context& cont
     layout.pushBytes = sizeof(LightmapCopyPush);
     layout.specialization = {bake.params.bandsY, bake.params.bandsC};
     PIC_TRY_ASSIGN(pass->mKernel, Kernel::create(context, kSpirvLightmapCopyComp, layout, "lightmap_copy"));
-    PIC_TRY_ASSIGN(pass->mGridIndex, context.createBufferWith(
-                                         std::span<const uint32_t>(bake.grid.cacheIndex), 0, "grid index"));
+    PIC_TRY_ASSIGN(pass->mGridIndex,
+                   Buffer::createWith(context, std::span<const uint32_t>(bake.grid.cacheIndex), 0,
+                                      "grid index"));
     PIC_TRY_ASSIGN(pass->mLightmapIndex,
-                   context.createBufferWith(std::span<const uint32_t>(bake.lightmap.cacheIndex), 0,
-                                            "light-map index"));
+                   Buffer::createWith(context, std::span<const uint32_t>(bake.lightmap.cacheIndex),
+                                      0, "light-map index"));
     for (int ch = 0; ch < 3; ++ch) {
         const VkDeviceSize count = ch == 0 ? pass->mCountY : pass->mCountC;
-        PIC_TRY_ASSIGN(pass->mGrid[ch], context.createBuffer(2 * count * pass->mGridVertices, 0,
-                                                             MemoryUse::Device, "grid textures"));
-        PIC_TRY_ASSIGN(pass->mLightmap[ch], context.createBuffer(2 * count * pass->mLightmapTexels, 0,
-                                                                 MemoryUse::Device, "light-map textures"));
+        PIC_TRY_ASSIGN(pass->mGrid[ch], Buffer::create(context, 2 * count * pass->mGridVertices, 0,
+                                                       MemoryUse::Device, "grid textures"));
+        PIC_TRY_ASSIGN(pass->mLightmap[ch],
+                       Buffer::create(context, 2 * count * pass->mLightmapTexels, 0,
+                                      MemoryUse::Device, "light-map textures"));
     }
     return pass;
 }

@@ -1,14 +1,16 @@
 #pragma once
 /// Light-map copy on the GPU (paper 000 Figure 2 step 5): the caches' half-float SH into the
 /// grid and light-map textures (coefficient-major layers per YCoCg channel, layout in
-/// render/cpu/lightmap_copy.h). CPU twin: render/cpu/lightmap_copy.h.
+/// core/cache_textures.h). CPU twin: render/cpu/lightmap_copy.h.
 
 #include <array>
 #include <memory>
 
 #include "core/bake_data.h"
 #include "core/cache_textures.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 
 namespace pic::gpu {
 

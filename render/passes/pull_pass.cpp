@@ -43,15 +43,14 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
         inner[n - nS] = {node.left, node.right, radianceScale(node.area), 0};
     }
     if (inner.empty()) return pass;  // a single surfel: nothing to pull
-    PIC_TRY_ASSIGN(pass->mInnerNodes, context.createBufferWith(
-                                          std::span<const PullNode>(inner),
-                                          VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
-    PIC_TRY_ASSIGN(
-        pass->mInnerView,
-        context.createTexelView(pass->mInnerNodes, VK_FORMAT_R32G32B32A32_UINT, "pull nodes"));
+    PIC_TRY_ASSIGN(pass->mInnerNodes,
+                   Buffer::createWith(context, std::span<const PullNode>(inner),
+                                      VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
+    PIC_TRY_ASSIGN(pass->mInnerView, TexelView::create(context, pass->mInnerNodes,
+                                                       VK_FORMAT_R32G32B32A32_UINT, "pull nodes"));
     PIC_TRY_ASSIGN(
         pass->mLevelOffsetBuffer,
-        context.createBufferWith(std::span<const uint32_t>(offsets), 0, "level offsets"));
+        Buffer::createWith(context, std::span<const uint32_t>(offsets), 0, "level offsets"));
     return pass;
 }
 
@@ -59,8 +58,8 @@ Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buff
     if (!mInnerNodes.handle()) return {};
     PIC_TRY(mLevel.resetSets());
     PIC_TRY(mTail.resetSets());
-    PIC_TRY_ASSIGN(mFluxView,
-                   context.createTexelView(nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT, "node flux"));
+    PIC_TRY_ASSIGN(mFluxView, TexelView::create(context, nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT,
+                                                "node flux"));
     const std::array<BindingResource, 5> resources = {
         BindingResource::storage(0, nodeFlux), BindingResource::texels(1, mInnerView),
         BindingResource::storage(2, nodeRadiance), BindingResource::texels(3, mFluxView),

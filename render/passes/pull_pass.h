@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "core/bake_data.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 
 namespace pic::gpu {
 

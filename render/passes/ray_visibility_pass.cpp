@@ -20,12 +20,12 @@ Result<std::unique_ptr<RayVisibilityPass>> RayVisibilityPass::create(Context& co
     std::unique_ptr<RayVisibilityPass> pass(new RayVisibilityPass(context, rays, bake));
     pass->mWords = uint32_t(visibilityWords(bake.surfels.size()));
     PIC_TRY_ASSIGN(pass->mLights,
-                   context.createBuffer(kMaxLights * sizeof(GpuLight), kVisibilityUsage,
-                                        MemoryUse::Device, "light records"));
+                   Buffer::create(context, kMaxLights * sizeof(GpuLight), kVisibilityUsage,
+                                  MemoryUse::Device, "light records"));
     // Room for one light until a light set asks for more.
     PIC_TRY_ASSIGN(pass->mVisibility,
-                   context.createBuffer(std::max<size_t>(pass->mWords, 1) * sizeof(uint32_t),
-                                        kVisibilityUsage, MemoryUse::Device, "surfel visibility"));
+                   Buffer::create(context, std::max<size_t>(pass->mWords, 1) * sizeof(uint32_t),
+                                  kVisibilityUsage, MemoryUse::Device, "surfel visibility"));
     return pass;
 }
 
@@ -38,8 +38,8 @@ Result<void> RayVisibilityPass::prepare(const LightSet& lights, bool& reallocate
         // A new buffer holds none of the bits traced before: every light is traced again (the
         // buffer grows only when a light set has more lights than any before it).
         mKeys.clear();
-        PIC_TRY_ASSIGN(mVisibility, mContext.createBuffer(bytes, kVisibilityUsage,
-                                                          MemoryUse::Device, "surfel visibility"));
+        PIC_TRY_ASSIGN(mVisibility, Buffer::create(mContext, bytes, kVisibilityUsage,
+                                                   MemoryUse::Device, "surfel visibility"));
         reallocated = true;
     }
     mBits.resize(count * mWords);

@@ -14,7 +14,8 @@
 
 #include "core/bake_data.h"
 #include "core/light_set.h"
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/resources.h"
 #include "rays/embree_scene.h"
 
 namespace pic::gpu {

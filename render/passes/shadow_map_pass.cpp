@@ -13,6 +13,7 @@
 
 #include "core/parallel.h"
 #include "core/sampling.h"
+#include "gpu/pipelines.h"
 
 #include "spirv/shadow_map_vert.h"
 
@@ -412,28 +413,26 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
         pass->mLevels.push_back(level);
     }
     PIC_TRY_ASSIGN(pass->mVertices,
-                   context.createBufferWith(std::span<const float>(positions),
-                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "shadow vertices"));
+                   Buffer::createWith(context, std::span<const float>(positions),
+                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "shadow vertices"));
     PIC_TRY_ASSIGN(pass->mIndices,
-                   context.createBufferWith(std::span<const uint32_t>(indices),
-                                            VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "shadow indices"));
-    PIC_TRY_ASSIGN(pass->mLights, context.createBuffer(sizeof(GpuLight) * kMaxLights,
-                                                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
-                                                       MemoryUse::Device, "lights"));
-    PIC_TRY_ASSIGN(pass->mLayerBuffer, context.createBuffer(sizeof(GpuShadowLayer) * 6 * kMaxLights, 0,
-                                                            MemoryUse::Device, "shadow layers"));
+                   Buffer::createWith(context, std::span<const uint32_t>(indices),
+                                      VK_BUFFER_USAGE_INDEX_BUFFER_BIT, "shadow indices"));
+    PIC_TRY_ASSIGN(pass->mLights, Buffer::create(context, sizeof(GpuLight) * kMaxLights,
+                                                 VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT,
+                                                 MemoryUse::Device, "lights"));
+    PIC_TRY_ASSIGN(pass->mLayerBuffer,
+                   Buffer::create(context, sizeof(GpuShadowLayer) * 6 * kMaxLights, 0,
+                                  MemoryUse::Device, "shadow layers"));
     // A one-layer placeholder keeps descriptor sets valid before the first light arrives.
-    PIC_TRY_ASSIGN(pass->mDepth, context.createDepthArray(size, 1));
+    PIC_TRY_ASSIGN(pass->mDepth, DepthArray::create(context, size, 1));
 
     // Depth-only pipelines: no fragment shader, viewport and scissor set per layer. Open
     // triangles are drawn from both sides (surfels sit on both sides of single-sided
     // geometry); solids seen from outside only from the side that looks at the light.
-    VkDevice device = context.device();
-    const VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(ShadowMapPush)};
-    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    layoutInfo.pushConstantRangeCount = 1;
-    layoutInfo.pPushConstantRanges = &push;
-    PIC_VK_TRY(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pass->mPipelineLayout));
+    PIC_TRY_ASSIGN(pass->mPipelineLayout,
+                   createPipelineLayout(context, VK_NULL_HANDLE,
+                                        {VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(ShadowMapPush)}));
 
     RasterPipelineDesc desc;
     desc.vertexSpirv = kSpirvShadowMapVert;
@@ -442,18 +441,11 @@ Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, c
     const VkVertexInputAttributeDescription position{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
     desc.attributes = std::span(&position, 1);
     desc.depthCompare = VK_COMPARE_OP_LESS;
-    desc.layout = pass->mPipelineLayout;
-    PIC_TRY_ASSIGN(pass->mPipeline, context.createRasterPipeline(desc));
+    desc.layout = pass->mPipelineLayout.get();
+    PIC_TRY_ASSIGN(pass->mPipeline, createRasterPipeline(context, desc));
     desc.cullMode = kCullAwayFromLight;
-    PIC_TRY_ASSIGN(pass->mOneSidedPipeline, context.createRasterPipeline(desc));
+    PIC_TRY_ASSIGN(pass->mOneSidedPipeline, createRasterPipeline(context, desc));
     return pass;
-}
-
-ShadowMapPass::~ShadowMapPass() {
-    VkDevice device = mContext.device();
-    if (mPipeline) vkDestroyPipeline(device, mPipeline, nullptr);
-    if (mOneSidedPipeline) vkDestroyPipeline(device, mOneSidedPipeline, nullptr);
-    if (mPipelineLayout) vkDestroyPipelineLayout(device, mPipelineLayout, nullptr);
 }
 
 uint32_t ShadowMapPass::levelFor(const LightSlot& slot, uint32_t layer) const {
@@ -617,7 +609,7 @@ Result<void> ShadowMapPass::prepare(const LightSet& lights, bool& reallocated) {
     // The image grows when the lights need more layers (every map is then re-rendered); it
     // never shrinks, so that toggling a light does not reallocate.
     if (layer > mDepth.layers()) {
-        PIC_TRY_ASSIGN(mDepth, mContext.createDepthArray(mSize, layer));
+        PIC_TRY_ASSIGN(mDepth, DepthArray::create(mContext, mSize, layer));
         reallocated = true;
     }
     // A light keeps its maps when the same light sat on the same layers with the same
@@ -655,7 +647,8 @@ void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint3
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
     const ShadowMapPush push{mLayers[layer].clipFromWorld};
-    vkCmdPushConstants(cmd, mPipelineLayout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), &push);
+    vkCmdPushConstants(cmd, mPipelineLayout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push),
+                       &push);
     const VkBuffer vertices = mVertices.handle();
     const VkDeviceSize zero = 0;
     vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &zero);
@@ -717,7 +710,8 @@ void ShadowMapPass::record(VkCommandBuffer cmd) {
                 for (const TriangleRange& range : ranges) {
                     if (range.oneSided != oneSided) continue;
                     if (!bound) {
-                        bindPipeline(cmd, oneSided ? mOneSidedPipeline : mPipeline, layer, side);
+                        bindPipeline(cmd, (oneSided ? mOneSidedPipeline : mPipeline).get(), layer,
+                                     side);
                         bound = true;
                     }
                     vkCmdDrawIndexed(cmd, 3 * range.triangleCount, 1, 3 * range.firstTriangle, 0, 0);

@@ -24,7 +24,9 @@
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "core/solids.h"
-#include "gpu/context.h"
+#include "gpu/device.h"
+#include "gpu/handle.h"
+#include "gpu/resources.h"
 #include "shaders/shared/shadow_map.h"
 
 namespace pic::gpu {
@@ -170,7 +172,6 @@ public:
     static Result<std::unique_ptr<ShadowMapPass>> create(Context& context, const Scene& scene,
                                                          uint32_t size,
                                                          const ShadowMapOptions& options = {});
-    ~ShadowMapPass();
 
     /// Lays out `lights` on layers, writes their GpuLight records and matrices and marks the
     /// lights whose maps must be rendered. `reallocated` tells whether the depth image was
@@ -254,9 +255,9 @@ private:
     Buffer mLights;
     Buffer mLayerBuffer;
     DepthArray mDepth;
-    VkPipelineLayout mPipelineLayout = VK_NULL_HANDLE;
-    VkPipeline mPipeline = VK_NULL_HANDLE;         ///< both faces
-    VkPipeline mOneSidedPipeline = VK_NULL_HANDLE;  ///< faces looking towards the light
+    PipelineLayout mPipelineLayout;
+    Pipeline mPipeline;          ///< both faces
+    Pipeline mOneSidedPipeline;  ///< faces looking towards the light
     uint32_t mSolidTriangles = 0;
     std::vector<LightSlot> mCurrent;
     std::vector<GpuShadowLayer> mLayers;

@@ -79,40 +79,41 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
     }, 1024);
 
     PIC_TRY_ASSIGN(pass->mSurfels,
-                   context.createBufferWith(bake.surfels.data(), nS * sizeof(pic::Surfel), kTexels,
-                                            "surfels"));
+                   Buffer::createWith(context, bake.surfels.data(), nS * sizeof(pic::Surfel),
+                                      kTexels, "surfels"));
     PIC_TRY_ASSIGN(pass->mStencils,
-                   context.createBufferWith(std::span<const SurfelStencil>(stencils), kTexels,
-                                            "surfel stencils"));
-    PIC_TRY_ASSIGN(pass->mEmissiveScale,
-                   context.createBuffer(std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
-                                        kTexels, MemoryUse::Device, "emissive scales"));
-    PIC_TRY_ASSIGN(pass->mDirectFlux, context.createBuffer(nS * sizeof(glm::vec4), kTexels,
-                                                           MemoryUse::Device, "direct flux"));
+                   Buffer::createWith(context, std::span<const SurfelStencil>(stencils), kTexels,
+                                      "surfel stencils"));
+    PIC_TRY_ASSIGN(
+        pass->mEmissiveScale,
+        Buffer::create(context, std::max<size_t>(scene.materials.size(), 1) * sizeof(float),
+                       kTexels, MemoryUse::Device, "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFlux, Buffer::create(context, nS * sizeof(glm::vec4), kTexels,
+                                                     MemoryUse::Device, "direct flux"));
     // Records as RGBA32UI texels (their floats bit casts), flux as RGBA32F.
-    PIC_TRY_ASSIGN(pass->mSurfelView,
-                   context.createTexelView(pass->mSurfels, VK_FORMAT_R32G32B32A32_UINT, "surfels"));
+    PIC_TRY_ASSIGN(pass->mSurfelView, TexelView::create(context, pass->mSurfels,
+                                                        VK_FORMAT_R32G32B32A32_UINT, "surfels"));
+    PIC_TRY_ASSIGN(pass->mStencilView,
+                   TexelView::create(context, pass->mStencils, VK_FORMAT_R32G32B32A32_UINT,
+                                     "surfel stencils"));
+    PIC_TRY_ASSIGN(pass->mEmissiveView, TexelView::create(context, pass->mEmissiveScale,
+                                                          VK_FORMAT_R32_SFLOAT, "emissive scales"));
+    PIC_TRY_ASSIGN(pass->mDirectFluxView,
+                   TexelView::create(context, pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT,
+                                     "direct flux"));
     PIC_TRY_ASSIGN(
-        pass->mStencilView,
-        context.createTexelView(pass->mStencils, VK_FORMAT_R32G32B32A32_UINT, "surfel stencils"));
-    PIC_TRY_ASSIGN(
-        pass->mEmissiveView,
-        context.createTexelView(pass->mEmissiveScale, VK_FORMAT_R32_SFLOAT, "emissive scales"));
-    PIC_TRY_ASSIGN(
-        pass->mDirectFluxView,
-        context.createTexelView(pass->mDirectFlux, VK_FORMAT_R32G32B32A32_SFLOAT, "direct flux"));
-    PIC_TRY_ASSIGN(pass->mGroupFlux,
-                   context.createBuffer(2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
-                                        MemoryUse::Readback, "surfel flux sums"));
+        pass->mGroupFlux,
+        Buffer::create(context, 2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
+                       MemoryUse::Readback, "surfel flux sums"));
     // Both modes share one shader, which declares both sources: the one not in use is bound to
     // a placeholder.
     if (rays) {
-        PIC_TRY_ASSIGN(pass->mUnusedLayers, context.createBuffer(sizeof(GpuShadowLayer), 0,
-                                                                 MemoryUse::Device, "unused"));
-        PIC_TRY_ASSIGN(pass->mUnusedDepth, context.createDepthArray(kMinShadowSide, 1));
+        PIC_TRY_ASSIGN(pass->mUnusedLayers, Buffer::create(context, sizeof(GpuShadowLayer), 0,
+                                                           MemoryUse::Device, "unused"));
+        PIC_TRY_ASSIGN(pass->mUnusedDepth, DepthArray::create(context, kMinShadowSide, 1));
     } else {
-        PIC_TRY_ASSIGN(pass->mUnusedVisibility, context.createBuffer(sizeof(uint32_t), kTexels,
-                                                                     MemoryUse::Device, "unused"));
+        PIC_TRY_ASSIGN(pass->mUnusedVisibility, Buffer::create(context, sizeof(uint32_t), kTexels,
+                                                               MemoryUse::Device, "unused"));
     }
     return pass;
 }
@@ -126,13 +127,13 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     const Buffer& lights = rays ? r.rays->lightBuffer() : r.shadows->lightBuffer();
     const Buffer& visibility = rays ? r.rays->visibilityBuffer() : mUnusedVisibility;
     PIC_TRY_ASSIGN(mLightView,
-                   mContext.createTexelView(lights, VK_FORMAT_R32G32B32A32_UINT, "lights"));
+                   TexelView::create(mContext, lights, VK_FORMAT_R32G32B32A32_UINT, "lights"));
     PIC_TRY_ASSIGN(mVisibilityView,
-                   mContext.createTexelView(visibility, VK_FORMAT_R32_UINT, "visibility"));
+                   TexelView::create(mContext, visibility, VK_FORMAT_R32_UINT, "visibility"));
     const std::array<const Buffer*, 3> caches = {r.cacheY, r.cacheCo, r.cacheCg};
     for (size_t c = 0; c < caches.size(); ++c) {
         PIC_TRY_ASSIGN(mCacheViews[c],
-                       mContext.createTexelView(*caches[c], VK_FORMAT_R16_SFLOAT, "caches"));
+                       TexelView::create(mContext, *caches[c], VK_FORMAT_R16_SFLOAT, "caches"));
     }
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::texels(0, mSurfelView),

@@ -15,7 +15,9 @@
 #include "core/bake_data.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "gpu/device.h"
 #include "gpu/kernel.h"
+#include "gpu/resources.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
 
