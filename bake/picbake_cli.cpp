@@ -12,9 +12,9 @@
 #include "bake/bake.h"
 #include "bake/bake_options_cli.h"
 #include "core/bake_file.h"
+#include "core/cli.h"
 #include "core/gltf_loader.h"
 #include "core/parallel.h"
-#include "core/progress.h"
 
 namespace pic {
 
@@ -37,10 +37,7 @@ std::string humanBytes(uint64_t bytes) {
 /// Stage timings live beside the bake, so the bake itself stays byte-identical across runs.
 std::string timingsPath(const std::string& bakePath) { return bakePath + ".timings.json"; }
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picbake: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
+int reportError(const Error& error) { return pic::reportError("picbake", error); }
 
 int runBakeCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options) {
     using Clock = std::chrono::steady_clock;
@@ -181,11 +178,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
 int picbakeMain(int argc, char** argv) {
     CLI::App app{"picbake: precomputes surfels, hierarchy, caches and links of a glTF scene"};
     app.require_subcommand(1);
-    app.fallthrough();  // global flags may follow the subcommand
-    int threads = 0;
-    bool quiet = false;
-    app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-    app.add_flag("--quiet", quiet, "no progress bars");
+    addGlobalFlags(app);
 
     CLI::App* bakeCommand = app.add_subcommand("bake", "bake a glTF 2.0 scene (.gltf or .glb)");
     std::string scenePath, outPath;
@@ -200,19 +193,7 @@ int picbakeMain(int argc, char** argv) {
     infoCommand->add_option("bake", infoPath, "bake file (.pic)")->required();
     infoCommand->add_flag("--json", json, "print one JSON object");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
-    setWorkerCount(threads);
-    Progress::setEnabled(!quiet);
-
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (bakeCommand->parsed()) {
         return runBakeCommand(scenePath, outPath, bakeFlags.toOptions());
     }

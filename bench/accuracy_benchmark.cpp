@@ -11,7 +11,6 @@
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
 #include "bench/bench_common.h"
-#include "core/camera.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/image.h"
@@ -67,17 +66,12 @@ float exposureFor(const Image& reference) {
     return mean > 0.0 ? static_cast<float>(0.25 / mean) : 1.0f;
 }
 
-int failWith(const Error& error) {
-    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
-
 /// The inputs both modes report.
 Json inputsJson(const AccuracyParams& params) {
     Json json;
     json["scene"] = params.scenePath;
     json["lights"] = params.lightsPath.empty() ? "scene" : params.lightsPath;
-    json["size"] = params.size;
+    json["size"] = fmt::format("{}x{}", params.view.size.x, params.view.size.y);
     json["reference_spp"] = params.spp;
     json["probe_samples"] = params.probeSamples;
     return json;
@@ -105,7 +99,7 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
                   const Camera& camera, const LightSet& lights, glm::uvec2 size) {
     auto reference = pathTrace(scene, rays, lights, camera,
                                referenceParams(params, size, PathTraceParams::Component::Indirect));
-    if (!reference) return failWith(reference.error());
+    if (!reference) return reportError(reference.error());
 
     ShadeParams shade;
     shade.width = size.x;
@@ -128,23 +122,23 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
         BakeReport report;
         std::fprintf(stderr, "picbench: baking nL %u …\n", links);
         auto bake = runBake(scene, options, report);
-        if (!bake) return failWith(bake.error());
+        if (!bake) return reportError(bake.error());
         auto runtime = createCpuRuntime(scene, rays, *bake, BounceParams{params.bounces});
-        if (!runtime) return failWith(runtime.error());
+        if (!runtime) return reportError(runtime.error());
         std::vector<double> updateMs;
         const CacheValues* values = nullptr;
         for (int k = 0; k < 3; ++k) {
             const Clock::time_point start = Clock::now();
             auto updated = (*runtime)->setLights(lights, nullptr);
-            if (!updated) return failWith(updated.error());
+            if (!updated) return reportError(updated.error());
             updateMs.push_back(1e3 * secondsSince(start));
             values = *updated;
         }
         std::sort(updateMs.begin(), updateMs.end());
         auto image = shadeFromCaches(scene, rays, *bake, *values, lights, camera, shade);
-        if (!image) return failWith(image.error());
+        if (!image) return reportError(image.error());
         auto error = compareImages(*image, *reference);
-        if (!error) return failWith(error.error());
+        if (!error) return reportError(error.error());
         if (!idealError) {
             // The ideal caches sit where every bake of this scene puts them (nL changes only
             // the links): their error is the floor that more links approach.
@@ -153,11 +147,11 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
             probe.bounces = params.bounces;
             probe.seed = params.seed;
             auto ideal = pathTraceProbes(scene, rays, *bake, lights, probe);
-            if (!ideal) return failWith(ideal.error());
+            if (!ideal) return reportError(ideal.error());
             auto idealImage = shadeFromCaches(scene, rays, *bake, *ideal, lights, camera, shade);
-            if (!idealImage) return failWith(idealImage.error());
+            if (!idealImage) return reportError(idealImage.error());
             auto e = compareImages(*idealImage, *reference);
-            if (!e) return failWith(e.error());
+            if (!e) return reportError(e.error());
             idealError = e->relativeRmse;
             json["ideal_indirect"] = errorJson(*e);
         }
@@ -199,41 +193,40 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
 }  // namespace
 
 int runAccuracyBenchmark(const AccuracyParams& params) {
-    auto size = parseImageSize(params.size);
-    if (!size) return failWith(size.error());
+    const glm::uvec2 size = params.view.size;
     auto scene = loadScene(params.scenePath);
-    if (!scene) return failWith(scene.error());
-    auto camera = params.camera.empty() ? sceneCamera(*scene, params.sceneCamera) : parseCamera(params.camera);
-    if (!camera) return failWith(camera.error());
+    if (!scene) return reportError(scene.error());
+    auto camera = params.view.cameraIn(*scene);
+    if (!camera) return reportError(camera.error());
     auto loaded = loadLightSet(params.lightsPath, *scene);
-    if (!loaded) return failWith(loaded.error());
+    if (!loaded) return reportError(loaded.error());
     const LightSet& lights = *loaded;
     if (!params.linksSweep.empty()) {
         auto rays = EmbreeScene::create(*scene);
-        if (!rays) return failWith(rays.error());
-        return runLinksSweep(params, *scene, **rays, *camera, lights, *size);
+        if (!rays) return reportError(rays.error());
+        return runLinksSweep(params, *scene, **rays, *camera, lights, size);
     }
 
     Json seconds;
     auto start = Clock::now();
     BakeReport bakeReport;
     auto bake = runBake(*scene, params.bake, bakeReport);
-    if (!bake) return failWith(bake.error());
+    if (!bake) return reportError(bake.error());
     seconds["bake"] = secondsSince(start);
 
     auto rays = EmbreeScene::create(*scene);
-    if (!rays) return failWith(rays.error());
+    if (!rays) return reportError(rays.error());
     start = Clock::now();
     auto runtime = createCpuRuntime(*scene, **rays, *bake, BounceParams{params.bounces});
-    if (!runtime) return failWith(runtime.error());
+    if (!runtime) return reportError(runtime.error());
     UpdateStats update;
     auto values = (*runtime)->setLights(lights, &update);
-    if (!values) return failWith(values.error());
+    if (!values) return reportError(values.error());
     seconds["runtime_cpu"] = secondsSince(start);
 
     ShadeParams shade;
-    shade.width = size->x;
-    shade.height = size->y;
+    shade.width = size.x;
+    shade.height = size.y;
     shade.samplesPerPixel = params.shadeSpp;
     auto shadeBoth = [&](const CacheValues& caches, Image& full, Image& indirect) -> Result<void> {
         shade.component = ShadeComponent::Full;
@@ -244,19 +237,19 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     };
     Image oursFull, oursIndirect;
     start = Clock::now();
-    if (auto ok = shadeBoth(**values, oursFull, oursIndirect); !ok) return failWith(ok.error());
+    if (auto ok = shadeBoth(**values, oursFull, oursIndirect); !ok) return reportError(ok.error());
     seconds["shade"] = secondsSince(start);
 
     start = Clock::now();
     auto refFull = pathTrace(*scene, **rays, lights, *camera,
-                             referenceParams(params, *size, PathTraceParams::Component::Full));
-    if (!refFull) return failWith(refFull.error());
+                             referenceParams(params, size, PathTraceParams::Component::Full));
+    if (!refFull) return reportError(refFull.error());
     seconds["reference_full"] = secondsSince(start);
     start = Clock::now();
     auto refIndirect =
         pathTrace(*scene, **rays, lights, *camera,
-                  referenceParams(params, *size, PathTraceParams::Component::Indirect));
-    if (!refIndirect) return failWith(refIndirect.error());
+                  referenceParams(params, size, PathTraceParams::Component::Indirect));
+    if (!refIndirect) return reportError(refIndirect.error());
     seconds["reference_indirect"] = secondsSince(start);
 
     ProbeParams probe;
@@ -265,11 +258,11 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     probe.seed = params.seed;
     start = Clock::now();
     auto ideal = pathTraceProbes(*scene, **rays, *bake, lights, probe);
-    if (!ideal) return failWith(ideal.error());
+    if (!ideal) return reportError(ideal.error());
     seconds["probes"] = secondsSince(start);
     Image idealFull, idealIndirect;
     start = Clock::now();
-    if (auto ok = shadeBoth(*ideal, idealFull, idealIndirect); !ok) return failWith(ok.error());
+    if (auto ok = shadeBoth(*ideal, idealFull, idealIndirect); !ok) return reportError(ok.error());
     seconds["shade_ideal"] = secondsSince(start);
 
     auto compare = [&](const Image& a, const Image& b) { return compareImages(a, b); };
@@ -278,7 +271,7 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     auto eIdealIndirect = compare(idealIndirect, *refIndirect);
     auto eIdealFull = compare(idealFull, *refFull);
     for (const auto* e : {&eIndirect, &eFull, &eIdealIndirect, &eIdealFull})
-        if (!*e) return failWith(e->error());
+        if (!*e) return reportError(e->error());
 
     std::error_code ec;
     std::filesystem::create_directories(params.outDir, ec);
@@ -293,13 +286,13 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
              {"_ours_full.exr", &oursFull}, {"_ours_indirect.exr", &oursIndirect},
              {"_ref_full.exr", &*refFull}, {"_ref_indirect.exr", &*refIndirect},
              {"_ideal_indirect.exr", &idealIndirect}})
-        if (auto ok = writeImage(base + name, *image); !ok) return failWith(ok.error());
+        if (auto ok = writeImage(base + name, *image); !ok) return reportError(ok.error());
     Image indirectSide = sideBySide({oursIndirect, idealIndirect, *refIndirect, heatMap(oursIndirect, *refIndirect)},
                                     {exposureIndirect, exposureIndirect, exposureIndirect, 1.0f});
     Image fullSide = sideBySide({oursFull, idealFull, *refFull, heatMap(oursFull, *refFull)},
                                 {exposureFull, exposureFull, exposureFull, 1.0f});
-    if (auto ok = writeImage(base + "_indirect_side.png", indirectSide); !ok) return failWith(ok.error());
-    if (auto ok = writeImage(base + "_full_side.png", fullSide); !ok) return failWith(ok.error());
+    if (auto ok = writeImage(base + "_indirect_side.png", indirectSide); !ok) return reportError(ok.error());
+    if (auto ok = writeImage(base + "_full_side.png", fullSide); !ok) return reportError(ok.error());
 
     Json json = inputsJson(params);
     json["bake"] = {{"surfels", bake->params.surfels}, {"links_per_cache", bake->params.linksPerCache},
@@ -317,8 +310,8 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     const std::string jsonPath = params.jsonPath.empty() ? base + "_accuracy.json" : params.jsonPath;
     std::ofstream(jsonPath) << json.dump(2) << "\n";
 
-    std::printf("%s: %ux%u, reference %u spp, %d runtime bounces, %zu caches\n", stem.c_str(), size->x,
-                size->y, params.spp, update.bounces, bake->caches.size());
+    std::printf("%s: %ux%u, reference %u spp, %d runtime bounces, %zu caches\n", stem.c_str(), size.x,
+                size.y, params.spp, update.bounces, bake->caches.size());
     std::printf("  %-22s %14s %12s\n", "", "relative RMSE", "mean ratio");
     std::printf("  %-22s %14.4f %12.4f\n", "indirect (linked)", eIndirect->relativeRmse, eIndirect->meanRatio);
     std::printf("  %-22s %14.4f %12.4f\n", "indirect (ideal)", eIdealIndirect->relativeRmse, eIdealIndirect->meanRatio);

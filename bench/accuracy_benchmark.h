@@ -9,15 +9,14 @@
 #include <vector>
 
 #include "bake/bake.h"
+#include "core/cli.h"
 
 namespace pic {
 
 struct AccuracyParams {
     std::string scenePath;
     std::string lightsPath;   ///< empty: the scene's own lights
-    std::string camera;       ///< --camera text; empty: use sceneCamera
-    int sceneCamera = 0;
-    std::string size = "256x256";
+    View view;                ///< image size and camera
     uint32_t spp = 256;           ///< path-traced reference samples per pixel
     uint32_t probeSamples = 1024; ///< path-traced directions per ideal cache
     uint32_t shadeSpp = 4;        ///< subsamples per pixel when shading from caches

@@ -21,10 +21,7 @@ int runBakeBenchmark(const BakeBenchmarkParams& params) {
     using Clock = std::chrono::steady_clock;
     auto loadStart = Clock::now();
     auto scene = loadScene(params.scenePath);
-    if (!scene) {
-        std::fprintf(stderr, "picbench: error: %s\n", scene.error().message.c_str());
-        return exitCode(scene.error());
-    }
+    if (!scene) return reportError(scene.error());
     double loadSeconds = std::chrono::duration<double>(Clock::now() - loadStart).count();
 
     std::vector<std::string> stageOrder;
@@ -36,10 +33,7 @@ int runBakeBenchmark(const BakeBenchmarkParams& params) {
         BakeReport report;
         auto start = Clock::now();
         auto bake = runBake(*scene, params.options, report);
-        if (!bake) {
-            std::fprintf(stderr, "picbench: error: %s\n", bake.error().message.c_str());
-            return exitCode(bake.error());
-        }
+        if (!bake) return reportError(bake.error());
         totals.push_back(std::chrono::duration<double>(Clock::now() - start).count());
         for (const auto& [stage, s] : report.seconds) {
             if (!stageSeconds.count(stage)) stageOrder.push_back(stage);
@@ -54,16 +48,10 @@ int runBakeBenchmark(const BakeBenchmarkParams& params) {
     std::string tmp = (std::filesystem::temp_directory_path() /
                        ("picbench_" + std::to_string(::getpid()) + ".pic")).string();
     auto written = writeBakeFile(tmp, last);
-    if (!written) {
-        std::fprintf(stderr, "picbench: error: %s\n", written.error().message.c_str());
-        return exitCode(written.error());
-    }
+    if (!written) return reportError(written.error());
     auto info = inspectBakeFile(tmp);
     std::filesystem::remove(tmp);
-    if (!info) {
-        std::fprintf(stderr, "picbench: error: %s\n", info.error().message.c_str());
-        return exitCode(info.error());
-    }
+    if (!info) return reportError(info.error());
 
     nlohmann::ordered_json json;
     json["scene"] = params.scenePath;

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "core/chart.h"
+#include "core/cli.h"
 #include "core/gltf_loader.h"
 
 namespace pic {
@@ -52,28 +53,25 @@ LightSet changedLights(const LightSet& base, int k, float step, const std::strin
 std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath) {
     auto scene = loadScene(scenePath);
     if (!scene) {
-        std::fprintf(stderr, "picbench: error: %s\n", scene.error().message.c_str());
+        reportError(scene.error());
         return std::nullopt;
     }
     auto lights = loadLightSet(lightsPath, *scene);
     if (!lights) {
-        std::fprintf(stderr, "picbench: error: %s\n", lights.error().message.c_str());
+        reportError(lights.error());
         return std::nullopt;
     }
     if (lights->lights.empty())
         std::fprintf(stderr, "picbench: warning: the light set has no punctual lights\n");
     auto rays = EmbreeScene::create(*scene);
     if (!rays) {
-        std::fprintf(stderr, "picbench: error: %s\n", rays.error().message.c_str());
+        reportError(rays.error());
         return std::nullopt;
     }
     return BenchInputs{std::move(*scene), std::move(*lights), std::move(*rays)};
 }
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
+int reportError(const Error& error) { return reportError("picbench", error); }
 
 std::string chartPathFor(const std::string& jsonPath) {
     const std::string suffix = ".json";

@@ -10,6 +10,7 @@
 
 #include "bake/link_generation.h"
 #include "bake/ref/path_tracer.h"
+#include "bench/bench_common.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/light_set.h"
@@ -59,20 +60,16 @@ Json ratiosJson(const Estimates& e, uint32_t caches) {
 }  // namespace
 
 int runLinkErrorBenchmark(const LinkErrorParams& params) {
-    auto failWith = [](const Error& error) {
-        std::fprintf(stderr, "picbench: error: %s\n", error.message.c_str());
-        return exitCode(error);
-    };
     auto scene = loadScene(params.scenePath);
-    if (!scene) return failWith(scene.error());
+    if (!scene) return reportError(scene.error());
     auto loaded = loadLightSet(params.lightsPath, *scene);
-    if (!loaded) return failWith(loaded.error());
+    if (!loaded) return reportError(loaded.error());
     const LightSet& lights = *loaded;
     BakeReport report;
     auto bake = runBake(*scene, params.bake, report);
-    if (!bake) return failWith(bake.error());
+    if (!bake) return reportError(bake.error());
     auto rays = EmbreeScene::create(*scene);
-    if (!rays) return failWith(rays.error());
+    if (!rays) return reportError(rays.error());
 
     // One bounce of the runtime: direct surfel flux, pulled, gathered through the links.
     const size_t nS = bake->surfels.size();
@@ -169,7 +166,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     if (!params.jsonPath.empty()) {
         std::ofstream out(params.jsonPath);
         out << json.dump(2) << "\n";
-        if (!out) return failWith(Error{ErrorCode::Io, "cannot write " + params.jsonPath});
+        if (!out) return reportError(Error{ErrorCode::Io, "cannot write " + params.jsonPath});
         std::printf("  wrote %s\n", params.jsonPath.c_str());
     }
     return 0;

@@ -5,28 +5,39 @@
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
 #include "bench/bake_benchmark.h"
+#include "bench/bench_common.h"
 #include "bench/codec_benchmark.h"
 #include "bench/link_error_benchmark.h"
 #include "bench/runtime_benchmark.h"
 #include "bench/stream_benchmark.h"
-#include "core/parallel.h"
-#include "core/progress.h"
+#include "core/cli.h"
 
 namespace pic {
+
+namespace {
+
+/// --scene FILE, the scene a benchmark runs on.
+void addSceneOption(CLI::App& command, std::string& path) {
+    command.add_option("--scene", path, "scene file (.gltf or .glb)")->required();
+}
+
+/// --setting moderate|high: a row of paper 000's Table 2 (settingOptions).
+void addSettingOption(CLI::App& command, std::string& setting) {
+    command.add_option("--setting", setting, "paper 000 Table 2 setting (default: moderate)")
+        ->check(CLI::IsMember({"moderate", "high"}));
+}
+
+}  // namespace
 
 int picbenchMain(int argc, char** argv) {
     CLI::App app{"picbench: pic benchmarks (timings, memory, bytes) printed and written as JSON"};
     app.require_subcommand(1);
-    app.fallthrough();  // global flags may follow the subcommand
-    int threads = 0;
-    bool quiet = false;
-    app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-    app.add_flag("--quiet", quiet, "no progress bars");
+    addGlobalFlags(app);
 
     CLI::App* bake = app.add_subcommand("bake", "time every bake stage on one scene");
     BakeBenchmarkParams params;
     BakeOptionFlags flags;
-    bake->add_option("--scene", params.scenePath, "scene file (.gltf or .glb)")->required();
+    addSceneOption(*bake, params.scenePath);
     bake->add_option("--repeat", params.repeat, "bakes to run; stage times are medians (default 1)")
         ->check(CLI::PositiveNumber);
     bake->add_option("--json", params.jsonPath, "write the figures to this JSON file");
@@ -35,12 +46,10 @@ int picbenchMain(int argc, char** argv) {
     CLI::App* accuracy = app.add_subcommand("accuracy", "error of the cache term against a path-traced reference");
     AccuracyParams accuracyParams;
     BakeOptionFlags accuracyFlags;
-    accuracy->add_option("--scene", accuracyParams.scenePath, "scene file (.gltf or .glb)")->required();
-    accuracy->add_option("--lights", accuracyParams.lightsPath, "light set JSON (default: the scene's lights)");
-    auto* cameraOption = accuracy->add_option("--camera", accuracyParams.camera, "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
-    accuracy->add_option("--scene-camera", accuracyParams.sceneCamera, "the scene's N-th camera (default 0)")
-        ->excludes(cameraOption);
-    accuracy->add_option("--size", accuracyParams.size, "image size WxH (default 256x256)");
+    addSceneOption(*accuracy, accuracyParams.scenePath);
+    addLightsOption(*accuracy, accuracyParams.lightsPath);
+    ViewFlags accuracyView;
+    accuracyView.addTo(*accuracy, {.size = "256x256", .sceneCamera = 0});
     accuracy->add_option("--spp", accuracyParams.spp, "reference samples per pixel (default 256)")->check(CLI::PositiveNumber);
     accuracy->add_option("--probe-samples", accuracyParams.probeSamples, "path-traced directions per ideal cache (default 1024)")
         ->check(CLI::PositiveNumber);
@@ -62,8 +71,8 @@ int picbenchMain(int argc, char** argv) {
         "links", "decompose the linked caches' one-bounce error against path-traced radiance");
     LinkErrorParams linkParams;
     BakeOptionFlags linkFlags;
-    links->add_option("--scene", linkParams.scenePath, "scene file (.gltf or .glb)")->required();
-    links->add_option("--lights", linkParams.lightsPath, "light set JSON (default: the scene's lights)");
+    addSceneOption(*links, linkParams.scenePath);
+    addLightsOption(*links, linkParams.lightsPath);
     links->add_option("--caches", linkParams.caches, "caches to examine, spread over all (default 400)")
         ->check(CLI::PositiveNumber);
     links->add_option("--directions", linkParams.directions, "path-traced directions per cache (default 1024)")
@@ -75,8 +84,8 @@ int picbenchMain(int argc, char** argv) {
     CLI::App* runtime = app.add_subcommand(
         "runtime", "GPU backend against the CPU twin: ms per pass and update, link bandwidth, memory");
     RuntimeBenchmarkParams runtimeParams;
-    runtime->add_option("--scene", runtimeParams.scenePath, "scene file (.gltf or .glb)")->required();
-    runtime->add_option("--lights", runtimeParams.lightsPath, "light set JSON (default: the scene's lights)");
+    addSceneOption(*runtime, runtimeParams.scenePath);
+    addLightsOption(*runtime, runtimeParams.lightsPath);
     runtime->add_option("--settings", runtimeParams.settings, "paper 000 Table 2 settings (default: moderate high)")
         ->check(CLI::IsMember({"moderate", "high"}));
     runtime->add_option("--link-modes", runtimeParams.linkModes, "link forms (default: rtp sh)")
@@ -85,7 +94,7 @@ int picbenchMain(int argc, char** argv) {
                         "bounces per update, −1 = progressive (default: 1 -1)");
     runtime->add_option("--repeat", runtimeParams.repeat, "timed updates per backend (default 5)")
         ->check(CLI::Range(1, 1000));
-    runtime->add_option("--device", runtimeParams.device, "Vulkan device name substring");
+    addDeviceOption(*runtime, runtimeParams.device);
     runtime->add_option("--shadow-map-size", runtimeParams.shadowMapSize, "texels per shadow-map side (default 1024)")
         ->check(CLI::Range(16u, 16384u));
     runtime->add_option_function<std::string>(
@@ -112,10 +121,9 @@ int picbenchMain(int argc, char** argv) {
     CLI::App* shadows = app.add_subcommand(
         "shadows", "shadow-map size against time and direct-light error (GPU against the CPU twin's rays)");
     ShadowBenchmarkParams shadowParams;
-    shadows->add_option("--scene", shadowParams.scenePath, "scene file (.gltf or .glb)")->required();
-    shadows->add_option("--lights", shadowParams.lightsPath, "light set JSON (default: the scene's lights)");
-    shadows->add_option("--setting", shadowParams.setting, "paper 000 Table 2 setting (default: moderate)")
-        ->check(CLI::IsMember({"moderate", "high"}));
+    addSceneOption(*shadows, shadowParams.scenePath);
+    addLightsOption(*shadows, shadowParams.lightsPath);
+    addSettingOption(*shadows, shadowParams.setting);
     shadows->add_option("--sizes", shadowParams.sizes, "texels per shadow-map side (default: 256 512 1024 2048)")
         ->check(CLI::Range(16u, 16384u));
     shadows->add_option("--sides", shadowParams.sides,
@@ -123,16 +131,15 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::IsMember({"uniform", "footprint"}));
     shadows->add_option("--repeat", shadowParams.repeat, "timed light changes per size (default 5)")
         ->check(CLI::Range(1, 1000));
-    shadows->add_option("--device", shadowParams.device, "Vulkan device name substring");
+    addDeviceOption(*shadows, shadowParams.device);
     shadows->add_option("--json", shadowParams.jsonPath, "JSON file (default shadow_benchmark.json)");
 
     CLI::App* codec = app.add_subcommand(
         "codec", "stream frame sizes (key and delta, bits per SH coefficient) and codec ms under light changes");
     CodecBenchmarkParams codecParams;
-    codec->add_option("--scene", codecParams.scenePath, "scene file (.gltf or .glb)")->required();
-    codec->add_option("--lights", codecParams.lightsPath, "light set JSON (default: the scene's lights)");
-    codec->add_option("--setting", codecParams.setting, "paper 000 Table 2 setting (default: moderate)")
-        ->check(CLI::IsMember({"moderate", "high"}));
+    addSceneOption(*codec, codecParams.scenePath);
+    addLightsOption(*codec, codecParams.lightsPath);
+    addSettingOption(*codec, codecParams.setting);
     codec->add_option("--link-mode", codecParams.linkMode, "link form (default: rtp)")
         ->check(CLI::IsMember({"rtp", "sh"}));
     codec->add_option("--backend", codecParams.backend, "runtime backend (default: cpu)")
@@ -152,9 +159,8 @@ int picbenchMain(int argc, char** argv) {
         "stream", "the server under load: light-change latency to N subscribers, server CPU per "
                   "update, bytes per key and delta frame");
     StreamBenchmarkParams streamParams;
-    stream->add_option("--scene", streamParams.scenePath, "scene file (.gltf or .glb)")->required();
-    stream->add_option("--setting", streamParams.setting, "paper 000 Table 2 setting (default: moderate)")
-        ->check(CLI::IsMember({"moderate", "high"}));
+    addSceneOption(*stream, streamParams.scenePath);
+    addSettingOption(*stream, streamParams.setting);
     stream->add_option("--link-mode", streamParams.linkMode, "link form (default: rtp)")
         ->check(CLI::IsMember({"rtp", "sh"}));
     stream->add_option("--backend", streamParams.backend, "server backend (default: gpu)")
@@ -170,17 +176,11 @@ int picbenchMain(int argc, char** argv) {
     stream->add_option("--picserver", streamParams.picserver, "picserver binary (default: the build tree's)");
     stream->add_option("--json", streamParams.jsonPath, "JSON file (default stream_benchmark.json)");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
-    setWorkerCount(threads);
-    Progress::setEnabled(!quiet);
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (accuracy->parsed()) {
+        auto view = accuracyView.toView();
+        if (!view) return reportError(view.error());
+        accuracyParams.view = *view;
         accuracyParams.bake = accuracyFlags.toOptions();
         return runAccuracyBenchmark(accuracyParams);
     }

@@ -15,7 +15,7 @@
 
 #include "client/connection.h"
 #include "client/load_test.h"
-#include "core/camera.h"
+#include "core/cli.h"
 #include "core/image.h"
 #include "proto/wire.h"
 #include "render/renderer.h"
@@ -26,10 +26,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picclient: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
+int reportError(const Error& error) { return pic::reportError("picclient", error); }
 
 /// Assigns the value of a Result or returns the process exit code of its error.
 #define PIC_TRY_ASSIGN_OR_EXIT(lhs, expr)                              \
@@ -194,9 +191,7 @@ int runLoad(const Common& common, const LoadOptions& options, const std::string&
 
 struct RenderCommand {
     std::string lightsPath;
-    std::string cameraText;
-    int sceneCameraIndex = -1;
-    std::string sizeText;
+    ViewFlags view;
     std::string component = "full";
     std::string outPath;
     float exposure = 1.0f;
@@ -219,8 +214,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     const auto since = [](Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
     };
-    auto size = parseImageSize(command.sizeText);
-    if (!size) return reportError(size.error());
+    auto view = command.view.toView();
+    if (!view) return reportError(view.error());
     std::optional<LightSet> pushed;
     if (!command.lightsPath.empty()) {
         auto lights = readLightSet(command.lightsPath);
@@ -236,16 +231,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!client) return reportError(client.error());
     const double sceneMs = since(sceneStart);
 
-    Camera camera;
-    if (!command.cameraText.empty()) {
-        auto parsed = parseCamera(command.cameraText);
-        if (!parsed) return reportError(parsed.error());
-        camera = *parsed;
-    } else {
-        auto fromScene = sceneCamera(client->scene, command.sceneCameraIndex);
-        if (!fromScene) return reportError(fromScene.error());
-        camera = *fromScene;
-    }
+    auto camera = view->cameraIn(client->scene);
+    if (!camera) return reportError(camera.error());
 
     // Subscribe first, then push: the wait below measures the light change to the frame.
     auto stream = connection->subscribe(common.session, common.token);
@@ -318,13 +305,13 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!renderer) return reportError(renderer.error());
     if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
     ShadeParams params;
-    params.width = size->x;
-    params.height = size->y;
+    params.width = view->size.x;
+    params.height = view->size.y;
     params.component = toComponent(command.component);
     params.glossyExponent = command.glossyExponent;
     params.glossyWeight = command.glossyWeight;
     RenderTimings timings;
-    auto image = (*renderer)->render(lights, camera, params, &timings);
+    auto image = (*renderer)->render(lights, *camera, params, &timings);
     if (!image) return reportError(image.error());
     if (auto written = writeImage(command.outPath, *image, command.exposure); !written)
         return reportError(written.error());
@@ -337,7 +324,7 @@ int runRender(const Common& common, const RenderCommand& command) {
                  "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
                  "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
                  downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
-                 serverMs, bytes, decodeMs, texturesMs, size->x, size->y, command.component.c_str(),
+                 serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y, command.component.c_str(),
                  (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
                  command.outPath.c_str());
     std::printf("%s\n", command.outPath.c_str());
@@ -409,18 +396,13 @@ int picclientMain(int argc, char** argv) {
     addSession(*renderCommand, common);
     renderCommand->add_option("--lights", render.lightsPath,
                               "light set JSON to push first (needs the editor token)");
-    auto* cameraOption = renderCommand->add_option("--camera", render.cameraText,
-                                                   "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
-    auto* sceneCameraOption = renderCommand->add_option("--scene-camera", render.sceneCameraIndex,
-                                                        "the glTF's N-th camera (0-based)");
-    cameraOption->excludes(sceneCameraOption);
-    renderCommand->add_option("--size", render.sizeText, "image size WxH")->required();
+    render.view.addTo(*renderCommand);
     renderCommand->add_option("--component", render.component, "what the image holds")
         ->check(CLI::IsMember({"full", "direct", "indirect"}));
     renderCommand->add_option("--out", render.outPath, "image to write (.exr linear, .png sRGB)")
         ->required();
     renderCommand->add_option("--exposure", render.exposure, "factor applied before PNG quantisation");
-    renderCommand->add_option("--device", render.device, "Vulkan device whose name contains this");
+    addDeviceOption(*renderCommand, render.device);
     renderCommand->add_option("--shadow-map-size", render.shadowMapSize,
                               "texels per side of each shadow-map layer")
         ->check(CLI::Range(16u, 16384u));
@@ -436,26 +418,15 @@ int picclientMain(int argc, char** argv) {
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);
 
-    try {
-        app.parse(argc, argv);
-        if (renderCommand->parsed() && cameraOption->count() == 0 && sceneCameraOption->count() == 0)
-            throw CLI::RequiredError("--camera or --scene-camera");
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (session->parsed()) return runSession(common, bakeId);
     if (lights->parsed()) return runLights(common, lightsPath);
     if (watch->parsed()) return runWatch(common, count, watchSeconds);
     if (renderCommand->parsed()) return runRender(common, render);
     if (statsCommand->parsed()) return runStats(common);
     if (loadCommand->parsed()) {
-        if (load.session.empty() != load.editorToken.empty()) {
-            std::fprintf(stderr, "picclient: error: --session and --token go together\n");
-            return 2;
-        }
+        if (load.session.empty() != load.editorToken.empty())
+            return reportError({ErrorCode::InvalidInput, "--session and --token go together"});
         return runLoad(common, load, reportPath);
     }
     return 2;

@@ -17,8 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "core/parallel.h"
-#include "core/progress.h"
+#include "core/cli.h"
 #include "server/service.h"
 
 namespace pic {
@@ -27,10 +26,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picserver: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
+int reportError(const Error& error) { return pic::reportError("picserver", error); }
 
 Result<std::string> readTextFile(const std::string& path) {
     std::ifstream file(path, std::ios::binary);
@@ -70,8 +66,6 @@ int picserverMain(int argc, char** argv) {
     std::string listen = "127.0.0.1:50051";
     ServeOptions serve;
     ServerOptions options;
-    int threads = 0;
-    bool quiet = false;
     app.add_option("--bake", bakePaths, "bake file (.pic); repeat with --scene for several bakes")
         ->required();
     app.add_option("--scene", scenePaths, "the scene each --bake was made from, in order")
@@ -79,9 +73,7 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--listen", listen, "HOST:PORT to serve on; port 0 picks a free one");
     app.add_option("--backend", serve.backend, "runtime backend (cpu: the CPU twin)")
         ->check(CLI::IsMember({"cpu", "gpu"}));
-    app.add_option("--device", serve.device,
-                   "gpu backend: Vulkan device whose name contains this (default: a discrete "
-                   "GPU, else integrated, else lavapipe)");
+    addDeviceOption(app, serve.device);
     app.add_option("--shadow-map-size", serve.shadowMapSize,
                    "gpu backend: texels per side of each shadow-map layer")
         ->check(CLI::Range(16u, 8192u));
@@ -114,8 +106,6 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--session-idle-minutes", idleMinutes,
                    "remove a session without subscribers after this long unused")
         ->check(CLI::PositiveNumber);
-    app.add_option("--threads", threads, "worker threads of the CPU passes (0 = all cores)")
-        ->check(CLI::NonNegativeNumber);
     std::string tlsCert;
     std::string tlsKey;
     auto* certOption = app.add_option("--tls-cert", tlsCert, "serve TLS with this certificate chain (PEM file)")
@@ -124,20 +114,12 @@ int picserverMain(int argc, char** argv) {
                           ->check(CLI::ExistingFile);
     certOption->needs(keyOption);
     keyOption->needs(certOption);
-    app.add_flag("--quiet", quiet, "no progress bars");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
-    if (bakePaths.size() != scenePaths.size()) {
-        std::fprintf(stderr, "picserver: error: %zu --bake but %zu --scene; give one scene per bake\n",
-                     bakePaths.size(), scenePaths.size());
-        return 2;
-    }
+    addGlobalFlags(app);
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
+    if (bakePaths.size() != scenePaths.size())
+        return reportError({ErrorCode::InvalidInput,
+                            fmt::format("{} --bake but {} --scene; give one scene per bake",
+                                        bakePaths.size(), scenePaths.size())});
     // SIGINT and SIGTERM go to one thread, never to whichever thread gRPC, TBB or Vulkan runs:
     // before the server is up they end the process at once, after it they shut it down.
     sigset_t stopSignals;
@@ -157,9 +139,6 @@ int picserverMain(int argc, char** argv) {
         stopped.set_value(signal);
     });
     signalThread.detach();
-
-    setWorkerCount(threads);
-    Progress::setEnabled(!quiet);
 
     std::vector<std::unique_ptr<ServedBake>> bakes;
     for (size_t i = 0; i < bakePaths.size(); ++i) {

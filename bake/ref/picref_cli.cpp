@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,12 +15,11 @@
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
 #include "core/bake_file.h"
-#include "core/camera.h"
+#include "core/cli.h"
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/parallel.h"
-#include "core/progress.h"
 #include "rays/embree_scene.h"
 
 namespace pic {
@@ -31,9 +29,16 @@ namespace {
 using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picref: error: %s\n", error.message.c_str());
-    return exitCode(error);
+int reportError(const Error& error) { return pic::reportError("picref", error); }
+
+/// Says how many path samples were NaN, infinite or negative and counted as zero, if any.
+void warnAboutRejectedSamples(const PathTraceStats& stats) {
+    if (stats.rejected)
+        std::fprintf(stderr,
+                     "picref: warning: %llu of %llu samples were NaN, infinite or negative "
+                     "and counted as zero\n",
+                     static_cast<unsigned long long>(stats.rejected),
+                     static_cast<unsigned long long>(stats.samples));
 }
 
 /// InvalidInput unless `path` has one of `extensions` and its directory exists, so that a
@@ -71,9 +76,7 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& byt
 /// The flags of `picref SCENE …`.
 struct RenderArgs {
     std::string scenePath;
-    std::string cameraText;
-    std::optional<int> sceneCamera;
-    std::string sizeText;
+    View view;
     uint32_t spp = 0;
     int bounces = -1;
     std::string component = "full";
@@ -84,8 +87,6 @@ struct RenderArgs {
 };
 
 int runRender(const RenderArgs& args) {
-    auto size = parseImageSize(args.sizeText);
-    if (!size) return reportError(size.error());
     if (args.spp == 0)
         return reportError({ErrorCode::InvalidInput, "--spp must be at least 1, got 0"});
     if (args.bounces < -1)
@@ -99,31 +100,19 @@ int runRender(const RenderArgs& args) {
     if (auto ok = checkOutputPath(args.outPath, {".exr", ".png", ".hdr", ".tif", ".tiff"}, "--out");
         !ok)
         return reportError(ok.error());
-    std::optional<Camera> commandLineCamera;
-    if (!args.cameraText.empty()) {
-        auto camera = parseCamera(args.cameraText);
-        if (!camera) return reportError(camera.error());
-        commandLineCamera = *camera;
-    }
 
     auto scene = loadScene(args.scenePath);
     if (!scene) return reportError(scene.error());
-    Camera camera;
-    if (commandLineCamera) {
-        camera = *commandLineCamera;
-    } else {
-        auto fromScene = sceneCamera(*scene, *args.sceneCamera);
-        if (!fromScene) return reportError(fromScene.error());
-        camera = *fromScene;
-    }
+    auto camera = args.view.cameraIn(*scene);
+    if (!camera) return reportError(camera.error());
     auto lights = loadLightSet(args.lightsPath, *scene);
     if (!lights) return reportError(lights.error());
     auto rays = EmbreeScene::create(*scene);
     if (!rays) return reportError(rays.error());
 
     PathTraceParams params;
-    params.width = size->x;
-    params.height = size->y;
+    params.width = args.view.size.x;
+    params.height = args.view.size.y;
     params.spp = args.spp;
     params.bounces = args.bounces;
     params.component = args.component == "direct"     ? PathTraceParams::Component::Direct
@@ -131,7 +120,7 @@ int runRender(const RenderArgs& args) {
                                                       : PathTraceParams::Component::Full;
     params.seed = args.seed;
     PathTraceStats stats;
-    auto image = pathTrace(*scene, **rays, *lights, camera, params, &stats);
+    auto image = pathTrace(*scene, **rays, *lights, *camera, params, &stats);
     if (!image) return reportError(image.error());
     if (auto written = writeImage(args.outPath, *image, args.exposure); !written)
         return reportError(written.error());
@@ -142,12 +131,7 @@ int runRender(const RenderArgs& args) {
         params.width, params.height, params.spp, args.component.c_str(), params.bounces,
         stats.seconds, double(stats.samples) / stats.seconds / 1e6, workerCount(),
         args.outPath.c_str());
-    if (stats.rejected)
-        std::fprintf(stderr,
-                     "picref: warning: %llu of %llu samples were NaN, infinite or negative "
-                     "and counted as zero\n",
-                     static_cast<unsigned long long>(stats.rejected),
-                     static_cast<unsigned long long>(stats.samples));
+    warnAboutRejectedSamples(stats);
     return 0;
 }
 
@@ -243,12 +227,7 @@ int runProbes(const ProbeArgs& args) {
         bake->caches.size(), args.params.samples, stats.seconds,
         double(stats.samples) / std::max(stats.seconds, 1e-9) / 1e6, workerCount(),
         args.outPath.c_str());
-    if (stats.rejected)
-        std::fprintf(stderr,
-                     "picref: warning: %llu of %llu samples were NaN, infinite or negative "
-                     "and counted as zero\n",
-                     static_cast<unsigned long long>(stats.rejected),
-                     static_cast<unsigned long long>(stats.samples));
+    warnAboutRejectedSamples(stats);
     return 0;
 }
 
@@ -259,36 +238,28 @@ int picrefMain(int argc, char** argv) {
         "picref: path-traced reference images (picref SCENE …) and ideal caches "
         "(picref probes BAKE.pic …)"};
     app.require_subcommand(0, 1);
-    app.fallthrough();  // global flags may follow the subcommand
-    int threads = 0;
-    bool quiet = false;
-    app.add_option("--threads", threads, "worker threads (0 = all cores)")
-        ->check(CLI::NonNegativeNumber);
-    app.add_flag("--quiet", quiet, "no progress bars");
+    addGlobalFlags(app);
 
     RenderArgs render;
-    int sceneCameraIndex = 0;
+    CLI::Option* sceneOption = app.add_option("scene", render.scenePath, "scene file (.gltf or .glb)");
+    ViewFlags viewFlags;
+    viewFlags.addTo(app);
     std::vector<CLI::Option*> renderOnly = {
-        app.add_option("scene", render.scenePath, "scene file (.gltf or .glb)"),
-        app.add_option("--camera", render.cameraText,
-                       "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy (fovy in degrees)"),
-        app.add_option("--scene-camera", sceneCameraIndex, "use the glTF's N-th camera (0-based)"),
-        app.add_option("--size", render.sizeText, "image size WxH"),
+        sceneOption,
+        app.get_option("--camera"),
+        app.get_option("--scene-camera"),
+        app.get_option("--size"),
         app.add_option("--spp", render.spp, "samples per pixel"),
         app.add_option("--bounces", render.bounces,
                        "indirect bounces B: 0 = direct light only, -1 = unlimited (default)"),
         app.add_option("--component", render.component, "full (default), direct or indirect")
             ->check(CLI::IsMember({"full", "direct", "indirect"})),
-        app.add_option("--lights", render.lightsPath,
-                       "light set JSON (default: the glTF's lights)"),
+        addLightsOption(app, render.lightsPath),
         app.add_option("--seed", render.seed, "random seed (default 1)"),
         app.add_option("--exposure", render.exposure,
                        "scale applied before PNG encoding (default 1)"),
         app.add_option("--out", render.outPath, "image to write (.exr linear float, .png sRGB)"),
     };
-    CLI::Option* cameraOption = renderOnly[1];
-    CLI::Option* sceneCameraOption = renderOnly[2];
-    cameraOption->excludes(sceneCameraOption);
 
     CLI::App* probesCommand =
         app.add_subcommand("probes", "path-traced incident radiance SH at every cache of a bake");
@@ -296,8 +267,7 @@ int picrefMain(int argc, char** argv) {
     probesCommand->add_option("bake", probes.bakePath, "bake file (.pic)")->required();
     probesCommand->add_option("--scene", probes.scenePath, "the scene the bake was made from")
         ->required();
-    probesCommand->add_option("--lights", probes.lightsPath,
-                              "light set JSON (default: the glTF's lights)");
+    addLightsOption(*probesCommand, probes.lightsPath);
     probesCommand->add_option("--samples", probes.params.samples,
                               "directions per cache (default 1024)");
     probesCommand->add_option(
@@ -311,19 +281,7 @@ int picrefMain(int argc, char** argv) {
     probesCommand->add_option("--binary", probes.binaryPath,
                               "also write the raw float32 arrays y, co, cg");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
-    setWorkerCount(threads);
-    Progress::setEnabled(!quiet);
-
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (probesCommand->parsed()) {
         // Options of the image form that reached the parent are mistakes, not silently ignored.
         for (const CLI::Option* option : renderOnly)
@@ -340,13 +298,12 @@ int picrefMain(int argc, char** argv) {
             {ErrorCode::InvalidInput,
              "missing SCENE: picref SCENE (--camera … | --scene-camera N) --size WxH "
              "--spp N --out FILE, or picref probes / picref shade"});
-    for (const char* name : {"--size", "--spp", "--out"})
+    auto view = viewFlags.toView();
+    if (!view) return reportError(view.error());
+    render.view = *view;
+    for (const char* name : {"--spp", "--out"})
         if (app.get_option(name)->count() == 0)
             return reportError({ErrorCode::InvalidInput, fmt::format("{} is required", name)});
-    if (cameraOption->count() == 0 && sceneCameraOption->count() == 0)
-        return reportError(
-            {ErrorCode::InvalidInput, "one of --camera or --scene-camera is required"});
-    if (sceneCameraOption->count() > 0) render.sceneCamera = sceneCameraIndex;
     return runRender(render);
 }
 

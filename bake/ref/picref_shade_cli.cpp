@@ -4,18 +4,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "core/bake_file.h"
-#include "core/camera.h"
+#include "core/cli.h"
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/parallel.h"
-#include "core/progress.h"
 #include "rays/embree_scene.h"
 #include "render/cpu/cache_shading.h"
 #include "render/cpu_runtime.h"
@@ -30,10 +28,7 @@ double millisecondsSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-int reportError(const Error& error) {
-    std::fprintf(stderr, "picref shade: error: %s\n", error.message.c_str());
-    return exitCode(error);
-}
+int reportError(const Error& error) { return pic::reportError("picref shade", error); }
 
 /// What the command line asked for, before any file is read.
 struct ShadeCommand {
@@ -44,9 +39,7 @@ struct ShadeCommand {
     uint32_t shadowMapSize = 1024;   ///< --shadow-map-size (gpu backend)
     std::string directVisibility = "auto";  ///< --direct-visibility (gpu backend)
     std::string lightsPath;
-    std::string cameraText;
-    int sceneCameraIndex = -1;  ///< used when --camera is not given
-    std::string sizeText;
+    ViewFlags view;
     std::string component = "full";
     int bounces = -1;
     uint32_t spp = 1;
@@ -84,14 +77,8 @@ ShadeComponent toComponent(const std::string& name) {
 /// Loads everything, relights through the CPU runtime, shades and writes the image.
 int runShade(const ShadeCommand& command) {
     if (auto usage = checkUsage(command); !usage) return reportError(usage.error());
-    auto size = parseImageSize(command.sizeText);
-    if (!size) return reportError(size.error());
-    std::optional<Camera> cliCamera;
-    if (!command.cameraText.empty()) {
-        auto parsed = parseCamera(command.cameraText);
-        if (!parsed) return reportError(parsed.error());
-        cliCamera = *parsed;
-    }
+    auto view = command.view.toView();
+    if (!view) return reportError(view.error());
 
     auto scene = loadScene(command.scenePath);
     if (!scene) return reportError(scene.error());
@@ -103,14 +90,8 @@ int runShade(const ShadeCommand& command) {
     auto bake = readBakeFile(command.bakePath);
     if (!bake) return reportError(bake.error());
 
-    Camera camera;
-    if (cliCamera) {
-        camera = *cliCamera;
-    } else {
-        auto fromScene = sceneCamera(*scene, command.sceneCameraIndex);
-        if (!fromScene) return reportError(fromScene.error());
-        camera = *fromScene;
-    }
+    auto camera = view->cameraIn(*scene);
+    if (!camera) return reportError(camera.error());
 
     auto loaded = loadLightSet(command.lightsPath, *scene);
     if (!loaded) return reportError(loaded.error());
@@ -147,14 +128,14 @@ int runShade(const ShadeCommand& command) {
                  (*runtime)->name(), stats.bounces, stats.totalMs, passes.c_str());
 
     ShadeParams params;
-    params.width = size->x;
-    params.height = size->y;
+    params.width = view->size.x;
+    params.height = view->size.y;
     params.component = toComponent(command.component);
     params.glossyExponent = command.glossyExponent;
     params.glossyWeight = command.glossyWeight;
     params.samplesPerPixel = command.spp;
     const auto shadeStart = Clock::now();
-    auto image = shadeFromCaches(*scene, **rays, *bake, **values, lights, camera, params);
+    auto image = shadeFromCaches(*scene, **rays, *bake, **values, lights, *camera, params);
     if (!image) return reportError(image.error());
     const double shadeMs = millisecondsSince(shadeStart);
 
@@ -174,28 +155,19 @@ int picrefShadeMain(int argc, char** argv) {
         "a camera view from its caches on the CPU"};
     app.name("picref shade");
     ShadeCommand command;
-    int threads = 0;
-    bool quiet = false;
     app.add_option("scene", command.scenePath, "scene file (.gltf or .glb)")->required();
     app.add_option("--bake", command.bakePath, "bake file of this scene (.pic)")->required();
     app.add_option("--backend", command.backend, "runtime backend")
         ->check(CLI::IsMember({"cpu", "gpu"}));
-    app.add_option("--device", command.device,
-                   "gpu backend: Vulkan device whose name contains this (default: a discrete "
-                   "GPU, else integrated, else lavapipe)");
+    addDeviceOption(app, command.device);
     app.add_option("--shadow-map-size", command.shadowMapSize,
                    "gpu backend: texels per side of each shadow-map layer (default 1024)");
     app.add_option("--direct-visibility", command.directVisibility,
                    "gpu backend: shadow-maps, rays (traced on the host) or auto (default: rays on "
                    "a CPU device, shadow maps on a GPU)")
         ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
-    app.add_option("--lights", command.lightsPath, "light set JSON (default: the scene's lights)");
-    auto* cameraOption = app.add_option("--camera", command.cameraText,
-                                        "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy");
-    auto* sceneCameraOption = app.add_option("--scene-camera", command.sceneCameraIndex,
-                                             "the glTF's N-th camera (0-based)");
-    cameraOption->excludes(sceneCameraOption);
-    app.add_option("--size", command.sizeText, "image size WxH")->required();
+    addLightsOption(app, command.lightsPath);
+    command.view.addTo(app);
     app.add_option("--component", command.component, "what the image holds")
         ->check(CLI::IsMember({"full", "direct", "indirect"}));
     app.add_option("--bounces", command.bounces,
@@ -211,24 +183,11 @@ int picrefShadeMain(int argc, char** argv) {
                                    ->check(CLI::NonNegativeNumber);
     glossyOption->needs(glossyWeightOption);
     glossyWeightOption->needs(glossyOption);
-    app.add_option("--threads", threads, "worker threads (0 = all cores)")
-        ->check(CLI::NonNegativeNumber);
-    app.add_flag("--quiet", quiet, "no progress bars");
+    addGlobalFlags(app);
     app.add_option("--out", command.outPath, "image to write (.exr linear, .png sRGB)")->required();
     app.add_option("--exposure", command.exposure, "factor applied before PNG quantisation");
 
-    try {
-        app.parse(argc, argv);
-        if (cameraOption->count() == 0 && sceneCameraOption->count() == 0)
-            throw CLI::RequiredError("--camera or --scene-camera");
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return 2;
-    }
-    setWorkerCount(threads);
-    Progress::setEnabled(!quiet);
+    if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     return runShade(command);
 }
 

@@ -1,0 +1,85 @@
+#include "core/cli.h"
+
+#include <cstdio>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+
+namespace pic {
+
+std::optional<int> parseCommandLine(CLI::App& app, int argc, char** argv) {
+    try {
+        app.parse(argc, argv);
+        return std::nullopt;
+    } catch (const CLI::ParseError& e) {
+        // --help ends parsing as an "error" with exit code 0; app.exit prints it on stdout and
+        // every real error on stderr.
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+}
+
+void addGlobalFlags(CLI::App& app) {
+    app.fallthrough();
+    app.add_option_function<int>("--threads", [](const int& threads) { setWorkerCount(threads); },
+                                 "worker threads (0 = all cores)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag_callback("--quiet", [] { Progress::setEnabled(false); }, "no progress bars");
+}
+
+int reportError(std::string_view program, const Error& error) {
+    fmt::print(stderr, "{}: error: {}\n", program, error.message);
+    return exitCode(error);
+}
+
+CLI::Option* addDeviceOption(CLI::App& command, std::string& name) {
+    return command.add_option("--device", name,
+                              "Vulkan device whose name contains this (default: a discrete GPU, "
+                              "else integrated, else lavapipe)");
+}
+
+CLI::Option* addLightsOption(CLI::App& command, std::string& path) {
+    return command.add_option("--lights", path, "light set JSON (default: the scene's lights)");
+}
+
+Result<Camera> View::cameraIn(const Scene& scene) const {
+    if (camera) return *camera;
+    return sceneCamera(scene, sceneCameraIndex);
+}
+
+void ViewFlags::addTo(CLI::App& command, const ViewDefaults& defaults) {
+    mDefaults = defaults;
+    mSizeText = defaults.size;
+    mSceneCamera = defaults.sceneCamera.value_or(0);
+    mCameraOption = command.add_option(
+        "--camera", mCameraText,
+        "pinhole camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy (eye, target, up, vertical field of view "
+        "in degrees)");
+    mSceneCameraOption = command.add_option(
+        "--scene-camera", mSceneCamera,
+        defaults.sceneCamera
+            ? fmt::format("the glTF's N-th camera (0-based; default {})", *defaults.sceneCamera)
+            : std::string("the glTF's N-th camera (0-based)"));
+    mCameraOption->excludes(mSceneCameraOption);
+    mSizeOption = command.add_option("--size", mSizeText,
+                                     defaults.size.empty()
+                                         ? std::string("image size WxH")
+                                         : fmt::format("image size WxH (default {})", defaults.size));
+}
+
+Result<View> ViewFlags::toView() const {
+    if (mSizeOption->count() == 0 && mDefaults.size.empty())
+        return fail(ErrorCode::InvalidInput, "--size is required");
+    View view;
+    PIC_TRY_ASSIGN(view.size, parseImageSize(mSizeText));
+    if (mCameraOption->count() > 0) {
+        PIC_TRY_ASSIGN(view.camera, parseCamera(mCameraText));
+    } else if (mSceneCameraOption->count() == 0 && !mDefaults.sceneCamera) {
+        return fail(ErrorCode::InvalidInput, "one of --camera or --scene-camera is required");
+    }
+    view.sceneCameraIndex = mSceneCamera;
+    return view;
+}
+
+}  // namespace pic

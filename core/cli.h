@@ -1,0 +1,73 @@
+#pragma once
+/// What every command-line front end repeats (ARCHITECTURE.md §5): the CLI11 parse step and
+/// its exit codes, the global flags, error lines, the light-set file and the view of an image
+/// (--camera … | --scene-camera N, --size WxH), spelled and checked the same way everywhere.
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+#include "core/scene.h"
+
+namespace pic {
+
+/// Parses argv into `app`. Returns the exit code when the program should stop: 0 after --help
+/// (printed on stdout), 2 after a usage error (CLI11's message on stderr); std::nullopt after a
+/// successful parse.
+std::optional<int> parseCommandLine(CLI::App& app, int argc, char** argv);
+
+/// Adds --threads N (worker threads, 0 = all cores) and --quiet (no progress bars) to `app`,
+/// applied to the process as they are parsed. Call it before adding subcommands: they fall
+/// through to `app`, so the global flags may also follow a subcommand.
+void addGlobalFlags(CLI::App& app);
+
+/// Prints "PROGRAM: error: MESSAGE" on stderr; returns the error's exit code (1 or 2).
+int reportError(std::string_view program, const Error& error);
+
+/// Adds --device NAME: the Vulkan device whose name contains NAME (empty: a discrete GPU, else
+/// an integrated one, else lavapipe).
+CLI::Option* addDeviceOption(CLI::App& command, std::string& name);
+
+/// Adds --lights FILE (a light set JSON; empty: the scene's own lights, as loadLightSet reads it).
+CLI::Option* addLightsOption(CLI::App& command, std::string& path);
+
+/// The view of an image as the command line gives it.
+struct View {
+    glm::uvec2 size{0};
+    std::optional<Camera> camera;  ///< --camera; empty: the scene's sceneCameraIndex-th camera
+    int sceneCameraIndex = 0;
+
+    /// The camera in `scene`: --camera, else the scene's sceneCameraIndex-th (InvalidInput
+    /// naming the index when the scene has fewer cameras).
+    Result<Camera> cameraIn(const Scene& scene) const;
+};
+
+/// What a view falls back on where the user gives nothing.
+struct ViewDefaults {
+    std::string size;                ///< empty: --size is required
+    std::optional<int> sceneCamera;  ///< empty: --camera or --scene-camera is required
+};
+
+/// --camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy | --scene-camera N (exclusive) and --size WxH.
+class ViewFlags {
+public:
+    /// Adds the three options to `command`.
+    void addTo(CLI::App& command, const ViewDefaults& defaults = {});
+    /// The view after parsing, before any file is read: InvalidInput naming a bad --size or
+    /// --camera text, or a missing flag that has no default.
+    Result<View> toView() const;
+
+private:
+    ViewDefaults mDefaults;
+    std::string mCameraText, mSizeText;
+    int mSceneCamera = 0;
+    CLI::Option* mCameraOption = nullptr;
+    CLI::Option* mSceneCameraOption = nullptr;
+    CLI::Option* mSizeOption = nullptr;
+};
+
+}  // namespace pic
