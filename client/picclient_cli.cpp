@@ -16,7 +16,6 @@
 #include "client/connection.h"
 #include "client/load_test.h"
 #include "core/cli.h"
-#include "core/image.h"
 #include "proto/wire.h"
 #include "render/renderer.h"
 
@@ -192,22 +191,13 @@ int runLoad(const Common& common, const LoadOptions& options, const std::string&
 struct RenderCommand {
     std::string lightsPath;
     ViewFlags view;
-    std::string component = "full";
-    std::string outPath;
-    float exposure = 1.0f;
+    ShadeFlags shade;
+    ImageOutputFlags output;
     std::string device;
     uint32_t shadowMapSize = 1024;
-    float glossyExponent = 0.0f;
-    float glossyWeight = 0.0f;
     std::string cacheDir;
     double waitSeconds = 60;
 };
-
-ShadeComponent toComponent(const std::string& name) {
-    if (name == "direct") return ShadeComponent::Direct;
-    if (name == "indirect") return ShadeComponent::Indirect;
-    return ShadeComponent::Full;
-}
 
 int runRender(const Common& common, const RenderCommand& command) {
     const auto start = Clock::now();
@@ -216,6 +206,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     };
     auto view = command.view.toView();
     if (!view) return reportError(view.error());
+    if (auto output = command.output.check(); !output) return reportError(output.error());
     std::optional<LightSet> pushed;
     if (!command.lightsPath.empty()) {
         auto lights = readLightSet(command.lightsPath);
@@ -304,17 +295,10 @@ int runRender(const Common& common, const RenderCommand& command) {
     auto renderer = Renderer::create(**context, client->scene, clientLayoutOf(*client), rendererOptions);
     if (!renderer) return reportError(renderer.error());
     if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
-    ShadeParams params;
-    params.width = view->size.x;
-    params.height = view->size.y;
-    params.component = toComponent(command.component);
-    params.glossyExponent = command.glossyExponent;
-    params.glossyWeight = command.glossyWeight;
     RenderTimings timings;
-    auto image = (*renderer)->render(lights, *camera, params, &timings);
+    auto image = (*renderer)->render(lights, *camera, command.shade.toParams(view->size), &timings);
     if (!image) return reportError(image.error());
-    if (auto written = writeImage(command.outPath, *image, command.exposure); !written)
-        return reportError(written.error());
+    if (auto written = command.output.write(*image); !written) return reportError(written.error());
 
     std::string passes;
     for (const auto& [pass, ms] : timings.passMs)
@@ -324,10 +308,10 @@ int runRender(const Common& common, const RenderCommand& command) {
                  "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
                  "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
                  downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
-                 serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y, command.component.c_str(),
+                 serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y, command.shade.component().c_str(),
                  (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
-                 command.outPath.c_str());
-    std::printf("%s\n", command.outPath.c_str());
+                 command.output.path().c_str());
+    std::printf("%s\n", command.output.path().c_str());
     return 0;
 }
 
@@ -397,23 +381,12 @@ int picclientMain(int argc, char** argv) {
     renderCommand->add_option("--lights", render.lightsPath,
                               "light set JSON to push first (needs the editor token)");
     render.view.addTo(*renderCommand);
-    renderCommand->add_option("--component", render.component, "what the image holds")
-        ->check(CLI::IsMember({"full", "direct", "indirect"}));
-    renderCommand->add_option("--out", render.outPath, "image to write (.exr linear, .png sRGB)")
-        ->required();
-    renderCommand->add_option("--exposure", render.exposure, "factor applied before PNG quantisation");
+    render.shade.addTo(*renderCommand);
+    render.output.addTo(*renderCommand);
     addDeviceOption(*renderCommand, render.device);
     renderCommand->add_option("--shadow-map-size", render.shadowMapSize,
                               "texels per side of each shadow-map layer")
         ->check(CLI::Range(16u, 16384u));
-    auto* glossyOption = renderCommand->add_option("--glossy", render.glossyExponent,
-                                                   "Phong exponent of an added glossy lobe (> 0)")
-                             ->check(CLI::PositiveNumber);
-    auto* glossyWeightOption = renderCommand->add_option("--glossy-weight", render.glossyWeight,
-                                                         "factor on the glossy lobe (≥ 0)")
-                                   ->check(CLI::NonNegativeNumber);
-    glossyOption->needs(glossyWeightOption);
-    glossyWeightOption->needs(glossyOption);
     renderCommand->add_option("--cache-dir", render.cacheDir, "where downloaded scenes are kept");
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);

@@ -1,6 +1,10 @@
 #include "core/cli.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "core/camera.h"
 #include "core/image.h"
@@ -80,6 +84,68 @@ Result<View> ViewFlags::toView() const {
     }
     view.sceneCameraIndex = mSceneCamera;
     return view;
+}
+
+Result<void> checkOutputPath(const std::string& path,
+                             std::initializer_list<std::string_view> extensions,
+                             std::string_view option) {
+    namespace fs = std::filesystem;
+    std::string extension = fs::path(path).extension().string();
+    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (std::find(extensions.begin(), extensions.end(), extension) == extensions.end())
+        return fail(ErrorCode::InvalidInput, "{} '{}' has extension '{}'; expected one of {}",
+                    option, path, extension, fmt::join(extensions, ", "));
+    const fs::path directory = fs::path(path).parent_path();
+    std::error_code ec;
+    if (!directory.empty() && !fs::is_directory(directory, ec))
+        return fail(ErrorCode::InvalidInput, "{} '{}': directory '{}' does not exist", option, path,
+                    directory.string());
+    return {};
+}
+
+void ImageOutputFlags::addTo(CLI::App& command, bool required) {
+    command.add_option("--out", mPath, "image to write (.exr linear float, .png sRGB, .hdr, .tif)")
+        ->required(required);
+    command.add_option("--exposure", mExposure, "factor applied before PNG quantisation (default 1)");
+}
+
+Result<void> ImageOutputFlags::check() const {
+    if (mPath.empty()) return fail(ErrorCode::InvalidInput, "--out is required");
+    PIC_TRY(checkOutputPath(mPath, {".exr", ".png", ".hdr", ".tif", ".tiff"}, "--out"));
+    if (!(std::isfinite(mExposure) && mExposure > 0.0f))
+        return fail(ErrorCode::InvalidInput, "--exposure {} must be a finite number > 0",
+                    mExposure);
+    return {};
+}
+
+Result<void> ImageOutputFlags::write(const Image& image) const {
+    return writeImage(mPath, image, mExposure);
+}
+
+void ShadeFlags::addTo(CLI::App& command) {
+    command.add_option("--component", mComponent, "what the image holds (default full)")
+        ->check(CLI::IsMember({"full", "direct", "indirect"}));
+    auto* glossy = command.add_option("--glossy", mGlossyExponent,
+                                      "Phong exponent of an added glossy lobe (> 0)")
+                       ->check(CLI::PositiveNumber);
+    auto* glossyWeight = command.add_option("--glossy-weight", mGlossyWeight,
+                                            "factor on the glossy lobe's radiance (≥ 0)")
+                             ->check(CLI::NonNegativeNumber);
+    glossy->needs(glossyWeight);
+    glossyWeight->needs(glossy);
+}
+
+ShadeParams ShadeFlags::toParams(glm::uvec2 size, uint32_t samplesPerPixel) const {
+    ShadeParams params;
+    params.width = size.x;
+    params.height = size.y;
+    params.component = mComponent == "direct"     ? ShadeComponent::Direct
+                       : mComponent == "indirect" ? ShadeComponent::Indirect
+                                                  : ShadeComponent::Full;
+    params.glossyExponent = mGlossyExponent;
+    params.glossyWeight = mGlossyWeight;
+    params.samplesPerPixel = samplesPerPixel;
+    return params;
 }
 
 }  // namespace pic

@@ -3,6 +3,7 @@
 /// its exit codes, the global flags, error lines, the light-set file and the view of an image
 /// (--camera … | --scene-camera N, --size WxH), spelled and checked the same way everywhere.
 
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -11,7 +12,9 @@
 #include <glm/glm.hpp>
 
 #include "core/error.h"
+#include "core/image.h"
 #include "core/scene.h"
+#include "core/shade_params.h"
 
 namespace pic {
 
@@ -68,6 +71,48 @@ private:
     CLI::Option* mCameraOption = nullptr;
     CLI::Option* mSceneCameraOption = nullptr;
     CLI::Option* mSizeOption = nullptr;
+};
+
+/// InvalidInput naming `option` unless `path` ends in one of `extensions` (".exr"; any case)
+/// and its directory exists, so that a long run never ends in an unwritable output.
+Result<void> checkOutputPath(const std::string& path,
+                             std::initializer_list<std::string_view> extensions,
+                             std::string_view option);
+
+/// --out FILE (.exr linear float, .png sRGB, .hdr, .tif) and --exposure X (a factor applied
+/// before PNG quantisation): where an image goes.
+class ImageOutputFlags {
+public:
+    /// Adds the two options to `command`; --out marked required unless `required` is false
+    /// (then check() asks for it).
+    void addTo(CLI::App& command, bool required = true);
+    /// InvalidInput naming a missing or unwritable --out or an --exposure that is not a finite
+    /// number > 0; call it before any long work.
+    Result<void> check() const;
+    /// Writes `image` to --out with --exposure.
+    Result<void> write(const Image& image) const;
+    const std::string& path() const { return mPath; }
+
+private:
+    std::string mPath;
+    float mExposure = 1.0f;
+};
+
+/// --component full|direct|indirect, --glossy N and --glossy-weight W (each needs the other):
+/// what a view is shaded with (core/shade_params.h).
+class ShadeFlags {
+public:
+    /// Adds the three options to `command`.
+    void addTo(CLI::App& command);
+    /// The parameters for an image of `size` with `samplesPerPixel` subsamples.
+    ShadeParams toParams(glm::uvec2 size, uint32_t samplesPerPixel = 1) const;
+    /// --component as given: "full", "direct" or "indirect".
+    const std::string& component() const { return mComponent; }
+
+private:
+    std::string mComponent = "full";
+    float mGlossyExponent = 0.0f;
+    float mGlossyWeight = 0.0f;
 };
 
 }  // namespace pic

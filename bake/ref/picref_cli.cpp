@@ -1,8 +1,6 @@
 #include "bake/ref/picref_cli.h"
 
 #include <algorithm>
-#include <cctype>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,23 +39,6 @@ void warnAboutRejectedSamples(const PathTraceStats& stats) {
                      static_cast<unsigned long long>(stats.samples));
 }
 
-/// InvalidInput unless `path` has one of `extensions` and its directory exists, so that a
-/// long run never ends in an unwritable output.
-Result<void> checkOutputPath(const std::string& path, const std::vector<std::string>& extensions,
-                             const char* option) {
-    std::string extension = fs::path(path).extension().string();
-    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (std::find(extensions.begin(), extensions.end(), extension) == extensions.end())
-        return fail(ErrorCode::InvalidInput, "{} '{}' has extension '{}'; expected one of {}",
-                    option, path, extension, fmt::join(extensions, ", "));
-    fs::path directory = fs::path(path).parent_path();
-    std::error_code ec;
-    if (!directory.empty() && !fs::is_directory(directory, ec))
-        return fail(ErrorCode::InvalidInput, "{} '{}': directory '{}' does not exist", option, path,
-                    directory.string());
-    return {};
-}
-
 /// Writes `bytes` to `path` through a temporary file and a rename.
 Result<void> writeFileAtomically(const std::string& path, const std::string& bytes) {
     std::string temporary = path + ".tmp";
@@ -82,8 +63,7 @@ struct RenderArgs {
     std::string component = "full";
     std::string lightsPath;
     uint64_t seed = 1;
-    float exposure = 1.0f;
-    std::string outPath;
+    ImageOutputFlags output;
 };
 
 int runRender(const RenderArgs& args) {
@@ -93,13 +73,7 @@ int runRender(const RenderArgs& args) {
         return reportError(
             {ErrorCode::InvalidInput,
              fmt::format("--bounces must be -1 (unlimited) or >= 0, got {}", args.bounces)});
-    if (!(args.exposure > 0.0f) || !std::isfinite(args.exposure))
-        return reportError(
-            {ErrorCode::InvalidInput,
-             fmt::format("--exposure must be a positive number, got {}", args.exposure)});
-    if (auto ok = checkOutputPath(args.outPath, {".exr", ".png", ".hdr", ".tif", ".tiff"}, "--out");
-        !ok)
-        return reportError(ok.error());
+    if (auto output = args.output.check(); !output) return reportError(output.error());
 
     auto scene = loadScene(args.scenePath);
     if (!scene) return reportError(scene.error());
@@ -122,15 +96,14 @@ int runRender(const RenderArgs& args) {
     PathTraceStats stats;
     auto image = pathTrace(*scene, **rays, *lights, *camera, params, &stats);
     if (!image) return reportError(image.error());
-    if (auto written = writeImage(args.outPath, *image, args.exposure); !written)
-        return reportError(written.error());
+    if (auto written = args.output.write(*image); !written) return reportError(written.error());
 
     std::fprintf(
         stderr,
         "picref: %ux%u, %u spp, %s, bounces %d: %.3f s, %.3f M samples/s on %d threads -> %s\n",
         params.width, params.height, params.spp, args.component.c_str(), params.bounces,
         stats.seconds, double(stats.samples) / stats.seconds / 1e6, workerCount(),
-        args.outPath.c_str());
+        args.output.path().c_str());
     warnAboutRejectedSamples(stats);
     return 0;
 }
@@ -244,6 +217,7 @@ int picrefMain(int argc, char** argv) {
     CLI::Option* sceneOption = app.add_option("scene", render.scenePath, "scene file (.gltf or .glb)");
     ViewFlags viewFlags;
     viewFlags.addTo(app);
+    render.output.addTo(app, false);
     std::vector<CLI::Option*> renderOnly = {
         sceneOption,
         app.get_option("--camera"),
@@ -256,9 +230,8 @@ int picrefMain(int argc, char** argv) {
             ->check(CLI::IsMember({"full", "direct", "indirect"})),
         addLightsOption(app, render.lightsPath),
         app.add_option("--seed", render.seed, "random seed (default 1)"),
-        app.add_option("--exposure", render.exposure,
-                       "scale applied before PNG encoding (default 1)"),
-        app.add_option("--out", render.outPath, "image to write (.exr linear float, .png sRGB)"),
+        app.get_option("--exposure"),
+        app.get_option("--out"),
     };
 
     CLI::App* probesCommand =
@@ -301,9 +274,8 @@ int picrefMain(int argc, char** argv) {
     auto view = viewFlags.toView();
     if (!view) return reportError(view.error());
     render.view = *view;
-    for (const char* name : {"--spp", "--out"})
-        if (app.get_option(name)->count() == 0)
-            return reportError({ErrorCode::InvalidInput, fmt::format("{} is required", name)});
+    if (app.get_option("--spp")->count() == 0)
+        return reportError({ErrorCode::InvalidInput, "--spp is required"});
     return runRender(render);
 }
 

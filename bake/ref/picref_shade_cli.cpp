@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -40,13 +39,10 @@ struct ShadeCommand {
     std::string directVisibility = "auto";  ///< --direct-visibility (gpu backend)
     std::string lightsPath;
     ViewFlags view;
-    std::string component = "full";
+    ShadeFlags shade;
     int bounces = -1;
     uint32_t spp = 1;
-    float glossyExponent = 0.0f;
-    float glossyWeight = 0.0f;
-    std::string outPath;
-    float exposure = 1.0f;
+    ImageOutputFlags output;
 };
 
 /// Checks what can be checked without reading files, so that usage errors come first.
@@ -57,24 +53,10 @@ Result<void> checkUsage(const ShadeCommand& command) {
     if (command.bounces < -1)
         return fail(ErrorCode::InvalidInput, "--bounces {} must be ≥ 0 (or −1: until converged)",
                     command.bounces);
-    const std::string extension = std::filesystem::path(command.outPath).extension().string();
-    if (extension != ".exr" && extension != ".png" && extension != ".hdr" && extension != ".tif")
-        return fail(ErrorCode::InvalidInput,
-                    "--out {} must end in .exr (linear) or .png (sRGB), or .hdr or .tif",
-                    command.outPath);
-    if (!(std::isfinite(command.exposure) && command.exposure > 0.0f))
-        return fail(ErrorCode::InvalidInput, "--exposure {} must be a finite number > 0",
-                    command.exposure);
-    return {};
+    return command.output.check();
 }
 
-ShadeComponent toComponent(const std::string& name) {
-    if (name == "direct") return ShadeComponent::Direct;
-    if (name == "indirect") return ShadeComponent::Indirect;
-    return ShadeComponent::Full;
-}
-
-/// Loads everything, relights through the CPU runtime, shades and writes the image.
+/// Loads everything, relights on the chosen backend, shades on the CPU and writes the image.
 int runShade(const ShadeCommand& command) {
     if (auto usage = checkUsage(command); !usage) return reportError(usage.error());
     auto view = command.view.toView();
@@ -127,23 +109,16 @@ int runShade(const ShadeCommand& command) {
     std::fprintf(stderr, "picref shade: update on %s: %d bounces, %.1f ms (ms per pass: %s)\n",
                  (*runtime)->name(), stats.bounces, stats.totalMs, passes.c_str());
 
-    ShadeParams params;
-    params.width = view->size.x;
-    params.height = view->size.y;
-    params.component = toComponent(command.component);
-    params.glossyExponent = command.glossyExponent;
-    params.glossyWeight = command.glossyWeight;
-    params.samplesPerPixel = command.spp;
+    const ShadeParams params = command.shade.toParams(view->size, command.spp);
     const auto shadeStart = Clock::now();
     auto image = shadeFromCaches(*scene, **rays, *bake, **values, lights, *camera, params);
     if (!image) return reportError(image.error());
     const double shadeMs = millisecondsSince(shadeStart);
 
-    if (auto written = writeImage(command.outPath, *image, command.exposure); !written)
-        return reportError(written.error());
+    if (auto written = command.output.write(*image); !written) return reportError(written.error());
     std::fprintf(stderr, "picref shade: shading %ux%u, %u spp, %s: %.1f ms on %d threads -> %s\n",
-                 params.width, params.height, params.samplesPerPixel, command.component.c_str(),
-                 shadeMs, workerCount(), command.outPath.c_str());
+                 params.width, params.height, params.samplesPerPixel, command.shade.component().c_str(),
+                 shadeMs, workerCount(), command.output.path().c_str());
     return 0;
 }
 
@@ -168,24 +143,14 @@ int picrefShadeMain(int argc, char** argv) {
         ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
     addLightsOption(app, command.lightsPath);
     command.view.addTo(app);
-    app.add_option("--component", command.component, "what the image holds")
-        ->check(CLI::IsMember({"full", "direct", "indirect"}));
+    command.shade.addTo(app);
     app.add_option("--bounces", command.bounces,
                    "cache passes: 0 = direct light only, B = up to B reflections (default: until "
                    "a bounce adds < 0.5 % of the flux, at most 8)");
     app.add_option("--spp", command.spp, "subsamples per pixel (box filter)")
         ->check(CLI::Range(1u, 4096u));
-    auto* glossyOption = app.add_option("--glossy", command.glossyExponent,
-                                        "Phong exponent of an added glossy lobe (> 0)")
-                             ->check(CLI::PositiveNumber);
-    auto* glossyWeightOption = app.add_option("--glossy-weight", command.glossyWeight,
-                                              "factor on the glossy lobe's radiance (≥ 0)")
-                                   ->check(CLI::NonNegativeNumber);
-    glossyOption->needs(glossyWeightOption);
-    glossyWeightOption->needs(glossyOption);
     addGlobalFlags(app);
-    app.add_option("--out", command.outPath, "image to write (.exr linear, .png sRGB)")->required();
-    app.add_option("--exposure", command.exposure, "factor applied before PNG quantisation");
+    command.output.addTo(app);
 
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     return runShade(command);

@@ -170,5 +170,75 @@ TEST(CliReport, PrefixesTheProgramAndReturnsTheExitCode) {
     EXPECT_EQ(testing::internal::GetCapturedStderr(), "picx: error: disk full\n");
 }
 
+TEST(CliShade, FlagsGiveTheShadeParameters) {
+    CLI::App app{"shade"};
+    ShadeFlags flags;
+    flags.addTo(app);
+    ASSERT_EQ(parse(app, {"--component", "indirect", "--glossy", "32", "--glossy-weight", "0.5"}),
+              std::nullopt);
+    const ShadeParams params = flags.toParams({64, 48}, 4);
+    EXPECT_EQ(params.width, 64u);
+    EXPECT_EQ(params.height, 48u);
+    EXPECT_EQ(params.component, ShadeComponent::Indirect);
+    EXPECT_EQ(params.glossyExponent, 32.0f);
+    EXPECT_EQ(params.glossyWeight, 0.5f);
+    EXPECT_EQ(params.samplesPerPixel, 4u);
+    EXPECT_EQ(flags.component(), "indirect");
+
+    CLI::App defaults{"shade"};
+    ShadeFlags none;
+    none.addTo(defaults);
+    ASSERT_EQ(parse(defaults, {}), std::nullopt);
+    EXPECT_EQ(none.toParams({8, 8}).component, ShadeComponent::Full);
+    EXPECT_EQ(none.toParams({8, 8}).glossyWeight, 0.0f);
+}
+
+TEST(CliShade, BadComponentAndGlossyAloneAreUsageErrors) {
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"--component", "specular"}, {"--glossy", "8"},
+          {"--glossy-weight", "0.5"}, {"--glossy", "-1", "--glossy-weight", "1"}}) {
+        CLI::App app{"shade"};
+        ShadeFlags flags;
+        flags.addTo(app);
+        testing::internal::CaptureStderr();
+        EXPECT_EQ(parse(app, args), 2) << args[0];
+        testing::internal::GetCapturedStderr();
+    }
+}
+
+TEST(CliOutput, OutAndExposureAreCheckedBeforeAnyWork) {
+    auto checked = [](const std::vector<std::string>& args) {
+        CLI::App app{"out"};
+        ImageOutputFlags flags;
+        flags.addTo(app, false);
+        EXPECT_EQ(parse(app, args), std::nullopt);
+        return flags.check();
+    };
+    EXPECT_TRUE(checked({"--out", "image.exr"}));
+    EXPECT_TRUE(checked({"--out", "IMAGE.PNG", "--exposure", "4"}));
+    const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+        {{}, "--out is required"},
+        {{"--out", "image.jpg"}, "'.jpg'"},
+        {{"--out", "no/such/folder/image.exr"}, "directory 'no/such/folder' does not exist"},
+        {{"--out", "image.exr", "--exposure", "0"}, "--exposure 0"},
+        {{"--out", "image.exr", "--exposure", "-2"}, "--exposure -2"},
+    };
+    for (const auto& [args, part] : refused) {
+        const Result<void> result = checked(args);
+        ASSERT_FALSE(result) << part;
+        EXPECT_EQ(result.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(result.error().message.find(part), std::string::npos) << result.error().message;
+    }
+}
+
+TEST(CliOutput, RequiredOutIsAUsageError) {
+    CLI::App app{"out"};
+    ImageOutputFlags flags;
+    flags.addTo(app);
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(parse(app, {}), 2);
+    EXPECT_NE(testing::internal::GetCapturedStderr().find("--out"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace pic
