@@ -138,7 +138,7 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
     const auto levels = (*coarse)->levels();
     for (size_t k = 1; k < levels.size(); ++k) {
         EXPECT_GT(levels[k].error, levels[k - 1].error);
-        EXPECT_LE(levels[k].triangles, gpu::kCasterLevelReduction * levels[k - 1].triangles);
+        EXPECT_LE(levels[k].triangles, kCasterLevelReduction * levels[k - 1].triangles);
     }
     // Only the atrium has curved surfaces (columns) to simplify.
     if (GetParam() == "atrium") {
@@ -153,7 +153,7 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
             if (light.shadowKind == gpu::kShadowOrthographic) {
                 EXPECT_EQ(level, levels.size() - 1);
             }
-            EXPECT_LE(error, gpu::kCasterErrorPerTexel * (*coarse)->layerRecords()[l].texelSlope *
+            EXPECT_LE(error, kCasterErrorPerTexel * (*coarse)->layerRecords()[l].texelSlope *
                                  (light.shadowKind == gpu::kShadowOrthographic ? 1.0f : light.depthFar));
             // Depths differ by more than the level's error only on silhouettes and grazing
             // surfaces, where moving a surface sideways moves the depth along the ray more.
