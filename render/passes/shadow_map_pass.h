@@ -8,7 +8,8 @@
 /// larger ones; the closed surfaces of the scene (core/solids.h) that a light sees from outside
 /// are drawn without the faces that look away from it; and layers whose texels are wide draw a
 /// simplified level of detail whose measured distance from the scene stays within half a
-/// texel (which the shadow test's offsets already absorb).
+/// texel (which the shadow test's offsets already absorb). The casters are prepared on the
+/// CPU by render/shadow_casters.h.
 /// Perspective layers may also be smaller than the image's layers (ShadowMapOptions::
 /// equalFootprint): each light then renders and samples the top-left side × side texels.
 
@@ -28,6 +29,7 @@
 #include "gpu/handle.h"
 #include "gpu/resources.h"
 #include "shaders/shared/shadow_map.h"
+#include "render/shadow_casters.h"
 
 namespace pic::gpu {
 
@@ -35,54 +37,11 @@ namespace pic::gpu {
 /// need a field of view near 180°). Radians.
 inline constexpr float kMaxPerspectiveSpot = 1.0472f;  // 60°
 
-/// Spatially close triangles, consecutive in the pass's index buffer: the unit of frustum
-/// culling, so that a cube face rasterises only the part of the scene it can see.
-struct TriangleCluster {
-    uint32_t firstTriangle = 0;
-    uint32_t triangleCount = 0;
-    Aabb bounds;
-    /// The union of the bounds of the solids its triangles belong to; empty when they are
-    /// open (a cluster never mixes the two).
-    Aabb solidBounds;
-};
-
-/// Triangles per cluster: small enough that a cube face skips most of a room, large enough
-/// that one layer needs few draws.
-inline constexpr uint32_t kShadowClusterTriangles = 128;
-
 /// The faces the one-sided pipeline skips. Solids wind counter-clockwise seen from outside;
 /// the light-space matrices are right-handed with y up in clip space, which Vulkan's
 /// framebuffer (y down) mirrors, so a face that looks at the light winds clockwise there:
 /// Vulkan's back face under VK_FRONT_FACE_COUNTER_CLOCKWISE. Skipped are the front ones.
 inline constexpr VkCullModeFlags kCullAwayFromLight = VK_CULL_MODE_FRONT_BIT;
-
-/// Relative error (of the scene's extent) up to which mergeShadowCasters collapses edges: float
-/// rounding, so that only coplanar triangles merge.
-inline constexpr float kCasterMergeError = 1e-6f;
-
-/// The scene's triangles as shadow casters (positions only): corners welded by position and
-/// runs of coplanar triangles merged into fewer, larger ones by meshoptimizer's edge-collapse
-/// simplifier at kCasterMergeError, with open borders locked. The same surfaces.
-Scene mergeShadowCasters(const Scene& scene);
-
-/// `casters` (welded, as mergeShadowCasters returns them) simplified by edge collapses whose
-/// error stays within `error` metres, open borders locked: a coarser level of detail.
-Scene simplifyShadowCasters(const Scene& casters, float error);
-
-/// How far the surface of `fine` strays from that of `coarse`, metres: the largest distance
-/// from a sample of `fine` (its corners and centroids) to the nearest point of `coarse`,
-/// found with Embree's point queries; +∞ when a sample has nothing of `coarse` within `limit`.
-float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit);
-
-/// How far (in texels of the layer, at the caster's depth) a level of detail may move a
-/// caster's surface. surfel lighting's shadow test moves the receiver one texel along its
-/// normal and allows half a texel more, so a surface moved by half a texel neither shadows
-/// itself nor moves a shadow's edge by more than the map's own resolution does.
-inline constexpr float kCasterErrorPerTexel = 0.5f;
-
-/// Coarser levels of detail are kept only when they have at most this fraction of the
-/// triangles of the previous level (otherwise they would cost memory for nothing).
-inline constexpr float kCasterLevelReduction = 0.75f;
 
 /// Area-weighted points on the scene's surfaces from which a perspective light's typical
 /// receiver distance is taken (ShadowMapOptions::equalFootprint).
@@ -93,46 +52,6 @@ inline constexpr uint32_t kMinShadowSide = 16;
 /// The GpuLight record of `light` as lightIrradiance (shaders/lib/lights.glsl) reads it:
 /// type, position, direction, range, radiant intensity and cone; the shadow fields zero.
 GpuLight gpuLightRecord(const Light& light);
-
-/// Splits the scene's triangles into spatially compact clusters of at most `maxTriangles`
-/// (median splits of their centroids); `order` receives the triangle indices in cluster order.
-/// With `solids`, the triangles of solids come first and share no cluster with open ones.
-std::vector<TriangleCluster> buildTriangleClusters(const Scene& scene, uint32_t maxTriangles,
-                                                   std::vector<uint32_t>& order,
-                                                   const Solids* solids = nullptr);
-
-/// Where a layer's light sits, as far as solids are concerned.
-struct ShadowEye {
-    bool atInfinity = true;    ///< a directional light: outside every solid
-    glm::vec3 position{0.0f};  ///< a point or spot light's position, metres
-    /// Metres: solids closer to the light than this keep both faces, because the near plane
-    /// may clip the faces where the light's rays enter them.
-    float margin = 0.0f;
-
-    /// Whether the light lies outside every solid within `solidBounds`.
-    bool outside(const Aabb& solidBounds) const;
-};
-
-/// A run of triangles to draw: [firstTriangle, firstTriangle + triangleCount).
-struct TriangleRange {
-    uint32_t firstTriangle = 0;
-    uint32_t triangleCount = 0;
-    /// Triangles of solids the light sees from outside: their faces that look away from the
-    /// light may be skipped.
-    bool oneSided = false;
-};
-
-/// The clusters whose bounds can intersect the clip volume of `clipFromWorld` (Vulkan's:
-/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w), adjacent ones with the same sidedness merged into one range.
-/// Conservative: a cluster is dropped only when its box lies wholly outside one of the six
-/// planes.
-std::vector<TriangleRange> visibleTriangleRanges(std::span<const TriangleCluster> clusters,
-                                                 const glm::mat4& clipFromWorld,
-                                                 const ShadowEye& eye = {});
-
-/// The nearest view depth (metres; w of clip space) of the clusters whose bounds can meet
-/// the clip volume of `clipFromWorld`, +∞ when none can.
-float nearestClusterDepth(std::span<const TriangleCluster> clusters, const glm::mat4& clipFromWorld);
 
 /// How the pass draws the scene. The caster options are on by default; off only to measure
 /// what they save and to test what they change. The first two store the same depths; levels

@@ -16,29 +16,18 @@
 #include "core/gltf_loader.h"
 #include "core/sh.h"
 #include "rays/embree_scene.h"
+#include "tests/support/baked_scene.h"
 
 namespace pic {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Scene loadTestScene(const std::string& name) {
-    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf");
-    EXPECT_TRUE(scene.has_value()) << (scene ? "" : scene.error().message);
-    return scene ? std::move(*scene) : Scene{};
-}
-
-BakeOptions smallOptions() {
-    BakeOptions options;
-    options.surfels = 8192;
-    options.links = 96;
-    options.gridCell = 0.2f;
-    options.lightmapTexel = 0.1f;
-    return options;
-}
+/// The bake tests' small bake: 8192 surfels, 96 links per cache, 0.2 m grid cells, 0.1 m texels.
+BakeOptions smallOptions() { return test::smallBakeOptions(8192, 96, 0.2f, 0.1f); }
 
 TEST(SurfelPlacement, AreaIsConservedAndSurfelsLieOnTheirTriangles) {
-    Scene scene = loadTestScene("cornell");
+    Scene scene = test::loadTestScene("cornell");
     ASSERT_FALSE(scene.triangles.empty());
     auto surfels = placeSurfels(scene, SurfelParams{10000, 4, 16, 7});
     ASSERT_TRUE(surfels) << surfels.error().message;
@@ -58,7 +47,7 @@ TEST(SurfelPlacement, AreaIsConservedAndSurfelsLieOnTheirTriangles) {
 
 TEST(SurfelPlacement, SamplingFollowsArea) {
     // Red and green walls have equal area: they must get about the same number of surfels.
-    Scene scene = loadTestScene("cornell");
+    Scene scene = test::loadTestScene("cornell");
     auto surfels = placeSurfels(scene, SurfelParams{20000, 0, 4, 1});
     ASSERT_TRUE(surfels);
     int left = 0, right = 0;
@@ -72,7 +61,7 @@ TEST(SurfelPlacement, SamplingFollowsArea) {
 
 TEST(SurfelPlacement, EmissionAndTexturedAlbedoComeFromTheMaterial) {
     // cornell_area: the ceiling panel emits 10 W/(m²·sr); nothing else emits.
-    Scene area = loadTestScene("cornell_area");
+    Scene area = test::loadTestScene("cornell_area");
     auto lit = placeSurfels(area, SurfelParams{20000, 2, 16, 3});
     ASSERT_TRUE(lit);
     int emitting = 0;
@@ -88,7 +77,7 @@ TEST(SurfelPlacement, EmissionAndTexturedAlbedoComeFromTheMaterial) {
 
     // textured_quad: the floor's 8×8 checker of two sRGB colours averages, over all floor
     // surfels, to the mean of their linear values (0.791 / 0.021 in red and blue).
-    Scene quad = loadTestScene("textured_quad");
+    Scene quad = test::loadTestScene("textured_quad");
     auto textured = placeSurfels(quad, SurfelParams{4000, 2, 16, 3});
     ASSERT_TRUE(textured);
     glm::dvec3 sum(0.0);
@@ -114,7 +103,7 @@ TEST(DiscSolidAngle, MatchesExactOnAxisAndSmallDiscLimit) {
 }
 
 TEST(GridCaches, NoCacheOutsideAClosedRoomAndAllNearGeometry) {
-    Scene scene = loadTestScene("closed_box");
+    Scene scene = test::loadTestScene("closed_box");
     auto rays = EmbreeScene::create(scene);
     ASSERT_TRUE(rays);
     GridCacheParams params;
@@ -143,28 +132,23 @@ std::vector<double> solidAnglePerCache(const LinkResult& links, size_t caches, u
 }
 
 TEST(LinkGeneration, LinksOfACacheInAClosedBoxCoverTheSphere) {
-    Scene scene = loadTestScene("closed_box");
-    BakeReport report;
-    BakeOptions options = smallOptions();
-    options.surfels = 16384;
-    options.links = 128;
-    auto bake = runBake(scene, options, report);
-    ASSERT_TRUE(bake) << bake.error().message;
-    auto rays = EmbreeScene::create(scene);
-    ASSERT_TRUE(rays);
+    const test::BakedScene& b =
+        test::bakedScene("closed_box", test::smallBakeOptions(16384, 128, 0.2f, 0.1f));
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
     LinkParams params;
     params.linksPerCache = 128;
-    auto links = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    auto links = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
     ASSERT_TRUE(links);
-    auto sums = solidAnglePerCache(*links, bake->caches.size(), params.linksPerCache);
+    auto sums = solidAnglePerCache(*links, bake.caches.size(), params.linksPerCache);
     // Grid caches see the whole sphere, light-map caches the hemisphere above their surface.
     // A light-map cache 5 cm from a corner sees the near walls through a handful of surfels,
     // so single light-map caches deviate more (surfel noise, not the cut): they are checked
     // on average and with a looser bound each.
     int grid = 0, lightmap = 0;
     double lightmapMean = 0.0;
-    for (size_t c = 0; c < bake->caches.size(); ++c) {
-        const Cache& cache = bake->caches[c];
+    for (size_t c = 0; c < bake.caches.size(); ++c) {
+        const Cache& cache = bake.caches[c];
         if (cache.kind == gpu::kCacheKindGrid) {
             ++grid;
             EXPECT_NEAR(sums[c] / (4.0 * kPi), 1.0, 0.04) << "grid cache " << c;
@@ -182,18 +166,16 @@ TEST(LinkGeneration, LinksOfACacheInAClosedBoxCoverTheSphere) {
 
 TEST(LinkGeneration, RtpAndShFormsAgreeOnBandZero) {
     // Band 0 of the SH form is Ω_vis·y00/(πA); the RTP form holds factor·K0(α)·y00.
-    Scene scene = loadTestScene("cornell");
-    BakeReport report;
-    auto bake = runBake(scene, smallOptions(), report);
-    ASSERT_TRUE(bake) << bake.error().message;
-    auto rays = EmbreeScene::create(scene);
+    const test::BakedScene& b = test::bakedScene("cornell", smallOptions());
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
     LinkParams params;
     params.linksPerCache = 32;
     params.mode = LinkMode::Rtp;
-    auto rtp = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    auto rtp = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
     params.mode = LinkMode::Sh;
     params.bands = 3;
-    auto sh = generateLinks(**rays, bake->surfels, bake->nodes, bake->caches, params);
+    auto sh = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
     ASSERT_TRUE(rtp && sh);
     for (size_t i = 0; i < rtp->links.rtp.size(); i += 97) {
         const RtpLink& link = rtp->links.rtp[i];
@@ -207,29 +189,26 @@ TEST(LinkGeneration, RtpAndShFormsAgreeOnBandZero) {
 }
 
 TEST(LinkGeneration, UpperRoomNeverLinksToLowerRoomOnlyNodes) {
-    Scene scene = loadTestScene("two_floors");
-    BakeReport report;
-    BakeOptions options = smallOptions();
-    options.gridCell = 0.5f;
-    options.lightmapTexel = 0.25f;
-    auto bake = runBake(scene, options, report);
-    ASSERT_TRUE(bake) << bake.error().message;
+    const test::BakedScene& b =
+        test::bakedScene("two_floors", test::smallBakeOptions(8192, 96, 0.5f, 0.25f));
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
     // tests/scenes: the lower room is y in [0, 2.5], the 2 cm slab y in [2.5, 2.52] (it
     // reaches 5 cm past the walls), the upper room y in [2.52, 5.02], walls at |x|, |z| = 2.
     const float slabBottom = 2.5f, slabTop = 2.52f, halfWidth = 2.0f;
-    const uint32_t nL = bake->links.linksPerCache;
+    const uint32_t nL = bake.links.linksPerCache;
     int upperCaches = 0;
-    for (size_t c = 0; c < bake->caches.size(); ++c) {
-        const glm::vec3 p = bake->caches[c].position;
+    for (size_t c = 0; c < bake.caches.size(); ++c) {
+        const glm::vec3 p = bake.caches[c].position;
         if (p.y <= slabTop || std::abs(p.x) >= halfWidth || std::abs(p.z) >= halfWidth) continue;
         ++upperCaches;
         for (uint32_t l = 0; l < nL; ++l) {
-            const RtpLink& link = bake->links.rtp[c * nL + l];
+            const RtpLink& link = bake.links.rtp[c * nL + l];
             if (link.factor == 0.0f) continue;
-            const Node& node = bake->nodes[link.node];
+            const Node& node = bake.nodes[link.node];
             bool lowerOnly = true;
             for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount && lowerOnly; ++s)
-                lowerOnly = bake->surfels[s].position.y < slabBottom - 1e-3f;
+                lowerOnly = bake.surfels[s].position.y < slabBottom - 1e-3f;
             ASSERT_FALSE(lowerOnly) << "cache " << c << " links node " << link.node
                                     << " made only of lower-room surfels";
         }
@@ -238,7 +217,7 @@ TEST(LinkGeneration, UpperRoomNeverLinksToLowerRoomOnlyNodes) {
 }
 
 TEST(Bake, IsDeterministic) {
-    Scene scene = loadTestScene("cornell");
+    Scene scene = test::loadTestScene("cornell");
     BakeReport first, second;
     auto a = runBake(scene, smallOptions(), first);
     auto b = runBake(scene, smallOptions(), second);
@@ -254,32 +233,31 @@ TEST(Bake, IsDeterministic) {
 
 TEST(Bake, BlindCachesAreDroppedAndIndicesStayValid) {
     // cornell is open at the front: grid vertices outside its walls see no surface.
-    Scene scene = loadTestScene("cornell");
-    BakeReport report;
-    auto bake = runBake(scene, smallOptions(), report);
-    ASSERT_TRUE(bake) << bake.error().message;
-    const uint32_t nL = bake->links.linksPerCache;
-    ASSERT_EQ(bake->links.rtp.size(), bake->caches.size() * nL);
-    for (size_t c = 0; c < bake->caches.size(); ++c) EXPECT_GT(bake->links.rtp[c * nL].factor, 0.0f) << c;
-    std::vector<int> referenced(bake->caches.size(), 0);
-    for (const auto* index : {&bake->grid.cacheIndex, &bake->lightmap.cacheIndex})
+    const test::BakedScene& b = test::bakedScene("cornell", smallOptions());
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
+    const uint32_t nL = bake.links.linksPerCache;
+    ASSERT_EQ(bake.links.rtp.size(), bake.caches.size() * nL);
+    for (size_t c = 0; c < bake.caches.size(); ++c) EXPECT_GT(bake.links.rtp[c * nL].factor, 0.0f) << c;
+    std::vector<int> referenced(bake.caches.size(), 0);
+    for (const auto* index : {&bake.grid.cacheIndex, &bake.lightmap.cacheIndex})
         for (uint32_t i : *index) {
             if (i == kNoCache) continue;
-            ASSERT_LT(i, bake->caches.size());
+            ASSERT_LT(i, bake.caches.size());
             referenced[i] = 1;
         }
     // Every unique cache is still used by its own grid vertex or texel.
-    for (size_t c = 0; c < bake->caches.size(); ++c) EXPECT_TRUE(referenced[c]) << c;
-    for (size_t c = 0; c < bake->caches.size(); ++c) {
-        const Cache& cache = bake->caches[c];
-        const auto& index = cache.kind == gpu::kCacheKindGrid ? bake->grid.cacheIndex : bake->lightmap.cacheIndex;
+    for (size_t c = 0; c < bake.caches.size(); ++c) EXPECT_TRUE(referenced[c]) << c;
+    for (size_t c = 0; c < bake.caches.size(); ++c) {
+        const Cache& cache = bake.caches[c];
+        const auto& index = cache.kind == gpu::kCacheKindGrid ? bake.grid.cacheIndex : bake.lightmap.cacheIndex;
         EXPECT_EQ(index[cache.texel], c);
     }
 }
 
 TEST(Bake, DefaultsFollowTheSceneSize) {
-    Scene small = loadTestScene("cornell");
-    Scene large = loadTestScene("atrium");
+    Scene small = test::loadTestScene("cornell");
+    Scene large = test::loadTestScene("atrium");
     std::map<std::string, std::string> d1, d2;
     auto p1 = resolveBakeParams(small, BakeOptions{}, d1);
     auto p2 = resolveBakeParams(large, BakeOptions{}, d2);
@@ -290,7 +268,7 @@ TEST(Bake, DefaultsFollowTheSceneSize) {
 }
 
 TEST(Bake, RejectsBadParameters) {
-    Scene scene = loadTestScene("cornell");
+    Scene scene = test::loadTestScene("cornell");
     std::map<std::string, std::string> defaults;
     BakeOptions options;
     options.bandsY = 9;

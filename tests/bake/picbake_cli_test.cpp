@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/support/baked_scene.h"
 #include "tests/support/command.h"
 
 namespace {
@@ -21,9 +22,7 @@ protected:
         return test::runCommand(std::string(PIC_PICBAKE) + " --quiet " + args, mDir.path());
     }
 
-    std::string scene(const std::string& name) const {
-        return std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf";
-    }
+    std::string scene(const std::string& name) const { return test::testScenePath(name); }
 
     std::string smallBake(const std::string& name, const std::string& out) {
         return "bake " + scene(name) + " -o " + out +

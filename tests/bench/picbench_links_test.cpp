@@ -9,24 +9,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tests/support/command.h"
+#include "tests/bench/picbench_fixture.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 namespace test = pic::test;
 
-class PicbenchLinks : public ::testing::Test {
+class PicbenchLinks : public test::PicbenchTest {
 protected:
-    /// Runs picbench with `args`; returns its exit code, stderr in `err`.
-    int run(const std::string& args, std::string& err) {
-        test::CommandResult result =
-            test::runCommand(std::string(PIC_PICBENCH) + " --quiet " + args, mDir.path());
-        err = std::move(result.err);
-        return result.exitCode;
-    }
-
-    test::ScratchDir mDir{"picbench_links"};
+    PicbenchLinks() : PicbenchTest("picbench_links") {}
 };
 
 TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {

@@ -25,7 +25,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/bake.h"
 #include "client/connection.h"
 #include "core/bake_file.h"
 #include "core/camera.h"
@@ -38,6 +37,7 @@
 #include "render/renderer.h"
 #include "server/service.h"
 #include "server/token_digest.h"
+#include "tests/support/baked_scene.h"
 #include "tests/support/command.h"
 
 namespace pic {
@@ -46,28 +46,15 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-const std::string kScene = std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf";
+const std::string kScene = test::testScenePath("cornell");
 
 /// A small bake of the Cornell box, written once per test process into a scratch directory
 /// that goes when the process exits.
 const std::string& bakePath() {
-    static const test::ScratchDir dir("pic_stream_test");
-    static const std::string path = [] {
-        const std::string out = (dir / "cornell.pic").string();
-        auto scene = loadScene(kScene);
-        EXPECT_TRUE(scene);
-        BakeOptions options;
-        options.surfels = 2048;
-        options.links = 32;
-        options.bandsY = 3;
-        options.bandsC = 2;
-        BakeReport report;
-        auto bake = runBake(*scene, options, report);
-        EXPECT_TRUE(bake);
-        EXPECT_TRUE(writeBakeFile(out, *bake));
-        return out;
-    }();
-    return path;
+    BakeOptions options = test::smallBakeOptions(2048, 32);
+    options.bandsY = 3;
+    options.bandsC = 2;
+    return test::bakeFile("cornell", options);
 }
 
 /// The CPU twin on the test bake, set up as serve() runs it (one bounce): it is

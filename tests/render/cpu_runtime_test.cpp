@@ -4,21 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <map>
 #include <memory>
 #include <numbers>
 #include <string>
 #include <tuple>
 #include <vector>
 
-#include "bake/bake.h"
 #include "core/color.h"
-#include "core/gltf_loader.h"
 #include "core/light_set.h"
 #include "core/sh.h"
-#include "rays/embree_scene.h"
 #include "render/cpu/surfel_lighting.h"
 #include "render/cpu_runtime.h"
+#include "tests/support/baked_scene.h"
 
 namespace pic {
 namespace {
@@ -28,42 +25,14 @@ constexpr double kPi = std::numbers::pi;
 const double kY00 = 0.5 / std::sqrt(kPi);
 
 /// A test scene with its rays and a small bake, made once per (scene, link mode) and shared.
-struct Baked {
-    Scene scene;
-    std::unique_ptr<EmbreeScene> rays;
-    BakeData bake;
-};
-
-const Baked& baked(const std::string& name, LinkMode mode) {
-    static std::map<std::pair<std::string, LinkMode>, std::unique_ptr<Baked>> cache;
-    auto& slot = cache[{name, mode}];
-    if (!slot) {
-        slot = std::make_unique<Baked>();
-        auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf");
-        EXPECT_TRUE(scene) << name << ": " << (scene ? "" : scene.error().message);
-        if (!scene) return *slot;
-        slot->scene = std::move(*scene);
-        auto rays = EmbreeScene::create(slot->scene);
-        EXPECT_TRUE(rays);
-        if (!rays) return *slot;
-        slot->rays = std::move(*rays);
-        // Small enough for a few seconds per bake on two cores.
-        BakeOptions options;
-        options.surfels = 4096;
-        options.links = 64;
-        options.linkMode = mode;
-        const float extent = slot->scene.bounds.diagonal();
-        options.gridCell = 0.12f * extent;
-        options.lightmapTexel = 0.06f * extent;
-        BakeReport report;
-        auto bake = runBake(slot->scene, options, report);
-        EXPECT_TRUE(bake) << name << ": " << (bake ? "" : bake.error().message);
-        if (bake) slot->bake = std::move(*bake);
-    }
-    return *slot;
+const test::BakedScene& baked(const std::string& name, LinkMode mode) {
+    // Small enough for a few seconds per bake on two cores.
+    BakeOptions options = test::smallBakeOptions(4096, 64);
+    options.linkMode = mode;
+    return test::bakedScene(name, options, 0.12f, 0.06f);
 }
 
-std::unique_ptr<Runtime> runtimeFor(const Baked& b, BounceParams bounces) {
+std::unique_ptr<Runtime> runtimeFor(const test::BakedScene& b, BounceParams bounces) {
     auto runtime = createCpuRuntime(b.scene, *b.rays, b.bake, bounces);
     EXPECT_TRUE(runtime) << (runtime ? "" : runtime.error().message);
     return runtime ? std::move(*runtime) : nullptr;
@@ -97,7 +66,7 @@ TEST(CpuRuntime, ClosedBoxReflectsAlbedoTimesTheLampsFlux) {
     // Every photon of the 1 W/sr lamp lands on a wall: ∫E dA = 4π·I, and the walls reflect
     // ρ·4π·I. Surfels sample the walls with equal areas, so their flux sums to that up to the
     // sampling of the smooth irradiance (well under 1 %).
-    const Baked& b = baked("closed_box", LinkMode::Rtp);
+    const test::BakedScene& b = baked("closed_box", LinkMode::Rtp);
     ASSERT_FALSE(b.bake.surfels.empty());
     const glm::dvec3 albedo = glm::dvec3(b.bake.surfels[0].albedo);
     std::vector<glm::vec3> flux(b.bake.surfels.size());
@@ -123,7 +92,7 @@ TEST(CpuRuntime, ClosedBoxCachesSeeTheWallsRadiance) {
     // centres are both the brightest and the nearest parts, that reads 7 % low on average and
     // 9 % at worst (2.5 % and 3 % with 254 links). Hence 10 % on the mean, 12 % on any cache;
     // a wrong π, cone factor, basis or YCoCg weight is off by far more.
-    const Baked& b = baked("closed_box", LinkMode::Rtp);
+    const test::BakedScene& b = baked("closed_box", LinkMode::Rtp);
     auto runtime = runtimeFor(b, BounceParams{.bounces = 1});
     ASSERT_TRUE(runtime);
     auto values = runtime->setLights(defaultLightSet(b.scene));
@@ -169,7 +138,7 @@ TEST(CpuRuntime, ClosedBoxCachesSeeTheWallsRadiance) {
 }
 
 TEST(CpuRuntime, ZeroBouncesLeaveTheCachesDark) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     auto runtime = runtimeFor(b, BounceParams{.bounces = 0});
     ASSERT_TRUE(runtime);
     UpdateStats stats;
@@ -183,7 +152,7 @@ TEST(CpuRuntime, ZeroBouncesLeaveTheCachesDark) {
 }
 
 TEST(CpuRuntime, MoreBouncesAddLessAndLessLight) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     std::vector<double> flux, radiance;
     for (int bounces = 1; bounces <= 5; ++bounces) {
         auto runtime = runtimeFor(b, BounceParams{.bounces = bounces});
@@ -208,7 +177,7 @@ TEST(CpuRuntime, MoreBouncesAddLessAndLessLight) {
 }
 
 TEST(CpuRuntime, ProgressiveBouncesStopWhereABounceAddsLittle) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     const BounceParams progressive{.bounces = -1, .convergence = 0.02f, .maxBounces = 8};
     auto runtime = runtimeFor(b, progressive);
     ASSERT_TRUE(runtime);
@@ -248,7 +217,7 @@ TEST(CpuRuntime, ProgressiveBouncesStopWhereABounceAddsLittle) {
 TEST(CpuRuntime, UpperRoomOfTwoFloorsStaysDark) {
     // The lamp is in the lower room and the slab is closed: the upper room's caches may only
     // see what the hierarchy leaks (paper 000 §5.2, failure case c), under 1 % of below.
-    const Baked& b = baked("two_floors", LinkMode::Rtp);
+    const test::BakedScene& b = baked("two_floors", LinkMode::Rtp);
     auto runtime = runtimeFor(b, BounceParams{});
     ASSERT_TRUE(runtime);
     auto values = runtime->setLights(defaultLightSet(b.scene));
@@ -276,7 +245,7 @@ class AllScenes : public testing::TestWithParam<std::tuple<std::string, LinkMode
 
 TEST_P(AllScenes, CachesHoldNoNanInfOrNegativeLight) {
     const auto& [name, mode] = GetParam();
-    const Baked& b = baked(name, mode);
+    const test::BakedScene& b = baked(name, mode);
     ASSERT_FALSE(b.bake.caches.empty());
     auto runtime = runtimeFor(b, BounceParams{});
     ASSERT_TRUE(runtime);
@@ -308,7 +277,7 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(CpuRuntime, RefusesABakeOfAnotherScene) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     Scene other = b.scene;
     other.hash ^= 1;
     auto runtime = createCpuRuntime(other, *b.rays, b.bake, BounceParams{});
@@ -318,7 +287,7 @@ TEST(CpuRuntime, RefusesABakeOfAnotherScene) {
 }
 
 TEST(CpuRuntime, RefusesBadBounceParameters) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     for (const BounceParams& p : {BounceParams{.bounces = -2}, BounceParams{.convergence = NAN},
                                   BounceParams{.maxBounces = -1}}) {
         auto runtime = createCpuRuntime(b.scene, *b.rays, b.bake, p);
@@ -328,7 +297,7 @@ TEST(CpuRuntime, RefusesBadBounceParameters) {
 }
 
 TEST(CpuRuntime, RefusesBadLightSets) {
-    const Baked& b = baked("cornell", LinkMode::Rtp);
+    const test::BakedScene& b = baked("cornell", LinkMode::Rtp);
     auto runtime = runtimeFor(b, BounceParams{.bounces = 1});
     ASSERT_TRUE(runtime);
     LightSet unknownMaterial;

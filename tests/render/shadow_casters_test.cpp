@@ -1,5 +1,6 @@
-// Frustum culling of the shadow-map pass (CPU side, no Vulkan): clusters partition the
-// triangles, and every triangle with a point inside a layer's clip volume is drawn.
+// Shadow-caster preparation (render/shadow_casters.h, CPU only, no Vulkan): coplanar triangles
+// merge and curved ones stay, levels of detail are measured, clusters partition the triangles,
+// and every triangle with a point inside a layer's clip volume is drawn.
 
 #include <gtest/gtest.h>
 
@@ -11,7 +12,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "render/passes/shadow_map_pass.h"
+#include "render/shadow_casters.h"
 
 namespace pic {
 namespace {
@@ -85,7 +86,7 @@ TEST(ShadowCasters, CoplanarTrianglesMergeAndCurvedOnesStay) {
         scene.triangles.push_back(Triangle{{a, c, b}});
         scene.triangles.push_back(Triangle{{a, d, c}});
     }
-    const Scene casters = gpu::mergeShadowCasters(scene);
+    const Scene casters = mergeShadowCasters(scene);
     // The floor's interior collapses; its border vertices stay, so what is left is a fan
     // over them, not 2 triangles. The tube cannot lose a facet.
     EXPECT_LT(casters.triangles.size(), 2 * kFacets + floorTriangles / 2);
@@ -180,21 +181,21 @@ TEST(ShadowCasters, SurfaceDeviationIsMeasuredNotEstimated) {
     }
     for (const auto& profile : {cylinder, sphere}) {
         const Scene scene = revolution(profile, 32);
-        const Scene merged = gpu::mergeShadowCasters(scene);
+        const Scene merged = mergeShadowCasters(scene);
         EXPECT_LE(merged.triangles.size(), scene.triangles.size());
-        EXPECT_NEAR(gpu::surfaceDeviation(scene, merged, 1.0f), deviation(scene, merged), 1e-5f);
+        EXPECT_NEAR(surfaceDeviation(scene, merged, 1.0f), deviation(scene, merged), 1e-5f);
         size_t previous = merged.triangles.size();
         for (float target : {0.004f, 0.02f, 0.1f}) {
-            const Scene level = gpu::simplifyShadowCasters(merged, target);
+            const Scene level = simplifyShadowCasters(merged, target);
             EXPECT_LT(level.triangles.size(), previous) << target;
             EXPECT_GT(level.triangles.size(), 0u) << target;
             // The measure (Embree point queries from corners and centroids) is what the
             // brute force over every pair finds, edge midpoints included.
-            const float measured = gpu::surfaceDeviation(scene, level, 1.0f);
+            const float measured = surfaceDeviation(scene, level, 1.0f);
             const float exhaustive = deviation(scene, level);
             EXPECT_NEAR(measured, exhaustive, 0.05f * exhaustive + 1e-5f) << target;
             // Nothing within the limit: +∞.
-            EXPECT_TRUE(std::isinf(gpu::surfaceDeviation(scene, level, 0.5f * measured)));
+            EXPECT_TRUE(std::isinf(surfaceDeviation(scene, level, 0.5f * measured)));
             previous = level.triangles.size();
         }
     }
@@ -206,31 +207,31 @@ TEST(ShadowCulling, NearestClusterDepthIsTheClosestVisibleBoxCorner) {
     const glm::mat4 clip = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, 0.01f, 20.0f) *
                            glm::lookAtRH(glm::vec3(0), glm::vec3(0, 0, -1), glm::vec3(0, 1, 0));
     auto cluster = [](const glm::vec3& lo, const glm::vec3& hi) {
-        gpu::TriangleCluster c;
+        TriangleCluster c;
         c.bounds.extend(lo);
         c.bounds.extend(hi);
         return c;
     };
-    std::vector<gpu::TriangleCluster> clusters = {
+    std::vector<TriangleCluster> clusters = {
         cluster({-1, -1, -6}, {1, 1, -5}), cluster({0.5f, 0, -3}, {1, 0.2f, -2}),
         cluster({-1, -1, 1}, {1, 1, 3}), cluster({3, 0, -1.2f}, {4, 1, -1})};
-    EXPECT_NEAR(gpu::nearestClusterDepth(clusters, clip), 2.0f, 1e-4f);
+    EXPECT_NEAR(nearestClusterDepth(clusters, clip), 2.0f, 1e-4f);
     clusters.erase(clusters.begin() + 1);
-    EXPECT_NEAR(gpu::nearestClusterDepth(clusters, clip), 5.0f, 1e-4f);
+    EXPECT_NEAR(nearestClusterDepth(clusters, clip), 5.0f, 1e-4f);
     clusters.erase(clusters.begin());
-    EXPECT_TRUE(std::isinf(gpu::nearestClusterDepth(clusters, clip)));
+    EXPECT_TRUE(std::isinf(nearestClusterDepth(clusters, clip)));
 }
 
 TEST(ShadowCulling, ClustersPartitionTheTrianglesAndBoundThem) {
     const Scene scene = randomTriangles(5000, 1);
     std::vector<uint32_t> order;
-    const auto clusters = gpu::buildTriangleClusters(scene, 512, order);
+    const auto clusters = buildTriangleClusters(scene, 512, order);
     ASSERT_EQ(order.size(), scene.triangles.size());
     std::vector<int> seen(scene.triangles.size(), 0);
     for (uint32_t t : order) ++seen.at(t);
     for (int s : seen) EXPECT_EQ(s, 1);
     uint32_t next = 0;
-    for (const gpu::TriangleCluster& c : clusters) {
+    for (const TriangleCluster& c : clusters) {
         EXPECT_EQ(c.firstTriangle, next);
         EXPECT_GT(c.triangleCount, 0u);
         EXPECT_LE(c.triangleCount, 512u);
@@ -248,7 +249,7 @@ TEST(ShadowCulling, ClustersPartitionTheTrianglesAndBoundThem) {
 TEST(ShadowCulling, EveryTriangleInsideALayerIsDrawnAndCubeFacesSkipMost) {
     const Scene scene = randomTriangles(20000, 2);
     std::vector<uint32_t> order;
-    const auto clusters = gpu::buildTriangleClusters(scene, 256, order);
+    const auto clusters = buildTriangleClusters(scene, 256, order);
 
     // The six cube faces of a point light inside the cloud, a narrow spot and an
     // orthographic layer over part of it, as the pass builds them.
@@ -267,10 +268,10 @@ TEST(ShadowCulling, EveryTriangleInsideALayerIsDrawnAndCubeFacesSkipMost) {
 
     uint64_t cubeDrawn = 0;
     for (size_t l = 0; l < layers.size(); ++l) {
-        const auto ranges = gpu::visibleTriangleRanges(clusters, layers[l]);
+        const auto ranges = visibleTriangleRanges(clusters, layers[l]);
         std::vector<bool> drawn(scene.triangles.size(), false);
         uint32_t end = 0;
-        for (const gpu::TriangleRange& r : ranges) {
+        for (const TriangleRange& r : ranges) {
             EXPECT_GE(r.firstTriangle, end) << "ranges overlap or are unsorted";
             end = r.firstTriangle + r.triangleCount;
             for (uint32_t i = r.firstTriangle; i < end; ++i) drawn[order[i]] = true;

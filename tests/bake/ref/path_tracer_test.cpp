@@ -21,6 +21,7 @@
 #include "core/progress.h"
 #include "core/sh.h"
 #include "rays/embree_scene.h"
+#include "tests/support/baked_scene.h"
 
 namespace pic {
 namespace {
@@ -476,7 +477,7 @@ TEST_F(PathTracerTest, SquareEmitterLightsThePlaneByItsViewFactor) {
 }
 
 TEST_F(PathTracerTest, ImagesDependOnTheSeedOnlyNotOnThreads) {
-    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf");
+    auto scene = loadScene(test::testScenePath("cornell"));
     ASSERT_TRUE(scene) << scene.error().message;
     auto camera = sceneCamera(*scene, 0);
     ASSERT_TRUE(camera) << camera.error().message;

@@ -7,11 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bake/bake.h"
 #include "core/bake_file.h"
-#include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/progress.h"
+#include "tests/support/baked_scene.h"
 #include "tests/support/command.h"
 
 namespace pic {
@@ -25,27 +24,12 @@ protected:
         return test::runCommand(std::string(PIC_PICREF) + " " + args, mDir.path());
     }
 
-    static std::string scene(const std::string& name) {
-        return std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf";
-    }
+    static std::string scene(const std::string& name) { return test::testScenePath(name); }
 
     /// A small bake of a test scene, made in-process.
     std::string bake(const std::string& name) {
         Progress::setEnabled(false);
-        auto loaded = loadScene(scene(name));
-        EXPECT_TRUE(loaded);
-        BakeOptions options;
-        options.surfels = 2048;
-        options.links = 16;
-        options.gridCell = 0.34f;
-        options.lightmapTexel = 0.2f;
-        BakeReport report;
-        auto baked = runBake(*loaded, options, report);
-        EXPECT_TRUE(baked) << baked.error().message;
-        std::string path = (mDir / (name + ".pic")).string();
-        auto written = writeBakeFile(path, *baked);
-        EXPECT_TRUE(written) << written.error().message;
-        return path;
+        return test::bakeFile(name, test::smallBakeOptions(2048, 16, 0.34f, 0.2f));
     }
 
     test::ScratchDir mDir{"picref_cli"};

@@ -1,67 +1,33 @@
 // `picref shade` end to end: the real binary on a bake written in-process, its image and its
 // exit codes for bad input.
 
-#include <unistd.h>
-
 #include <cmath>
-#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "bake/bake.h"
-#include "core/bake_file.h"
-#include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/progress.h"
+#include "tests/support/baked_scene.h"
 #include "tests/support/command.h"
 
 namespace pic {
 namespace {
 
-namespace fs = std::filesystem;
-
-std::string scenePath(const std::string& name) {
-    return std::string(PIC_TEST_SCENE_DIR) + "/" + name + ".gltf";
-}
-
-/// Bakes `scene` with small settings into `out`; false (with a test failure) on any error.
-bool bakeTo(const std::string& scene, const std::string& out) {
-    auto loaded = loadScene(scenePath(scene));
-    EXPECT_TRUE(loaded.has_value()) << (loaded ? "" : loaded.error().message);
-    if (!loaded) return false;
-    BakeOptions options;
-    options.surfels = 2048;
-    options.links = 48;
-    options.gridCell = 0.25f;
-    options.lightmapTexel = 0.1f;
-    BakeReport report;
-    Progress::setEnabled(false);
-    auto bake = runBake(*loaded, options, report);
-    EXPECT_TRUE(bake.has_value()) << (bake ? "" : bake.error().message);
-    if (!bake) return false;
-    auto written = writeBakeFile(out, *bake);
-    EXPECT_TRUE(written.has_value()) << (written ? "" : written.error().message);
-    return written.has_value();
-}
-
-/// A temporary directory with bakes of cornell and closed_box, made once for all tests.
+/// Small bakes of cornell and closed_box, and a temporary directory for the images, made once
+/// for all tests.
 struct ShadeFixture {
-    fs::path dir;
+    test::ScratchDir dir{"picref_shade_test"};
     std::string cornellBake;
     std::string otherBake;
     bool ok = false;
 
     ShadeFixture() {
-        dir = fs::temp_directory_path() / fmt::format("picref_shade_test_{}", ::getpid());
-        fs::create_directories(dir);
-        cornellBake = (dir / "cornell.pic").string();
-        otherBake = (dir / "closed_box.pic").string();
-        ok = bakeTo("cornell", cornellBake) && bakeTo("closed_box", otherBake);
-    }
-    ~ShadeFixture() {
-        std::error_code ignored;
-        fs::remove_all(dir, ignored);
+        Progress::setEnabled(false);
+        const BakeOptions options = test::smallBakeOptions(2048, 48, 0.25f, 0.1f);
+        cornellBake = test::bakeFile("cornell", options);
+        otherBake = test::bakeFile("closed_box", options);
+        ok = !cornellBake.empty() && !otherBake.empty();
     }
 };
 
@@ -72,7 +38,8 @@ const ShadeFixture& fixture() {
 
 /// Exit code and output of `picref shade ARGS`.
 test::CommandResult runShade(const std::string& args) {
-    return test::runCommand(fmt::format("'{}' shade {} --quiet", PIC_PICREF, args), fixture().dir);
+    return test::runCommand(fmt::format("'{}' shade {} --quiet", PIC_PICREF, args),
+                            fixture().dir.path());
 }
 
 TEST(PicrefShade, WritesAFiniteImageOfCornell) {
@@ -81,7 +48,7 @@ TEST(PicrefShade, WritesAFiniteImageOfCornell) {
     const std::string out = (f.dir / "cornell.exr").string();
     const test::CommandResult run =
         runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 32x32 --out '{}'",
-                             scenePath("cornell"), f.cornellBake, out));
+                             test::testScenePath("cornell"), f.cornellBake, out));
     ASSERT_EQ(run.exitCode, 0) << run.err;
     EXPECT_NE(run.err.find("bounces"), std::string::npos) << run.err;
     auto image = readImage(out);
@@ -101,9 +68,9 @@ TEST(PicrefShade, WritesAFiniteImageOfCornell) {
 TEST(PicrefShade, RefusesABakeOfAnotherScene) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
-    const test::CommandResult run =
-        runShade(fmt::format("'{}' --bake '{}' --scene-camera 0 --size 8x8 --out '{}'",
-                             scenePath("cornell"), f.otherBake, (f.dir / "other.exr").string()));
+    const test::CommandResult run = runShade(
+        fmt::format("'{}' --bake '{}' --scene-camera 0 --size 8x8 --out '{}'",
+                    test::testScenePath("cornell"), f.otherBake, (f.dir / "other.exr").string()));
     EXPECT_EQ(run.exitCode, 2) << run.err;
     EXPECT_NE(run.err.find("different scene"), std::string::npos) << run.err;
 }
@@ -119,7 +86,7 @@ TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
         const test::CommandResult run = runShade(fmt::format(
             "'{}' --bake '{}' --backend {} --scene-camera 0 --size 48x48 --component indirect "
             "--out '{}'",
-            scenePath("cornell"), f.cornellBake, backends[b], out));
+            test::testScenePath("cornell"), f.cornellBake, backends[b], out));
         ASSERT_EQ(run.exitCode, 0) << run.err;
         auto image = readImage(out);
         ASSERT_TRUE(image.has_value()) << image.error().message;
@@ -134,10 +101,10 @@ TEST(PicrefShade, GpuAndCpuBackendsGiveTheSameImage) {
 TEST(PicrefShade, UnknownGpuDeviceIsABadInput) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
-    const test::CommandResult run =
-        runShade(fmt::format("'{}' --bake '{}' --backend gpu --device no-such-gpu --scene-camera 0 "
-                             "--size 8x8 --out '{}'",
-                             scenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
+    const test::CommandResult run = runShade(
+        fmt::format("'{}' --bake '{}' --backend gpu --device no-such-gpu --scene-camera 0 "
+                    "--size 8x8 --out '{}'",
+                    test::testScenePath("cornell"), f.cornellBake, (f.dir / "gpu.exr").string()));
     EXPECT_EQ(run.exitCode, 2) << run.err;
     EXPECT_NE(run.err.find("no-such-gpu"), std::string::npos) << run.err;
 }
@@ -145,7 +112,8 @@ TEST(PicrefShade, UnknownGpuDeviceIsABadInput) {
 TEST(PicrefShade, BadUsageExitsWithTwo) {
     const ShadeFixture& f = fixture();
     ASSERT_TRUE(f.ok);
-    const std::string base = fmt::format("'{}' --bake '{}'", scenePath("cornell"), f.cornellBake);
+    const std::string base =
+        fmt::format("'{}' --bake '{}'", test::testScenePath("cornell"), f.cornellBake);
     // No --out.
     test::CommandResult run = runShade(base + " --scene-camera 0 --size 8x8");
     EXPECT_EQ(run.exitCode, 2) << run.err;

@@ -8,11 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include "bake/bake.h"
 #include "core/camera.h"
-#include "core/gltf_loader.h"
 #include "core/parallel.h"
 #include "core/sh.h"
+#include "tests/support/baked_scene.h"
 
 namespace pic {
 namespace {
@@ -20,34 +19,8 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 
 /// The cornell test scene and a small bake of it, shared by the tests that need a real bake.
-struct CornellFixture {
-    Scene scene;
-    std::unique_ptr<EmbreeScene> rays;
-    BakeData bake;
-
-    CornellFixture() {
-        auto loaded = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf");
-        EXPECT_TRUE(loaded.has_value()) << (loaded ? "" : loaded.error().message);
-        if (!loaded) return;
-        scene = std::move(*loaded);
-        auto created = EmbreeScene::create(scene);
-        EXPECT_TRUE(created.has_value());
-        rays = std::move(*created);
-        BakeOptions options;
-        options.surfels = 4096;
-        options.links = 64;
-        options.gridCell = 0.2f;
-        options.lightmapTexel = 0.1f;
-        BakeReport report;
-        auto baked = runBake(scene, options, report);
-        EXPECT_TRUE(baked.has_value()) << (baked ? "" : baked.error().message);
-        if (baked) bake = std::move(*baked);
-    }
-};
-
-const CornellFixture& cornell() {
-    static const CornellFixture fixture;
-    return fixture;
+const test::BakedScene& cornell() {
+    return test::bakedScene("cornell", test::smallBakeOptions(4096, 64, 0.2f, 0.1f));
 }
 
 /// Cache values whose every cache holds the constant radiance L (grey): band-0 Y = L·2√π.
@@ -61,7 +34,7 @@ CacheValues constantValues(const BakeData& bake, float radiance) {
 }
 
 TEST(CacheShading, ConstantRadianceGivesAlbedoTimesRadiance) {
-    const CornellFixture& f = cornell();
+    const test::BakedScene& f = cornell();
     ASSERT_TRUE(f.rays);
     constexpr float kRadiance = 0.75f;
     const CacheValues values = constantValues(f.bake, kRadiance);
@@ -95,7 +68,7 @@ TEST(CacheShading, ConstantRadianceGivesAlbedoTimesRadiance) {
 }
 
 TEST(CacheShading, GlossyLobeOfConstantRadianceIsThatRadiance) {
-    const CornellFixture& f = cornell();
+    const test::BakedScene& f = cornell();
     ASSERT_TRUE(f.rays);
     constexpr float kRadiance = 0.5f;
     constexpr float kWeight = 0.3f;
@@ -271,7 +244,7 @@ TEST(CacheShading, EmissionIsVisibleInFullOnlyFromTheFront) {
 }
 
 TEST(CacheShading, IsDeterministicAcrossThreadCounts) {
-    const CornellFixture& f = cornell();
+    const test::BakedScene& f = cornell();
     ASSERT_TRUE(f.rays);
     // Directional radiance per cache, so that every pixel's value depends on its lookup.
     CacheValues values =
@@ -305,7 +278,7 @@ TEST(CacheShading, IsDeterministicAcrossThreadCounts) {
 }
 
 TEST(CacheShading, RejectsValuesAndParametersThatDoNotFit) {
-    const CornellFixture& f = cornell();
+    const test::BakedScene& f = cornell();
     ASSERT_TRUE(f.rays);
     const LightSet lights = defaultLightSet(f.scene);
     const Camera& camera = f.scene.cameras.at(0);

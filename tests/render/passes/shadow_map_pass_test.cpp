@@ -1,7 +1,7 @@
 // The shadow-map pass on lavapipe (or the machine's GPU): merged coplanar casters and solids
 // drawn from one side store the same depths as the scene's own triangles drawn from both
 // sides; levels of detail stay within their error; footprint sides give the orthographic
-// texel at the median receiver distance.
+// texel at the median receiver distance; only lights that changed are rendered again.
 
 #include <gtest/gtest.h>
 
@@ -13,6 +13,7 @@
 #include "core/gltf_loader.h"
 #include "core/light_set.h"
 #include "render/passes/shadow_map_pass.h"
+#include "tests/render/gpu_fixture.h"
 
 namespace pic {
 namespace {
@@ -72,7 +73,7 @@ size_t differingTexels(const std::vector<std::vector<float>>& actual,
 class ShadowCasters : public testing::TestWithParam<std::string> {};
 
 TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
-    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + GetParam() + ".gltf");
+    auto scene = loadScene(test::testScenePath(GetParam()));
     ASSERT_TRUE(scene) << scene.error().message;
     auto context = gpu::Context::create();
     if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
@@ -122,7 +123,7 @@ float metres(const gpu::GpuLight& light, float stored) {
 }
 
 TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
-    auto scene = loadScene(std::string(PIC_TEST_SCENE_DIR) + "/" + GetParam() + ".gltf");
+    auto scene = loadScene(test::testScenePath(GetParam()));
     ASSERT_TRUE(scene) << scene.error().message;
     auto context = gpu::Context::create();
     if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
@@ -138,7 +139,7 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
     const auto levels = (*coarse)->levels();
     for (size_t k = 1; k < levels.size(); ++k) {
         EXPECT_GT(levels[k].error, levels[k - 1].error);
-        EXPECT_LE(levels[k].triangles, gpu::kCasterLevelReduction * levels[k - 1].triangles);
+        EXPECT_LE(levels[k].triangles, kCasterLevelReduction * levels[k - 1].triangles);
     }
     // Only the atrium has curved surfaces (columns) to simplify.
     if (GetParam() == "atrium") {
@@ -153,7 +154,7 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
             if (light.shadowKind == gpu::kShadowOrthographic) {
                 EXPECT_EQ(level, levels.size() - 1);
             }
-            EXPECT_LE(error, gpu::kCasterErrorPerTexel * (*coarse)->layerRecords()[l].texelSlope *
+            EXPECT_LE(error, kCasterErrorPerTexel * (*coarse)->layerRecords()[l].texelSlope *
                                  (light.shadowKind == gpu::kShadowOrthographic ? 1.0f : light.depthFar));
             // Depths differ by more than the level's error only on silhouettes and grazing
             // surfaces, where moving a surface sideways moves the depth along the ray more.
@@ -345,6 +346,34 @@ TEST(ShadowSides, EqualFootprintGivesTheOrthographicTexelAtTheMedianDistance) {
             EXPECT_LE(double(differing), 0.02 * double(compared)) << "layer " << l;
         }
     }
+}
+
+TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu =
+        test::gpuFor(b, BounceParams{1}, {.directVisibility = gpu::DirectVisibility::ShadowMaps});
+    ASSERT_TRUE(gpu);
+    LightSet lights = defaultLightSet(b.scene);
+    ASSERT_FALSE(lights.lights.empty());
+    Light second = lights.lights[0];
+    second.id = "second";
+    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
+    lights.lights.push_back(second);
+    UpdateStats stats;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 2);
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 0);
+    // Colour and intensity do not change a depth map.
+    lights.lights[1].intensity *= 2.0f;
+    lights.lights[1].color = {1.0f, 0.5f, 0.25f};
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 0);
+    // Moving one light re-renders that light only.
+    lights.lights[1].position.x += 0.05f;
+    ASSERT_TRUE(gpu->setLights(lights, &stats));
+    EXPECT_EQ(stats.shadowMapsRendered, 1);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ShadowCasters,

@@ -1,0 +1,186 @@
+// The cache-lighting CPU twin (render/cpu/cache_lighting.h) on one cache with known links: an
+// RTP link projects its node's cone (against quadrature and the closed form, with the YCoCg
+// band split), a tiny cone is a point source, and SH links pass their coefficients through,
+// losing only their half-float rounding.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "core/bake_data.h"
+#include "core/cache_values.h"
+#include "core/color.h"
+#include "core/geometry.h"
+#include "core/sh.h"
+#include "render/cpu/cache_lighting.h"
+
+namespace pic {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+
+/// A bake of one cache over a one-node hierarchy with nL links of the given mode.
+BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t nL,
+                      uint32_t surfels) {
+    BakeData bake;
+    bake.params.bandsY = bandsY;
+    bake.params.bandsC = bandsC;
+    bake.params.linkMode = mode;
+    bake.surfels.resize(surfels);
+    bake.nodes.resize(2 * surfels - 1);
+    bake.caches.resize(1);
+    bake.links.mode = mode;
+    bake.links.linksPerCache = nL;
+    if (mode == LinkMode::Sh) {
+        bake.links.bands = bandsY;
+        bake.links.shNodes.assign(nL, 0u);
+        bake.links.shCoefficients.assign(size_t{nL} * bandsY * bandsY, floatToHalf(0.0f));
+    } else {
+        bake.links.rtp.assign(nL, RtpLink{0, 0.0f, 0, 0.0f});
+    }
+    return bake;
+}
+
+/// Radiance SH of `flux`·factor·indicator(cone of 1 − cos α = u around d), projected by
+/// midpoint quadrature over the cone in a frame around d: an oracle independent of core/sh.h's
+/// zonal factors.
+std::vector<double> coneProjection(int bands, const glm::vec3& d, double u, double scale) {
+    glm::vec3 t, b;
+    orthonormalBasis(d, t, b);
+    const int nTheta = 400, nPhi = 256;
+    const double alpha = std::acos(1.0 - u);
+    std::vector<double> sum(shCount(bands), 0.0);
+    std::vector<float> basis(shCount(bands));
+    for (int i = 0; i < nTheta; ++i) {
+        const double theta = alpha * (i + 0.5) / nTheta;
+        const double weight = std::sin(theta) * (alpha / nTheta) * (2.0 * kPi / nPhi);
+        for (int j = 0; j < nPhi; ++j) {
+            const double phi = 2.0 * kPi * (j + 0.5) / nPhi;
+            const glm::vec3 w = float(std::cos(theta)) * d +
+                                float(std::sin(theta)) *
+                                    (float(std::cos(phi)) * t + float(std::sin(phi)) * b);
+            shEvaluate(bands, glm::normalize(w), basis.data());
+            for (int k = 0; k < shCount(bands); ++k) sum[k] += scale * weight * basis[k];
+        }
+    }
+    return sum;
+}
+
+TEST(CacheLighting, RtpLinkProjectsTheNodeConeWithYCoCgBandSplit) {
+    const uint32_t bandsY = 4, bandsC = 2;
+    BakeData bake = oneCacheBake(LinkMode::Rtp, bandsY, bandsC, 3, 2);
+    const glm::vec3 rgb(3.0f, 2.0f, 1.0f);
+    const float factor = 0.7f, u = 0.3f;
+    bake.links.rtp[0] = RtpLink{1, factor, encodeOctahedral(glm::vec3(1, 2, -3)), u};
+    // Padding: factor 0, here with a node out of range that must never be read.
+    bake.links.rtp[1] = RtpLink{12345, 0.0f, encodeOctahedral(glm::vec3(0, 0, 1)), 1.0f};
+    bake.links.rtp[2] = RtpLink{0, 0.0f, 0, 0.0f};
+    // Node 0 is very bright: padding that read it would show.
+    std::vector<glm::vec3> nodeFlux = {glm::vec3(1e6f), rgb, glm::vec3(1e6f)};
+
+    CacheValues values;
+    lightCaches(bake, nodeFlux, values);
+    ASSERT_EQ(values.cacheCount(), 1u);
+    ASSERT_EQ(values.bandsY, bandsY);
+    ASSERT_EQ(values.bandsC, bandsC);
+    ASSERT_EQ(values.y.size(), 16u);
+    ASSERT_EQ(values.co.size(), 4u);
+
+    const glm::vec3 d = decodeOctahedral(bake.links.rtp[0].directionOct);
+    const glm::vec3 flux = rgbToYCoCg(rgb);
+    const std::vector<double> fluxY = coneProjection(bandsY, d, u, flux.x * factor);
+    const std::vector<double> fluxCo = coneProjection(bandsC, d, u, flux.y * factor);
+    const std::vector<double> fluxCg = coneProjection(bandsC, d, u, flux.z * factor);
+    // The quadrature converges as 1/n²; 1e-4 of the band-0 value is far below any wrong
+    // factor, sign or basis orientation.
+    const double tolerance = 1e-4 * std::abs(fluxY[0]);
+    for (int i = 0; i < 16; ++i) EXPECT_NEAR(values.y[i], fluxY[i], tolerance) << "Y " << i;
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_NEAR(values.co[i], fluxCo[i], tolerance) << "Co " << i;
+        EXPECT_NEAR(values.cg[i], fluxCg[i], tolerance) << "Cg " << i;
+    }
+
+    // The closed form Φ·factor·K_l(α)·y_lm(d), and ∫L dω = 2√π·c00 = Φ·factor·Ω.
+    float basis[16];
+    shEvaluate(bandsY, d, basis);
+    for (int l = 0; l < int(bandsY); ++l)
+        for (int i = l * l; i < (l + 1) * (l + 1); ++i)
+            EXPECT_NEAR(values.y[i], flux.x * factor * coneZonal(l, u) * basis[i], 1e-6)
+                << "Y " << i;
+    const double solidAngle = 2.0 * kPi * u;
+    EXPECT_NEAR(2.0 * std::sqrt(kPi) * values.y[0], flux.x * factor * solidAngle, 1e-5);
+
+    // Back to RGB in the low bands: the RGB flux times the same transport.
+    for (int l = 0; l < int(bandsC); ++l) {
+        for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
+            const glm::vec3 back = yCoCgToRgb({values.y[i], values.co[i], values.cg[i]});
+            const double transport = factor * coneZonal(l, u) * basis[i];
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(back[c], rgb[c] * transport, 1e-5) << "coefficient " << i;
+        }
+    }
+}
+
+TEST(CacheLighting, TinyRtpConeIsTheProjectionOfAPointSource) {
+    // As α → 0 the cone becomes a delta of power Φ·factor·Ω: c_lm = Φ·factor·Ω·y_lm(d). (A
+    // band-limited SH cannot be evaluated back to Φ·factor in direction d; its integral can.)
+    const uint32_t bands = 8;
+    BakeData bake = oneCacheBake(LinkMode::Rtp, bands, bands, 1, 1);
+    const float factor = 2.5f, u = 1e-6f;
+    bake.links.rtp[0] = RtpLink{0, factor, encodeOctahedral(glm::vec3(-0.3f, 0.5f, 0.8f)), u};
+    std::vector<glm::vec3> nodeFlux = {glm::vec3(4.0f)};
+    CacheValues values;
+    lightCaches(bake, nodeFlux, values);
+    const glm::vec3 d = decodeOctahedral(bake.links.rtp[0].directionOct);
+    float basis[64];
+    shEvaluate(bands, d, basis);
+    const double power = 4.0 * factor * 2.0 * kPi * u;
+    for (int i = 0; i < 64; ++i)
+        EXPECT_NEAR(values.y[i], power * basis[i], 1e-4 * power) << "Y " << i;
+    for (int i = 0; i < 64; ++i) EXPECT_EQ(values.co[i], 0.0f);  // grey flux has no chroma
+}
+
+TEST(CacheLighting, ShLinksPassCoefficientsThroughWithChromaTruncated) {
+    // Two real links (nodes 1 and 2) and two padding links; dyadic numbers make every product
+    // and sum exact, so the coefficients must match exactly.
+    const uint32_t bandsY = 3, bandsC = 1, nL = 4;
+    BakeData bake = oneCacheBake(LinkMode::Sh, bandsY, bandsC, nL, 2);
+    const float c1[9] = {0.5f, -0.25f, 1.5f, 0.125f, -2.0f, 0.75f, 0.0f, 3.0f, -0.5f};
+    const float c2[9] = {0.25f, 0.5f, -0.125f, 1.0f, 0.0f, -1.0f, 2.0f, 0.5f, 0.25f};
+    bake.links.shNodes = {1, 2, 0, kNoNode};
+    for (int i = 0; i < 9; ++i) {
+        bake.links.shCoefficients[i] = floatToHalf(c1[i]);
+        bake.links.shCoefficients[9 + i] = floatToHalf(c2[i]);
+    }
+    const glm::vec3 rgb1(4.0f, 2.0f, 1.0f), rgb2(0.5f, 1.0f, 2.0f);
+    std::vector<glm::vec3> nodeFlux = {glm::vec3(1e6f), rgb1, rgb2};
+    CacheValues values;
+    lightCaches(bake, nodeFlux, values);
+    ASSERT_EQ(values.y.size(), 9u);
+    ASSERT_EQ(values.co.size(), 1u);
+    const glm::vec3 f1 = rgbToYCoCg(rgb1), f2 = rgbToYCoCg(rgb2);
+    for (int i = 0; i < 9; ++i) EXPECT_EQ(values.y[i], f1.x * c1[i] + f2.x * c2[i]) << i;
+    EXPECT_EQ(values.co[0], f1.y * c1[0] + f2.y * c2[0]);
+    EXPECT_EQ(values.cg[0], f1.z * c1[0] + f2.z * c2[0]);
+    const glm::vec3 back = yCoCgToRgb({values.y[0], values.co[0], values.cg[0]});
+    EXPECT_EQ(back, rgb1 * c1[0] + rgb2 * c2[0]);
+}
+
+TEST(CacheLighting, HalfRoundingIsTheOnlyLossOfShLinks) {
+    BakeData bake = oneCacheBake(LinkMode::Sh, 2, 2, 1, 1);
+    const float c[4] = {0.1f, -0.3f, 0.7f, 1e-3f};  // not representable in binary16
+    for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
+    std::vector<glm::vec3> nodeFlux = {glm::vec3(2.0f)};
+    CacheValues values;
+    lightCaches(bake, nodeFlux, values);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_NEAR(values.y[i], 2.0f * c[i], 2.0f * std::abs(c[i]) * 0x1p-11f) << i;
+        EXPECT_EQ(values.y[i], 2.0f * halfToFloat(floatToHalf(c[i]))) << i;
+    }
+}
+
+}  // namespace
+}  // namespace pic

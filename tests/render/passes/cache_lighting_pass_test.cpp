@@ -1,0 +1,116 @@
+// The cache-lighting pass on lavapipe (or the machine's GPU): its link packing, and the caches
+// it lights against its CPU twin (render/cpu/cache_lighting.h) for every link form and band
+// split, per subgroup or per invocation, links read in wide texels or a word at a time.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+#include <vector>
+
+#include "core/color.h"
+#include "core/light_set.h"
+#include "render/cpu/cache_lighting.h"
+#include "render/passes/cache_lighting_pass.h"
+#include "tests/render/gpu_fixture.h"
+
+namespace pic {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+TEST(GpuCacheLighting, RtpLinksPackIntoTwelveBytes) {
+    // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as unorm16.
+    const float area = 0.37f;
+    const auto pack = [&](float visible, float oneMinusCos) {
+        const gpu::RtpLink link{42, visible / (kPi * area), encodeOctahedral({0, 0, 1}),
+                                oneMinusCos};
+        return gpu::packRtpLink(link, area);
+    };
+    const auto visibleOf = [](const gpu::GpuRtpLink& l) {
+        return float(l.visibleAndCone & 0xFFFFu) / 65535.0f;
+    };
+    const auto coneOf = [](const gpu::GpuRtpLink& l) {
+        return halfToFloat(uint16_t(l.visibleAndCone >> 16));
+    };
+    for (const float visible : {1.0f, 0.75f, 0.3f, 1e-3f}) {
+        for (const float oneMinusCos : {2.0f, 0.5f, 1e-2f, 3e-5f, 1e-7f}) {
+            const gpu::GpuRtpLink l = pack(visible, oneMinusCos);
+            EXPECT_EQ(l.node, 42u);
+            EXPECT_EQ(l.directionOct, encodeOctahedral({0, 0, 1}));
+            EXPECT_NEAR(visibleOf(l), visible, 0.5f / 65535.0f + 1e-6f * visible);
+            // binary16: relative 2^-11 for normal values, 2^-25 absolute below 2^-14.
+            EXPECT_NEAR(coneOf(l), oneMinusCos, std::max(oneMinusCos / 2048.0f, 3e-8f));
+        }
+    }
+    // A link too faint for unorm16 keeps one step instead of reading as padding; padding
+    // (factor 0) stays 0; rounding never takes V past 1.
+    EXPECT_EQ(pack(1e-7f, 0.1f).visibleAndCone & 0xFFFFu, 1u);
+    EXPECT_EQ(pack(0.0f, 0.1f).visibleAndCone & 0xFFFFu, 0u);
+    EXPECT_EQ(pack(1.0001f, 0.1f).visibleAndCone & 0xFFFFu, 65535u);
+
+    // SH links: c·π·A in binary16, saturating.
+    const float c = 123.5f / (kPi * area);
+    EXPECT_NEAR(halfToFloat(gpu::radianceShCoefficient(floatToHalf(c), area)), 123.5f, 0.1f);
+    EXPECT_EQ(gpu::radianceShCoefficient(floatToHalf(-60000.0f), 10.0f), floatToHalf(-65504.0f));
+    EXPECT_EQ(gpu::radianceShCoefficient(floatToHalf(5.0f), 0.0f), floatToHalf(0.0f));
+}
+
+/// Cache lighting for a link form and band split, each cache lit by a subgroup (as on a
+/// GPU) or by an invocation (as on a CPU device), the links read in the widest texels the
+/// device has or a word at a time.
+class GpuCacheLighting : public testing::TestWithParam<
+                             std::tuple<std::tuple<LinkMode, uint32_t, uint32_t>, bool, uint32_t>> {
+};
+
+TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
+    const auto [form, perSubgroup, texelWords] = GetParam();
+    const auto [mode, bandsY, bandsC] = form;
+    const test::BakedScene& b = test::smallBake("cornell", mode, bandsY, bandsC);
+    ASSERT_TRUE(b.ok);
+    auto gpu =
+        test::gpuFor(b, {}, {.cachePerSubgroup = perSubgroup, .maxLinkTexelWords = texelWords});
+    ASSERT_TRUE(gpu);
+    // A link is 3 words (RTP) or 1 + ⌈lY²/2⌉; every device reads single words, and lavapipe
+    // texels of 2, 3 and 4 words, of which the pass takes 4 or 2 before 3.
+    const uint32_t linkWords = mode == LinkMode::Rtp ? 3 : gpu::shLinkWords(bandsY * bandsY);
+    EXPECT_EQ(linkWords % gpu->linkTexelWords(), 0u);
+    EXPECT_LE(gpu->linkTexelWords(), texelWords);
+    if (texelWords == 1) {
+        EXPECT_EQ(gpu->linkTexelWords(), 1u);
+    }
+    if (gpu->context().isCpuDevice() && texelWords == 4) {
+        const uint32_t expected = linkWords % 4 == 0   ? 4
+                                  : linkWords % 2 == 0 ? 2
+                                  : linkWords % 3 == 0 ? 3
+                                                       : 1;
+        EXPECT_EQ(gpu->linkTexelWords(), expected);
+    }
+    const std::vector<glm::vec3> nodes = test::cpuNodeFlux(b, defaultLightSet(b.scene));
+    CacheValues cpu;
+    lightCaches(b.bake, nodes, cpu);
+    auto values = gpu->runCacheLighting(nodes);
+    ASSERT_TRUE(values) << values.error().message;
+    ASSERT_EQ(values->bandsY, bandsY);
+    ASSERT_EQ(values->bandsC, bandsC);
+    EXPECT_LE(test::relativeL2(*values, cpu), 0.01);
+    EXPECT_GT(test::relativeL2(cpu, CacheValues::zeros(cpu.cacheCount(), bandsY, bandsC)), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(LinkFormsAndBands, GpuCacheLighting,
+                         testing::Combine(testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Rtp, 4u, 1u),
+                                                          std::make_tuple(LinkMode::Rtp, 2u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 4u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 1u, 1u)),
+                                          testing::Bool(), testing::Values(4u)));
+INSTANTIATE_TEST_SUITE_P(WordTexels, GpuCacheLighting,
+                         testing::Combine(testing::Values(std::make_tuple(LinkMode::Rtp, 3u, 2u),
+                                                          std::make_tuple(LinkMode::Sh, 3u, 2u)),
+                                          testing::Bool(), testing::Values(1u)));
+
+}  // namespace
+}  // namespace pic

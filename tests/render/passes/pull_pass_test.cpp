@@ -1,0 +1,87 @@
+// The pull pass on lavapipe (or the machine's GPU) against its CPU twin (render/cpu/pull.h):
+// node flux bit for bit in both of its modes, and node radiance as RGBE8 of flux over π·A.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "core/color.h"
+#include "core/light_set.h"
+#include "render/cpu/pull.h"
+#include "render/passes/pull_pass.h"
+#include "shaders/shared/pull.h"
+#include "tests/render/gpu_fixture.h"
+
+namespace pic {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+TEST(GpuPull, NodeFluxIsExact) {
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    // Both of the pull's modes run: large levels a dispatch each, the small upper ones as
+    // the tail.
+    const std::vector<uint32_t>& offsets = b.bake.levelOffsets;
+    ASSERT_GT(offsets[1] - offsets[0], gpu::kPullTailNodes);
+    ASSERT_LE(offsets.back() - offsets[offsets.size() - 2], gpu::kPullTailNodes);
+    auto gpu = test::gpuFor(b);
+    ASSERT_TRUE(gpu);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 2.0f);
+    std::vector<glm::vec3> nodes(b.bake.nodes.size(), glm::vec3(0.0f));
+    for (size_t i = 0; i < b.bake.surfels.size(); ++i) nodes[i] = {u(rng), u(rng), u(rng)};
+    auto pulled = gpu->runPull(std::span<const glm::vec3>(nodes.data(), b.bake.surfels.size()));
+    ASSERT_TRUE(pulled) << pulled.error().message;
+    pullFlux(b.bake, nodes);
+    // Each inner node is one float addition of the same two children: bit-exact.
+    for (size_t n = 0; n < nodes.size(); ++n) ASSERT_EQ((*pulled)[n], nodes[n]) << "node " << n;
+}
+
+TEST(GpuPull, NodeRadianceIsFluxOverPiAreaAsRgbe8) {
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = test::gpuFor(b, {}, {.directVisibility = gpu::DirectVisibility::Rays});
+    ASSERT_TRUE(gpu);
+    const size_t nS = b.bake.surfels.size();
+    // Leaves: surfel lighting packs flux / (π·A), its division rounded by the device, so the
+    // code may differ from the host's by one mantissa step (at most 2^-7 of the largest
+    // channel) besides the rounding (2^-8).
+    auto direct = gpu->runDirect(defaultLightSet(b.scene));
+    ASSERT_TRUE(direct) << direct.error().message;
+    auto leaves = gpu->nodeRadiance();
+    ASSERT_TRUE(leaves) << leaves.error().message;
+    size_t lit = 0;
+    for (size_t i = 0; i < nS; ++i) {
+        const glm::vec3 expected = (*direct)[i] / (kPi * b.bake.surfels[i].area);
+        const glm::vec3 got = unpackRgbe8((*leaves)[i]);
+        const float largest = std::max({expected.r, expected.g, expected.b});
+        if (largest > 0.0f) ++lit;
+        for (int c = 0; c < 3; ++c)
+            ASSERT_LE(std::abs(got[c] - expected[c]), largest / 64.0f) << "surfel " << i;
+    }
+    EXPECT_GT(lit, nS / 4);
+
+    // Inner nodes: the pull's float sum times the uploaded 1 / (π·A), packed with the same
+    // exact operations as packRgbe8: bit for bit.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 3.0f);
+    std::vector<glm::vec3> flux(nS);
+    for (glm::vec3& f : flux) f = {u(rng), u(rng), u(rng)};
+    auto pulled = gpu->runPull(flux);
+    ASSERT_TRUE(pulled) << pulled.error().message;
+    auto radiance = gpu->nodeRadiance();
+    ASSERT_TRUE(radiance) << radiance.error().message;
+    for (size_t n = nS; n < b.bake.nodes.size(); ++n)
+        ASSERT_EQ((*radiance)[n],
+                  packRgbe8((*pulled)[n] * gpu::radianceScale(b.bake.nodes[n].area)))
+            << "node " << n;
+}
+
+}  // namespace
+}  // namespace pic
