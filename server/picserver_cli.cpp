@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/cli.h"
+#include "render/gpu_runtime_flags.h"
 #include "server/service.h"
 
 namespace pic {
@@ -73,22 +74,7 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--listen", listen, "HOST:PORT to serve on; port 0 picks a free one");
     app.add_option("--backend", serve.backend, "runtime backend (cpu: the CPU twin)")
         ->check(CLI::IsMember({"cpu", "gpu"}));
-    addDeviceOption(app, serve.device);
-    app.add_option("--shadow-map-size", serve.shadowMapSize,
-                   "gpu backend: texels per side of each shadow-map layer")
-        ->check(CLI::Range(16u, 8192u));
-    app.add_option_function<std::string>(
-           "--shadow-sides",
-           [&](const std::string& sides) { serve.shadowEqualFootprint = sides == "footprint"; },
-           "gpu backend: footprint (default; point and spot layers only as wide as gives the "
-           "directional layer's texel at the median distance of the surfaces they light) or "
-           "uniform (every layer --shadow-map-size wide)")
-        ->check(CLI::IsMember({"footprint", "uniform"}));
-    app.add_option("--direct-visibility", serve.directVisibility,
-                   "gpu backend: where direct light's visibility comes from: shadow-maps, rays "
-                   "(one ray per surfel and light, traced on the host with Embree: exact) or auto "
-                   "(default: rays on a CPU device such as lavapipe, shadow maps on a GPU)")
-        ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
+    addGpuRuntimeFlags(app, serve.gpu);
     app.add_option("--bounces", serve.bounces.bounces,
                    "cache passes per update: 0 = direct light only, B = up to B reflections "
                    "(default: until a bounce adds < 0.5 % of the flux, at most 8)")

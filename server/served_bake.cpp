@@ -52,14 +52,8 @@ Result<std::unique_ptr<ServedBake>> ServedBake::load(const std::string& bakePath
 
     PIC_TRY_ASSIGN(served->mRays, EmbreeScene::create(served->mScene));
     if (options.backend == "gpu") {
-        GpuRuntimeOptions gpuOptions;
-        gpuOptions.deviceName = options.device;
-        gpuOptions.shadowMapSize = options.shadowMapSize;
-        gpuOptions.shadowEqualFootprint = options.shadowEqualFootprint;
-        PIC_TRY_ASSIGN(gpuOptions.directVisibility,
-                       gpu::parseDirectVisibility(options.directVisibility));
         PIC_TRY_ASSIGN(auto gpu, GpuRuntime::create(served->mScene, *served->mRays, served->mBake,
-                                                    options.bounces, gpuOptions));
+                                                    options.bounces, options.gpu));
         served->mDevice = gpu->context().deviceName();
         served->mDirectVisibility = gpu::directVisibilityName(gpu->directVisibility());
         served->mRuntime = std::move(gpu);

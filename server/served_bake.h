@@ -14,19 +14,16 @@
 #include "core/scene.h"
 #include "proto/pic.pb.h"
 #include "rays/embree_scene.h"
+#include "render/gpu_runtime.h"
 #include "render/runtime.h"
 
 namespace pic {
 
 /// How the server relights its bakes.
 struct ServeOptions {
-    std::string backend = "gpu";    ///< "gpu" or "cpu" (the CPU twin)
-    std::string device;             ///< gpu: substring of the Vulkan device name; empty = best
-    uint32_t shadowMapSize = 1024;  ///< gpu: texels per side of each shadow-map layer
-    bool shadowEqualFootprint = true;  ///< gpu: GpuRuntimeOptions::shadowEqualFootprint
-    /// gpu: GpuRuntimeOptions::directVisibility as "auto", "shadow-maps" or "rays".
-    std::string directVisibility = "auto";
-    BounceParams bounces;           ///< progressive by default, as everywhere
+    std::string backend = "gpu";  ///< "gpu" or "cpu" (the CPU twin)
+    GpuRuntimeOptions gpu;        ///< the gpu backend's device, shadow maps and visibility
+    BounceParams bounces;         ///< progressive by default, as everywhere
 };
 
 /// Bytes of one SceneChunk data message.

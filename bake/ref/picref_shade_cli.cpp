@@ -17,6 +17,7 @@
 #include "render/cpu/cache_shading.h"
 #include "render/cpu_runtime.h"
 #include "render/gpu_runtime.h"
+#include "render/gpu_runtime_flags.h"
 
 namespace pic {
 namespace {
@@ -34,9 +35,7 @@ struct ShadeCommand {
     std::string scenePath;
     std::string bakePath;
     std::string backend = "cpu";
-    std::string device;              ///< --device: Vulkan device name substring (gpu backend)
-    uint32_t shadowMapSize = 1024;   ///< --shadow-map-size (gpu backend)
-    std::string directVisibility = "auto";  ///< --direct-visibility (gpu backend)
+    GpuRuntimeOptions gpu;  ///< the gpu backend's flags
     std::string lightsPath;
     ViewFlags view;
     ShadeFlags shade;
@@ -47,9 +46,6 @@ struct ShadeCommand {
 
 /// Checks what can be checked without reading files, so that usage errors come first.
 Result<void> checkUsage(const ShadeCommand& command) {
-    if (command.shadowMapSize < 16 || command.shadowMapSize > 16384)
-        return fail(ErrorCode::InvalidInput, "--shadow-map-size {} must be in [16, 16384]",
-                    command.shadowMapSize);
     if (command.bounces < -1)
         return fail(ErrorCode::InvalidInput, "--bounces {} must be ≥ 0 (or −1: until converged)",
                     command.bounces);
@@ -83,13 +79,8 @@ int runShade(const ShadeCommand& command) {
     if (!rays) return reportError(rays.error());
     Result<std::unique_ptr<Runtime>> runtime;
     if (command.backend == "gpu") {
-        GpuRuntimeOptions options;
-        options.deviceName = command.device;
-        options.shadowMapSize = command.shadowMapSize;
-        auto visibility = gpu::parseDirectVisibility(command.directVisibility);
-        if (!visibility) return reportError(visibility.error());
-        options.directVisibility = *visibility;
-        auto gpu = GpuRuntime::create(*scene, **rays, *bake, BounceParams{command.bounces}, options);
+        auto gpu =
+            GpuRuntime::create(*scene, **rays, *bake, BounceParams{command.bounces}, command.gpu);
         if (!gpu) return reportError(gpu.error());
         std::fprintf(stderr, "picref shade: GPU backend on \"%s\", direct visibility by %s\n",
                      (*gpu)->context().deviceName().c_str(),
@@ -134,13 +125,7 @@ int picrefShadeMain(int argc, char** argv) {
     app.add_option("--bake", command.bakePath, "bake file of this scene (.pic)")->required();
     app.add_option("--backend", command.backend, "runtime backend")
         ->check(CLI::IsMember({"cpu", "gpu"}));
-    addDeviceOption(app, command.device);
-    app.add_option("--shadow-map-size", command.shadowMapSize,
-                   "gpu backend: texels per side of each shadow-map layer (default 1024)");
-    app.add_option("--direct-visibility", command.directVisibility,
-                   "gpu backend: shadow-maps, rays (traced on the host) or auto (default: rays on "
-                   "a CPU device, shadow maps on a GPU)")
-        ->check(CLI::IsMember({"auto", "shadow-maps", "rays"}));
+    addGpuRuntimeFlags(app, command.gpu);
     addLightsOption(app, command.lightsPath);
     command.view.addTo(app);
     command.shade.addTo(app);

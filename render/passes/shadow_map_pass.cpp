@@ -77,8 +77,9 @@ uint32_t footprintSide(float slopeAtOneTexel, float distance, float footprint, u
 Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
                                                              uint32_t size,
                                                              const ShadowMapOptions& options) {
-    if (size < 16 || size > 16384)
-        return fail(ErrorCode::InvalidInput, "shadow-map size must be in [16, 16384], got {}", size);
+    if (size < kMinShadowMapSize || size > kMaxShadowMapSize)
+        return fail(ErrorCode::InvalidInput, "shadow-map size must be in [{}, {}], got {}",
+                    kMinShadowMapSize, kMaxShadowMapSize, size);
     if (scene.triangles.empty() || scene.bounds.empty())
         return fail(ErrorCode::InvalidInput, "scene {} has no triangles to cast shadows",
                     scene.sourcePath);

@@ -33,6 +33,10 @@
 
 namespace pic::gpu {
 
+/// Sides of a shadow-map layer the pass accepts, texels.
+inline constexpr uint32_t kMinShadowMapSize = 16;
+inline constexpr uint32_t kMaxShadowMapSize = 16384;
+
 /// Spots with a wider outer half-angle get a cube map (a single perspective layer would
 /// need a field of view near 180°). Radians.
 inline constexpr float kMaxPerspectiveSpot = 1.0472f;  // 60°
