@@ -3,6 +3,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <system_error>
 
@@ -18,7 +20,34 @@ std::string_view trimmed(std::string_view text) {
     return text.substr(begin, end - begin + 1);
 }
 
+bool finite(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+/// Why `camera` cannot render, or nothing when it can.
+std::optional<std::string> cameraProblem(const Camera& camera) {
+    if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up) ||
+        !std::isfinite(camera.fovyDegrees))
+        return "a number is not finite";
+    const glm::vec3 view = camera.target - camera.eye;
+    if (!(glm::length(view) > 0.0f)) return "eye and target are the same point";
+    // Relative test, so that scenes in millimetres or kilometres behave alike.
+    const float upLength = glm::length(camera.up);
+    if (!(upLength > 0.0f) ||
+        glm::length(glm::cross(view / glm::length(view), camera.up / upLength)) < 1e-4f)
+        return "up vector is zero or parallel to the view direction";
+    if (!(camera.fovyDegrees > 0.0f && camera.fovyDegrees < 180.0f))
+        return fmt::format("fovy must be in (0, 180) degrees, got {}", camera.fovyDegrees);
+    return std::nullopt;
+}
+
 }  // namespace
+
+Result<void> checkCamera(const Camera& camera) {
+    if (auto problem = cameraProblem(camera))
+        return fail(ErrorCode::InvalidInput, "camera \"{}\": {}", camera.name, *problem);
+    return {};
+}
 
 Result<Camera> parseCamera(const std::string& text) {
     constexpr const char* kUsage = "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy";
@@ -52,20 +81,8 @@ Result<Camera> parseCamera(const std::string& text) {
     camera.up = {values[6], values[7], values[8]};
     camera.fovyDegrees = values[9];
 
-    glm::vec3 view = camera.target - camera.eye;
-    if (!(glm::length(view) > 0.0f))
-        return fail(ErrorCode::InvalidInput, "--camera eye and target are the same point in \"{}\"",
-                    text);
-    // Relative test, so that scenes in millimetres or kilometres behave alike.
-    float upLength = glm::length(camera.up);
-    if (!(upLength > 0.0f) ||
-        glm::length(glm::cross(view / glm::length(view), camera.up / upLength)) < 1e-4f)
-        return fail(ErrorCode::InvalidInput,
-                    "--camera up vector is zero or parallel to the view direction in \"{}\"", text);
-    if (!(camera.fovyDegrees > 0.0f && camera.fovyDegrees < 180.0f))
-        return fail(ErrorCode::InvalidInput,
-                    "--camera fovy must be in (0, 180) degrees, got {} in \"{}\"",
-                    camera.fovyDegrees, text);
+    if (auto problem = cameraProblem(camera))
+        return fail(ErrorCode::InvalidInput, "--camera {} in \"{}\"", *problem, text);
     return camera;
 }
 

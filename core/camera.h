@@ -16,6 +16,11 @@ namespace pic {
 /// outside (0, 180).
 Result<Camera> parseCamera(const std::string& text);
 
+/// InvalidInput naming the camera when a number is not finite, eye == target, up is zero or
+/// parallel to the view direction, or fovy is outside (0, 180): what parseCamera checks, for
+/// cameras that did not come through it.
+Result<void> checkCamera(const Camera& camera);
+
 /// The scene's N-th camera (0-based); InvalidInput if it has fewer.
 Result<Camera> sceneCamera(const Scene& scene, int index);
 

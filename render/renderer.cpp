@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/camera.h"
 #include "core/sh.h"
 #include "render/passes/cache_shading_pass.h"
 #include "render/passes/gbuffer_pass.h"
@@ -21,28 +22,6 @@ constexpr uint32_t kTimedPasses = 4;
 
 bool finite(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-/// The checks of core/camera.h parseCamera, for cameras that did not come through it.
-Result<void> checkCamera(const Camera& camera) {
-    if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up) ||
-        !std::isfinite(camera.fovyDegrees))
-        return fail(ErrorCode::InvalidInput, "camera \"{}\" has a non-finite number", camera.name);
-    const glm::vec3 view = camera.target - camera.eye;
-    if (!(glm::length(view) > 0.0f))
-        return fail(ErrorCode::InvalidInput, "camera \"{}\": eye and target are the same point",
-                    camera.name);
-    const float upLength = glm::length(camera.up);
-    if (!(upLength > 0.0f) ||
-        glm::length(glm::cross(view / glm::length(view), camera.up / upLength)) < 1e-4f)
-        return fail(ErrorCode::InvalidInput,
-                    "camera \"{}\": up vector is zero or parallel to the view direction",
-                    camera.name);
-    if (!(camera.fovyDegrees > 0.0f && camera.fovyDegrees < 180.0f))
-        return fail(ErrorCode::InvalidInput,
-                    "camera \"{}\": fovy must be in (0, 180) degrees, got {}", camera.name,
-                    camera.fovyDegrees);
-    return {};
 }
 
 /// The layout fits the scene and the shaders (band counts they are built for, finite numbers).

@@ -55,6 +55,34 @@ TEST(CameraParse, RejectsDegenerateGeometry) {
     expectInvalid("0,0,1,0,0,0,0,1,0,-30", "fovy must be in (0, 180)");
 }
 
+TEST(CameraCheck, RefusesWhatParseCameraRefusesNamingTheCamera) {
+    Camera camera;
+    camera.name = "Overview";
+    camera.eye = {0.0f, 0.0f, 1.0f};
+    camera.up = {0.0f, 1.0f, 0.0f};
+    camera.fovyDegrees = 45.0f;
+    EXPECT_TRUE(checkCamera(camera));
+    auto expectRefused = [](const Camera& bad, const std::string& part) {
+        auto checked = checkCamera(bad);
+        ASSERT_FALSE(checked) << part;
+        EXPECT_EQ(checked.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(checked.error().message.find("camera \"Overview\": " + part), std::string::npos)
+            << checked.error().message;
+    };
+    Camera bad = camera;
+    bad.eye.x = std::nanf("");
+    expectRefused(bad, "a number is not finite");
+    bad = camera;
+    bad.target = bad.eye;
+    expectRefused(bad, "eye and target are the same point");
+    bad = camera;
+    bad.up = {0.0f, 0.0f, 2.0f};
+    expectRefused(bad, "up vector is zero or parallel");
+    bad = camera;
+    bad.fovyDegrees = 180.0f;
+    expectRefused(bad, "fovy must be in (0, 180) degrees, got 180");
+}
+
 TEST(SceneCamera, PicksTheNthCameraOrNamesTheCount) {
     Scene scene;
     scene.sourcePath = "room.gltf";
