@@ -51,6 +51,46 @@ RTCRay makeRay(const glm::vec3& origin, const glm::vec3& direction, float tNear,
     return ray;
 }
 
+/// Distance from p to the nearest point of triangle abc (Ericson, Real-Time Collision
+/// Detection §5.1.5: the Voronoi region of p among the corners, edges and face), in double:
+/// in float, long thin triangles (merged strips) lose tens of micrometres to cancellation.
+double distanceToTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
+                          const glm::dvec3& c) {
+    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) return glm::length(ap);
+    const glm::dvec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) return glm::length(bp);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+    const glm::dvec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) return glm::length(cp);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
+        return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+    const double denominator = va + vb + vc;
+    if (!(denominator > 0.0)) return glm::length(ap);  // degenerate: the edges decided above
+    return glm::length(p - (a + ab * (vb / denominator) + ac * (vc / denominator)));
+}
+
+/// Point-query callback: shrinks the query radius to the distance of the nearest triangle of
+/// the Scene behind userPtr.
+bool nearerTriangle(RTCPointQueryFunctionArguments* args) {
+    const Scene& scene = *static_cast<const Scene*>(args->userPtr);
+    const Triangle& t = scene.triangles[args->primID];
+    const glm::dvec3 p(args->query->x, args->query->y, args->query->z);
+    const float d = float(distanceToTriangle(p, scene.vertices[t.v[0]].position,
+                                             scene.vertices[t.v[1]].position,
+                                             scene.vertices[t.v[2]].position));
+    if (!(d < args->query->radius)) return false;
+    args->query->radius = d;
+    return true;
+}
+
 }  // namespace
 
 EmbreeScene::~EmbreeScene() = default;
@@ -139,6 +179,14 @@ std::optional<RayHit> EmbreeScene::intersect(const glm::vec3& origin, const glm:
     hit.geometricNormal = mImpl->triangleNormals[hit.triangle];
     hit.backFace = glm::dot(hit.geometricNormal, direction) > 0.0f;
     return hit;
+}
+
+float EmbreeScene::nearestDistance(const glm::vec3& point, float limit) const {
+    RTCPointQuery query{point.x, point.y, point.z, 0.0f, limit};
+    RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    rtcPointQuery(mImpl->scene, &query, &context, nearerTriangle, const_cast<Scene*>(mScene));
+    return query.radius < limit ? query.radius : std::numeric_limits<float>::infinity();
 }
 
 }  // namespace pic

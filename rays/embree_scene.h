@@ -1,6 +1,7 @@
 #pragma once
-/// Ray queries against the scene's triangles with Embree 3: occlusion for visibility
-/// and closest hits for cache placement and the path tracer. Thread-safe queries.
+/// Queries against the scene's triangles with Embree 3: occlusion for visibility, closest hits
+/// for cache placement and the path tracer, nearest points for measuring simplified shadow
+/// casters. Thread-safe queries.
 
 #include <cstdint>
 #include <memory>
@@ -40,6 +41,10 @@ public:
     /// Closest hit along origin + t·direction for t in (tNear, tFar), if any.
     std::optional<RayHit> intersect(const glm::vec3& origin, const glm::vec3& direction,
                                     float tNear, float tFar) const;
+
+    /// Distance (metres) from `point` to the nearest point of the scene's triangles, +∞ when
+    /// none lies within `limit` (an Embree point query; distances computed in double).
+    float nearestDistance(const glm::vec3& point, float limit) const;
 
     /// A distance that is small against the scene (1e-5 of its diagonal, at least 1e-6 m),
     /// used to offset ray origins from surfaces.

@@ -1,5 +1,6 @@
 // Shadow-caster preparation (render/shadow_casters.h): welding, merging and simplifying casters
-// with meshoptimizer, measuring them with Embree point queries, clustering and culling.
+// with meshoptimizer, measuring them with point queries (rays/embree_scene.h), clustering and
+// culling.
 
 #include "render/shadow_casters.h"
 
@@ -9,10 +10,10 @@
 #include <numeric>
 #include <utility>
 
-#include <embree3/rtcore.h>
 #include <meshoptimizer.h>
 
 #include "core/parallel.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 namespace {
@@ -57,46 +58,6 @@ Scene simplifiedCasters(const Scene& scene, float relativeError) {
     return casters;
 }
 
-/// Distance from p to the nearest point of triangle abc (Ericson, Real-Time Collision
-/// Detection §5.1.5: the Voronoi region of p among the corners, edges and face), in double:
-/// in float, long thin triangles (merged strips) lose tens of micrometres to cancellation.
-double distanceToTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
-                          const glm::dvec3& c) {
-    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) return glm::length(ap);
-    const glm::dvec3 bp = p - b;
-    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) return glm::length(bp);
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
-    const glm::dvec3 cp = p - c;
-    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) return glm::length(cp);
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0)
-        return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-    const double denominator = va + vb + vc;
-    if (!(denominator > 0.0)) return glm::length(ap);  // degenerate: the edges decided above
-    return glm::length(p - (a + ab * (vb / denominator) + ac * (vc / denominator)));
-}
-
-/// Embree point-query callback: shrinks the query radius to the distance of the nearest
-/// triangle of the Scene behind userPtr.
-bool nearerTriangle(RTCPointQueryFunctionArguments* args) {
-    const Scene& scene = *static_cast<const Scene*>(args->userPtr);
-    const Triangle& t = scene.triangles[args->primID];
-    const glm::dvec3 p(args->query->x, args->query->y, args->query->z);
-    const float d = float(distanceToTriangle(p, scene.vertices[t.v[0]].position,
-                                             scene.vertices[t.v[1]].position,
-                                             scene.vertices[t.v[2]].position));
-    if (!(d < args->query->radius)) return false;
-    args->query->radius = d;
-    return true;
-}
-
 /// The eight corners' extreme of the plane function a·(p, 1) over a box: the corner farthest
 /// along the plane's normal (largest) or against it (smallest).
 float planeMax(const glm::vec4& plane, const Aabb& box) {
@@ -133,22 +94,8 @@ float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit) {
     constexpr float kInfinity = std::numeric_limits<float>::infinity();
     if (fine.triangles.empty()) return 0.0f;
     if (coarse.triangles.empty()) return kInfinity;
-    RTCDevice device = rtcNewDevice(nullptr);
-    if (!device) return kInfinity;
-    RTCScene scene = rtcNewScene(device);
-    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* positions = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), coarse.vertices.size()));
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), coarse.triangles.size()));
-    for (size_t v = 0; v < coarse.vertices.size(); ++v)
-        for (int k = 0; k < 3; ++k) positions[3 * v + k] = coarse.vertices[v].position[k];
-    for (size_t t = 0; t < coarse.triangles.size(); ++t)
-        for (int k = 0; k < 3; ++k) indices[3 * t + k] = coarse.triangles[t].v[k];
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(scene, geometry);
-    rtcReleaseGeometry(geometry);
-    rtcCommitScene(scene);
+    auto rays = EmbreeScene::create(coarse);
+    if (!rays) return kInfinity;
 
     // Samples: every corner (once per triangle that uses it: cheap, and no index needed)
     // and every centroid.
@@ -157,16 +104,9 @@ float surfaceDeviation(const Scene& fine, const Scene& coarse, float limit) {
         const Triangle& tri = fine.triangles[t];
         const glm::vec3 a = fine.vertices[tri.v[0]].position, b = fine.vertices[tri.v[1]].position,
                         c = fine.vertices[tri.v[2]].position;
-        for (const glm::vec3& p : {a, b, c, (a + b + c) / 3.0f}) {
-            RTCPointQuery query{p.x, p.y, p.z, 0.0f, limit};
-            RTCPointQueryContext context;
-            rtcInitPointQueryContext(&context);
-            rtcPointQuery(scene, &query, &context, nearerTriangle, const_cast<Scene*>(&coarse));
-            worst[t] = std::max(worst[t], query.radius < limit ? query.radius : kInfinity);
-        }
+        for (const glm::vec3& p : {a, b, c, (a + b + c) / 3.0f})
+            worst[t] = std::max(worst[t], (*rays)->nearestDistance(p, limit));
     });
-    rtcReleaseScene(scene);
-    rtcReleaseDevice(device);
     return *std::max_element(worst.begin(), worst.end());
 }
 

@@ -3,9 +3,9 @@
 /// CPU geometry: the scene's triangles welded and coplanar runs merged, coarser levels of
 /// detail simplified and their distance from the scene measured, triangles split into
 /// spatially compact clusters, and the clusters culled against a layer's clip volume.
-/// The levels of detail are measured with Embree point queries when a scene is loaded: that is
-/// why the engine, and so the thin client that shades with it, links Embree
-/// (ARCHITECTURE.md §2 lets render/ depend on rays/).
+/// The levels of detail are measured with Embree point queries (rays/embree_scene.h) when a
+/// scene is loaded: that is why the engine, and so the thin client that shades with it, links
+/// Embree (ARCHITECTURE.md §2 lets render/ depend on rays/).
 
 #include <cstdint>
 #include <span>
