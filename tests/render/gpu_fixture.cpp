@@ -31,6 +31,17 @@ std::unique_ptr<GpuRuntime> gpuFor(const BakedScene& b, BounceParams bounces,
     return std::move(*runtime);
 }
 
+LightSet twoLights(const Scene& scene) {
+    LightSet lights = defaultLightSet(scene);
+    EXPECT_FALSE(lights.lights.empty()) << scene.sourcePath;
+    if (lights.lights.empty()) return lights;
+    Light second = lights.lights[0];
+    second.id = "second";
+    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
+    lights.lights.push_back(second);
+    return lights;
+}
+
 double relativeL2(const CacheValues& a, const CacheValues& b) {
     double diff = 0.0, norm = 0.0;
     const std::vector<float>* pa[3] = {&a.y, &a.co, &a.cg};

@@ -28,6 +28,10 @@ const BakedScene& smallBake(const std::string& name, LinkMode mode, uint32_t ban
 std::unique_ptr<GpuRuntime> gpuFor(const BakedScene& b, BounceParams bounces = {},
                                    const GpuRuntimeOptions& options = {});
 
+/// The scene's own lights and a copy of the first, named "second", moved by (0.1, −0.2,
+/// 0.05) m: what the tests of per-light visibility reuse change, one light at a time.
+LightSet twoLights(const Scene& scene);
+
 /// ‖a − b‖ / ‖b‖ over all coefficients of all channels.
 double relativeL2(const CacheValues& a, const CacheValues& b);
 

@@ -17,12 +17,9 @@ TEST(GpuRayVisibility, OnlyLightsThatChangedAreRetracedAndMoreLightsKeepTheirBit
     const GpuRuntimeOptions options{.directVisibility = gpu::DirectVisibility::Rays};
     auto gpu = test::gpuFor(b, BounceParams{1}, options);
     ASSERT_TRUE(gpu);
-    LightSet lights = defaultLightSet(b.scene);
-    ASSERT_FALSE(lights.lights.empty());
-    Light second = lights.lights[0];
-    second.id = "second";
-    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
-    lights.lights.push_back(second);
+    LightSet lights = test::twoLights(b.scene);
+    ASSERT_EQ(lights.lights.size(), 2u);
+    const Light second = lights.lights[1];
     UpdateStats stats;
     ASSERT_TRUE(gpu->setLights(lights, &stats));
     EXPECT_EQ(stats.lightsTraced, 2);

@@ -354,12 +354,8 @@ TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
     auto gpu =
         test::gpuFor(b, BounceParams{1}, {.directVisibility = gpu::DirectVisibility::ShadowMaps});
     ASSERT_TRUE(gpu);
-    LightSet lights = defaultLightSet(b.scene);
-    ASSERT_FALSE(lights.lights.empty());
-    Light second = lights.lights[0];
-    second.id = "second";
-    second.position += glm::vec3(0.1f, -0.2f, 0.05f);
-    lights.lights.push_back(second);
+    LightSet lights = test::twoLights(b.scene);
+    ASSERT_EQ(lights.lights.size(), 2u);
     UpdateStats stats;
     ASSERT_TRUE(gpu->setLights(lights, &stats));
     EXPECT_EQ(stats.shadowMapsRendered, 2);
