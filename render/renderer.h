@@ -1,7 +1,7 @@
 #pragma once
 /// The thin client's headless renderer (ARCHITECTURE.md §1, `picclient render`): one frame of
-/// a scene shaded from the cache textures the server streams, on any Vulkan 1.3 device
-/// (lavapipe without a GPU). A rasterised G-buffer, direct light from shadow maps
+/// a scene shaded from cache textures (core/cache_textures.h: the client writes them from the
+/// caches the server streams), on any Vulkan 1.3 device (lavapipe without a GPU). A rasterised G-buffer, direct light from shadow maps
 /// (render/passes/shadow_map_pass.h), the cache term from the light map (bilinear) on
 /// light-mapped surfaces and the grid (trilinear) elsewhere (paper 000 §3.2), emission; the
 /// image holds the radiance at pixel centres. The CPU twin is render/cpu/cache_shading.h:
