@@ -9,6 +9,7 @@
 #include "bake/grid_caches.h"
 #include "bake/lightmap_caches.h"
 #include "bake/lightmap_charts.h"
+#include "bake/surfel_exposure.h"
 #include "bake/surfel_hierarchy.h"
 #include "bake/surfel_placement.h"
 #include "core/sh.h"
@@ -158,6 +159,9 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     p.linkSamples = options.linkSamples;
     if (p.linkSamples < 1 || p.linkSamples > 1024)
         return fail(ErrorCode::InvalidInput, "--link-samples must be in [1, 1024], got {}", p.linkSamples);
+    p.exposureRays = options.exposureRays;
+    if (p.exposureRays > 1024)
+        return fail(ErrorCode::InvalidInput, "--exposure-rays must be in [0, 1024], got {}", p.exposureRays);
     p.relaxIterations = options.relaxIterations;
     p.seed = options.seed;
     return p;
@@ -215,6 +219,16 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     report.lightmapGridShaded = lightmap.gridShadedTriangles;
     lightmapTimer.stop();
 
+    // The links' flux weights (bake/surfel_exposure.h), surfels in leaf order.
+    std::vector<float> weights;
+    if (p.exposureRays > 0) {
+        StageTimer exposureTimer(report, "exposure");
+        PIC_TRY_ASSIGN(const std::vector<float> freeDistance,
+                       surfelFreeDistance(*rays, scene.bounds, exposureReach(scene), bake.surfels,
+                                          ExposureParams{p.exposureRays, p.seed}));
+        weights = fluxWeights(bake.surfels, freeDistance);
+    }
+
     StageTimer linkTimer(report, "links");
     LinkParams linkParams;
     linkParams.linksPerCache = p.linksPerCache;
@@ -222,7 +236,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.bands = p.bandsY;
     linkParams.samplesPerNode = p.linkSamples;
     linkParams.seed = p.seed;
-    PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams));
+    PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
     bake.links = std::move(links.links);
     report.links = links.stats;
     report.blindCachesDropped = dropBlindCaches(bake, links.visibleSolidAngle);

@@ -25,6 +25,7 @@ struct BakeOptions {
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
     uint32_t linkSamples = 16;
+    uint32_t exposureRays = 64;
     uint32_t relaxIterations = 4;
     uint64_t seed = 1;
 };

@@ -14,6 +14,9 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     command.add_option("--hierarchy", mHierarchy, "agglomerative or kdtree (default agglomerative)")
         ->check(CLI::IsMember({"agglomerative", "kdtree"}));
     command.add_option("--link-samples", mOptions.linkSamples, "visibility rays per node estimate (default 16)");
+    command.add_option("--exposure-rays", mOptions.exposureRays,
+                       "rays per surfel that weight a node's flux towards its exposed surfels; 0: the "
+                       "paper's uniform node radiance (default 64)");
     command.add_option("--relax", mOptions.relaxIterations, "surfel relaxation iterations (default 4)");
     command.add_option("--seed", mOptions.seed, "random seed (default 1)");
 }

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <queue>
 
+#include "bake/surfel_exposure.h"
 #include "core/color.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -18,11 +19,11 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-/// A visible surfel sample of a node: direction from the cache and its solid angle
-/// (already multiplied by the node's sampling weight).
+/// A visible surfel sample of a node: direction from the cache and its share of the link's
+/// Σ w·Ω·V / Σ w·a (sr/m²), so that the samples of a node sum to its estimate.
 struct VisibleSample {
     glm::vec3 direction;
-    float solidAngle;
+    float share;
 };
 
 /// The estimate of one node's importance for one cache.
@@ -30,7 +31,8 @@ struct NodeEstimate {
     uint32_t node = 0;
     float visible = 0.0f;      ///< estimated visible solid angle, sr
     float unoccluded = 0.0f;   ///< estimated solid angle ignoring occlusion, sr
-    glm::vec3 directionSum{0.0f};
+    float perArea = 0.0f;      ///< estimated Σ w·Ω·V / Σ w·a over the node, sr/m²
+    glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
     float priority = 0.0f;     ///< refinement order: larger first
@@ -45,9 +47,15 @@ struct Scratch {
 
 class CacheLinker {
 public:
+    /// `weights`: the flux weight of every surfel (leaf order).
     CacheLinker(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
-                const std::vector<Node>& nodes, const LinkParams& params)
-        : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params) {}
+                const std::vector<Node>& nodes, const LinkParams& params,
+                const std::vector<float>& weights)
+        : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params), mWeights(weights),
+          mPrefix(surfels.size() + 1, 0.0) {
+        for (size_t s = 0; s < surfels.size(); ++s)
+            mPrefix[s + 1] = mPrefix[s] + double(weights[s]) * surfels[s].area;
+    }
 
     /// Fills the nL links of cache `c` starting at `out`; returns rays cast.
     uint64_t link(uint32_t cacheIndex, const Cache& cache, Scratch& scratch,
@@ -128,8 +136,12 @@ public:
     }
 
 private:
-    /// Estimates a node's solid angle from up to K of its surfels (all of them when it has
-    /// at most K), stratified over its contiguous surfel range, one occlusion ray each.
+    /// Estimates a node from up to K of its surfels: all of them when it has at most K (exact),
+    /// else K drawn in proportion to w·a (stratified over the node's contiguous range of the
+    /// prefix sums), one occlusion ray each. Drawn by weight, sample j estimates
+    /// Σ w·Ω·V / Σ w·a by Ω_j·V_j / a_j with bounded variance however uneven the weights; with
+    /// uniform weights n·Ω_j is the usual estimate of the solid angle, which the drawn samples
+    /// also give for the priority and the cone (that of the node's weighted part).
     NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, Rng& rng,
                           std::vector<VisibleSample>& samples, uint64_t& rays) const {
         const Node& node = mNodes[nodeIndex];
@@ -138,22 +150,36 @@ private:
         e.sampleBegin = static_cast<uint32_t>(samples.size());
         const uint32_t k = mParams.samplesPerNode;
         const uint32_t taken = std::min(node.surfelCount, k);
-        const float weight = static_cast<float>(node.surfelCount) / static_cast<float>(taken);
         e.exact = node.surfelCount <= k;
+        const double begin = mPrefix[node.firstSurfel];
+        const double weightedArea = mPrefix[node.firstSurfel + node.surfelCount] - begin;
+        const auto first = mPrefix.begin() + node.firstSurfel;
+        const auto last = mPrefix.begin() + node.firstSurfel + node.surfelCount;
         for (uint32_t j = 0; j < taken; ++j) {
-            uint32_t offset = e.exact ? j
-                                      : std::min(node.surfelCount - 1,
-                                                 static_cast<uint32_t>((j + rng.uniform()) * weight));
-            const SurfelView view = viewSurfel(mRays, cache, mSurfels[node.firstSurfel + offset]);
+            uint32_t s = node.firstSurfel + j;
+            if (!e.exact) {
+                const double target = begin + (j + rng.uniform()) / taken * weightedArea;
+                // The surfel whose [prefix[s], prefix[s + 1]) holds the target.
+                s = node.firstSurfel +
+                    static_cast<uint32_t>(std::min<ptrdiff_t>(
+                        std::upper_bound(first, last, target) - first - 1, node.surfelCount - 1));
+                s = std::max(s, node.firstSurfel);
+            }
+            const Surfel& surfel = mSurfels[s];
+            const SurfelView view = viewSurfel(mRays, cache, surfel);
             if (view.solidAngle <= 0.0f) continue;  // faces away or lies behind the cache
-            const float omega = weight * view.solidAngle;
+            // Exact: w_j·Ω_j / Σ w·a and Ω_j. Drawn: Ω_j / (K·a_j) and n·Ω_j / K.
+            const float share = e.exact ? float(double(mWeights[s]) * view.solidAngle / weightedArea)
+                                        : view.solidAngle / (float(taken) * surfel.area);
+            const float omega = e.exact ? view.solidAngle
+                                        : view.solidAngle * float(node.surfelCount) / float(taken);
             e.unoccluded += omega;
             ++rays;
             if (!view.visible) continue;
-            const glm::vec3 w = view.direction;
             e.visible += omega;
-            e.directionSum += omega * w;
-            samples.push_back({w, omega});
+            e.perArea += share;
+            e.directionSum += share * view.direction;
+            samples.push_back({view.direction, share});
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
         // An unlucky sample set may miss the visible part of a node (e.g. a few wall surfels
@@ -177,6 +203,8 @@ private:
     const std::vector<Surfel>& mSurfels;
     const std::vector<Node>& mNodes;
     const LinkParams& mParams;
+    const std::vector<float>& mWeights;
+    std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
 };
 
 }  // namespace
@@ -209,7 +237,7 @@ float discSolidAngle(float distance, float radius, float cosTheta) {
 
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
-                                 const LinkParams& params) {
+                                 const LinkParams& params, const std::vector<float>& weights) {
     if (params.linksPerCache == 0)
         return fail(ErrorCode::InvalidInput, "links per cache must be positive, got {}", params.linksPerCache);
     if (params.mode == LinkMode::Sh && (params.bands < 1 || params.bands > kMaxShBands))
@@ -218,6 +246,14 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
         return fail(ErrorCode::InvalidInput, "samples per node must be positive, got {}", params.samplesPerNode);
     if (nodes.empty() || surfels.empty() || nodes.size() != 2 * surfels.size() - 1)
         return fail(ErrorCode::InvalidInput, "hierarchy has {} nodes for {} surfels", nodes.size(), surfels.size());
+    if (!weights.empty() && weights.size() != surfels.size())
+        return fail(ErrorCode::InvalidInput, "{} flux weights for {} surfels", weights.size(), surfels.size());
+    for (size_t i = 0; i < weights.size(); ++i)
+        if (!(std::isfinite(weights[i]) && weights[i] > 0.0f))
+            return fail(ErrorCode::InvalidInput, "flux weight of surfel {} is {}, must be positive", i, weights[i]);
+    const std::vector<float> uniform = weights.empty() ? std::vector<float>(surfels.size(), 1.0f)
+                                                       : std::vector<float>{};
+    const std::vector<float>& fluxWeight = weights.empty() ? uniform : weights;
 
     const uint32_t nL = params.linksPerCache;
     const size_t nC = caches.size();
@@ -237,7 +273,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     }
     result.visibleSolidAngle.assign(nC * nL, 0.0f);
 
-    CacheLinker linker(rays, surfels, nodes, params);
+    CacheLinker linker(rays, surfels, nodes, params, fluxWeight);
     std::atomic<uint64_t> totalRays{0};
     std::atomic<uint32_t> blind{0}, clamped{0};
     std::vector<double> solidAngleSum(nC, 0.0);
@@ -255,25 +291,28 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
             used[c] = static_cast<uint32_t>(chosen.size());
             for (size_t l = 0; l < chosen.size(); ++l) {
                 const NodeEstimate& e = linker.estimateOf(scratch, chosen[l]);
-                const Node& node = nodes[e.node];
                 const size_t slot = c * nL + l;
                 result.visibleSolidAngle[slot] = e.visible;
                 solidAngleSum[c] += e.visible;
-                // Flux → radiance of the sender: B/π = Φ / (π·A_node) (paper 000 §4.1).
-                const float toRadiance = 1.0f / (kPi * node.area);
+                // Flux → radiance of the visible surfels: B_j/π = Φ·w_j / (π·Σ w·a), paper 000
+                // §4.1 with the node's flux spread by the weights instead of evenly.
+                constexpr float toRadiance = 1.0f / kPi;
                 if (params.mode == LinkMode::Rtp) {
+                    // The cone spans the node's unoccluded solid angle; the factor scales it to
+                    // Σ w·Ω·V / Σ w·a.
                     RtpLink& link = links.rtp[slot];
                     link.node = e.node;
-                    link.factor = e.visible / e.unoccluded * toRadiance;
+                    link.factor = e.perArea / e.unoccluded * toRadiance;
                     link.directionOct = encodeOctahedral(glm::normalize(e.directionSum));
                     link.oneMinusCosAlpha = std::min(2.0f, e.unoccluded / (2.0f * kPi));
                 } else {
-                    // Eq. 2: c_i = 1/(π A) Σ_j y_i(ω_j) V_j Ω_j over the node's visible samples.
+                    // Eq. 2 with weights: c_i = 1/(π Σ w·a) Σ_j y_i(ω_j) w_j V_j Ω_j over the
+                    // node's visible samples.
                     std::fill(sh.begin(), sh.end(), 0.0f);
                     for (uint32_t j = 0; j < e.sampleCount; ++j) {
                         const VisibleSample& s = scratch.samples[e.sampleBegin + j];
                         shEvaluate(bands, s.direction, basis);
-                        for (int i = 0; i < coefficients; ++i) sh[i] += s.solidAngle * basis[i];
+                        for (int i = 0; i < coefficients; ++i) sh[i] += s.share * basis[i];
                     }
                     links.shNodes[slot] = e.node;
                     uint16_t* out = &links.shCoefficients[slot * coefficients];

@@ -36,10 +36,13 @@ struct LinkResult {
     std::vector<float> visibleSolidAngle;  ///< per link (nC·nL), sr; 0 for padding
 };
 
-/// Builds the links of every cache against the hierarchy (surfels in leaf order).
+/// Builds the links of every cache against the hierarchy (surfels in leaf order). A link reads
+/// its node's flux as spread over the surfels by `weights` (bake/surfel_exposure.h: one per
+/// surfel; empty for uniform): the radiance it carries from visible surfel j is
+/// Φ_node·w_j / (π·Σ_node w·a), so its factor is Σ_visible w_j·Ω_j / (π·Σ_node w·a).
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
-                                 const LinkParams& params);
+                                 const LinkParams& params, const std::vector<float>& weights = {});
 
 /// How a cache sees one surfel: the unit direction to it, its disc's solid angle (0 when it
 /// faces away from the cache or lies behind a light-map cache's surface) and whether an

@@ -109,6 +109,9 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                "{:.3g} sr visible per cache, {:.3g} M rays\n",
                toString(p.linkMode), p.linkSamples, report.links.meanLinksUsed,
                report.links.meanVisibleSolidAngle, report.links.rays / 1e6);
+    fmt::print("  flux weights    {}\n", p.exposureRays > 0
+                                            ? fmt::format("exposure, {} rays per surfel", p.exposureRays)
+                                            : std::string("uniform (--exposure-rays 0)"));
     fmt::print("  bands           y {}, c {}{}\n", p.bandsY, p.bandsC,
                bake->defaults.count("bands") ? "  (default)" : "");
     fmt::print("  seed            {}\n", p.seed);
@@ -151,6 +154,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     out["seconds"] = seconds;
     out["params"] = {{"grid_cell", p.gridCell}, {"lightmap_texel", p.lightmapTexel},
                      {"hierarchy", toString(p.hierarchy)}, {"link_samples", p.linkSamples},
+                     {"exposure_rays", p.exposureRays},
                      {"relax_iterations", p.relaxIterations}, {"seed", p.seed}};
     out["defaults"] = Json::object();
     for (const auto& [key, how] : info->defaults) out["defaults"][key] = how;

@@ -6,8 +6,10 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <tuple>
 #include <utility>
 
+#include "bake/surfel_exposure.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
@@ -141,7 +143,13 @@ uint64_t spreadBits(uint64_t x) {
     return x;
 }
 
-// Surfel indices sorted along a Morton curve over the surfels' bounding cube.
+// The class of a surfel: emitters of one material form a class of their own (the light set
+// scales a material's emission as a whole), all other surfels one more.
+constexpr uint32_t kReflector = 0xFFFFFFFEu;
+constexpr uint32_t kMixed = 0xFFFFFFFFu;
+uint32_t surfelClass(const Surfel& s) { return isEmitter(s) ? s.material : kReflector; }
+
+// Surfel indices sorted by class, then along a Morton curve over the surfels' bounding cube.
 std::vector<uint32_t> mortonOrder(const std::vector<Surfel>& surfels) {
     glm::vec3 lo(std::numeric_limits<float>::max());
     glm::vec3 hi(std::numeric_limits<float>::lowest());
@@ -153,18 +161,18 @@ std::vector<uint32_t> mortonOrder(const std::vector<Surfel>& surfels) {
     constexpr float kMaxCell = static_cast<float>((1u << kMortonBits) - 1);
     float extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
     float scale = extent > 0.0f ? kMaxCell / extent : 0.0f;
-    std::vector<std::pair<uint64_t, uint32_t>> keys(surfels.size());
+    std::vector<std::tuple<uint32_t, uint64_t, uint32_t>> keys(surfels.size());
     parallelFor(0, surfels.size(), [&](size_t i) {
         glm::vec3 cell = glm::min((surfels[i].position - lo) * scale, glm::vec3(kMaxCell));
         uint64_t code = spreadBits(static_cast<uint64_t>(cell.x)) |
                         spreadBits(static_cast<uint64_t>(cell.y)) << 1 |
                         spreadBits(static_cast<uint64_t>(cell.z)) << 2;
-        keys[i] = {code, static_cast<uint32_t>(i)};
+        keys[i] = {surfelClass(surfels[i]), code, static_cast<uint32_t>(i)};
     });
     // Keys are unique (the index breaks ties), so the order is deterministic.
     std::sort(keys.begin(), keys.end());
     std::vector<uint32_t> order(surfels.size());
-    for (size_t i = 0; i < keys.size(); ++i) order[i] = keys[i].second;
+    for (size_t i = 0; i < keys.size(); ++i) order[i] = std::get<2>(keys[i]);
     return order;
 }
 
@@ -181,18 +189,26 @@ struct ActiveCluster {
     float area = 0.0f;
     glm::vec3 normal{0.0f};  // unit mean normal, zero where cancelled
     uint32_t node = 0;       // BuildTree node id
+    uint32_t kind = kReflector;  // surfelClass of all its surfels, or kMixed
 };
 
-ActiveCluster activeCluster(uint32_t node, const ClusterGeometry& geometry) {
-    return {geometry.center, geometry.area, meanNormal(geometry), node};
+ActiveCluster activeCluster(uint32_t node, const ClusterGeometry& geometry, uint32_t kind) {
+    return {geometry.center, geometry.area, meanNormal(geometry), node, kind};
 }
 
+// Clusters of different classes merge only when no cluster of the same class is in reach:
+// an emitter's flux then stays on its own nodes instead of being spread over the surfaces
+// around it (and a material's emissive scale moves only its own nodes). The penalty exceeds
+// every term of the metric (the spatial one is at most 1, the others their weights).
+constexpr float kClassPenalty = 16.0f;
+
 // Paper 000 eq. (§4.3): d(a, b) = |x_a − x_b|² / extent² + C_n (1 − ⟨m_a, m_b⟩)
-// + C_b |A_a − A_b| / max(A_a, A_b). Callers pass a before b in cluster order, so that
+// + C_b |A_a − A_b| / max(A_a, A_b), plus kClassPenalty across classes. Callers pass a before b in cluster order, so that
 // d(a, b) and d(b, a) are bitwise equal.
 float distance(const ActiveCluster& a, const ActiveCluster& b, const Metric& metric) {
     glm::vec3 delta = a.center - b.center;
-    return glm::dot(delta, delta) * metric.invExtent2 +
+    return (a.kind == b.kind && a.kind != kMixed ? 0.0f : kClassPenalty) +
+           glm::dot(delta, delta) * metric.invExtent2 +
            metric.normalWeight * (1.0f - glm::dot(a.normal, b.normal)) +
            metric.balanceWeight * std::abs(a.area - b.area) / std::max(a.area, b.area);
 }
@@ -239,7 +255,8 @@ BuildTree buildAgglomerative(const std::vector<Surfel>& surfels, const Hierarchy
     std::vector<ActiveCluster> active(nS);
     parallelFor(0, nS, [&](size_t i) {
         geometry[i] = leafGeometry(surfels[i]);
-        active[i] = activeCluster(order[i], leafGeometry(surfels[order[i]]));
+        active[i] = activeCluster(order[i], leafGeometry(surfels[order[i]]),
+                                  surfelClass(surfels[order[i]]));
     });
 
     Progress progress("surfel hierarchy", nS - 1);
@@ -263,7 +280,8 @@ BuildTree buildAgglomerative(const std::vector<Surfel>& surfels, const Hierarchy
                 auto node = static_cast<uint32_t>(nS + tree.children.size());
                 tree.children.push_back({a, b});
                 geometry[node] = merge(geometry[a], geometry[b]);
-                next.push_back(activeCluster(node, geometry[node]));
+                next.push_back(activeCluster(node, geometry[node],
+                                             active[i].kind == active[j].kind ? active[i].kind : kMixed));
                 ++merges;
             }
         }

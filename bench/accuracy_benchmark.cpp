@@ -90,7 +90,10 @@ PathTraceParams referenceParams(const AccuracyParams& params, glm::uvec2 size,
 }
 
 Json errorJson(const ImageError& e) {
-    return {{"relative_rmse", e.relativeRmse}, {"rmse", e.rmse}, {"mean_ratio", e.meanRatio}};
+    return {{"relative_rmse", e.relativeRmse},
+            {"rmse", e.rmse},
+            {"mean_ratio", e.meanRatio},
+            {"channel_ratio", {e.channelRatio.r, e.channelRatio.g, e.channelRatio.b}}};
 }
 
 /// The speed/accuracy trade-off over nL: one reference and one set of ideal caches, one bake
@@ -272,6 +275,9 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     auto eIdealFull = compare(idealFull, *refFull);
     for (const auto* e : {&eIndirect, &eFull, &eIdealIndirect, &eIdealFull})
         if (!*e) return reportError(e->error());
+    // Blotches: where the linked caches disagree with the ideal ones beyond a global scale.
+    auto blotch = blotchIndex(oursIndirect, idealIndirect);
+    if (!blotch) return reportError(blotch.error());
 
     std::error_code ec;
     std::filesystem::create_directories(params.outDir, ec);
@@ -305,6 +311,7 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     json["full"] = errorJson(*eFull);
     json["ideal_indirect"] = errorJson(*eIdealIndirect);
     json["ideal_full"] = errorJson(*eIdealFull);
+    json["blotch_index"] = *blotch;
     json["seconds"] = seconds;
     json["images"] = {base + "_indirect_side.png", base + "_full_side.png"};
     const std::string jsonPath = params.jsonPath.empty() ? base + "_accuracy.json" : params.jsonPath;
@@ -312,11 +319,15 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
 
     std::printf("%s: %ux%u, reference %u spp, %d runtime bounces, %zu caches\n", stem.c_str(), size.x,
                 size.y, params.spp, update.bounces, bake->caches.size());
-    std::printf("  %-22s %14s %12s\n", "", "relative RMSE", "mean ratio");
-    std::printf("  %-22s %14.4f %12.4f\n", "indirect (linked)", eIndirect->relativeRmse, eIndirect->meanRatio);
-    std::printf("  %-22s %14.4f %12.4f\n", "indirect (ideal)", eIdealIndirect->relativeRmse, eIdealIndirect->meanRatio);
-    std::printf("  %-22s %14.4f %12.4f\n", "full (linked)", eFull->relativeRmse, eFull->meanRatio);
-    std::printf("  %-22s %14.4f %12.4f\n", "full (ideal)", eIdealFull->relativeRmse, eIdealFull->meanRatio);
+    std::printf("  %-22s %14s %12s %22s\n", "", "relative RMSE", "mean ratio", "R G B ratios");
+    for (const auto& [name, e] : {std::pair{"indirect (linked)", &*eIndirect},
+                                  std::pair{"indirect (ideal)", &*eIdealIndirect},
+                                  std::pair{"full (linked)", &*eFull},
+                                  std::pair{"full (ideal)", &*eIdealFull}})
+        std::printf("  %-22s %14.4f %12.4f %8.3f %6.3f %6.3f\n", name, e->relativeRmse, e->meanRatio,
+                    e->channelRatio.r, e->channelRatio.g, e->channelRatio.b);
+    std::printf("  blotch index (linked against ideal caches, indirect, 4x4 blocks, mean-matched): %.4f\n",
+                *blotch);
     std::printf("  seconds: %s\n", seconds.dump().c_str());
     std::printf("  wrote %s, %s_indirect_side.png, %s_full_side.png (ours | ideal caches | path traced | error)\n",
                 jsonPath.c_str(), base.c_str(), base.c_str());

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "bake/link_generation.h"
-#include "bake/ref/path_tracer.h"
+#include "bake/surfel_exposure.h"
 #include "bench/bench_common.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
@@ -79,17 +80,52 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     CacheValues values = CacheValues::zeros(bake->caches.size(), bake->params.bandsY, bake->params.bandsC);
     lightCaches(*bake, flux, values);
 
-    // Luma radiance of every node as a link reads it: Φ_Y / (π·A).
-    std::vector<double> radiance(bake->nodes.size());
-    for (size_t n = 0; n < radiance.size(); ++n)
-        radiance[n] = rgbToYCoCg(flux[n]).x / (kPi * bake->nodes[n].area);
+    // Luma radiance of every surfel, and what a link reads for it: its node's flux spread by
+    // the flux weights the bake linked with (recomputed: the bake file does not keep them).
+    std::vector<float> weights(nS, 1.0f);
+    if (bake->params.exposureRays > 0) {
+        auto free = surfelFreeDistance(**rays, scene->bounds, exposureReach(*scene), bake->surfels,
+                                       ExposureParams{bake->params.exposureRays, bake->params.seed});
+        if (!free) return reportError(free.error());
+        weights = fluxWeights(bake->surfels, *free);
+    }
+    const std::vector<double> weightedArea = weightedNodeArea(bake->surfels, bake->nodes, weights);
+    std::vector<double> radiance(nS), fluxY(bake->nodes.size());
+    for (size_t n = 0; n < fluxY.size(); ++n) fluxY[n] = rgbToYCoCg(flux[n]).x;
+    for (size_t s = 0; s < nS; ++s) radiance[s] = fluxY[s] / (kPi * bake->surfels[s].area);
+    auto modelled = [&](uint32_t node, uint32_t s) {
+        return fluxY[node] * weights[s] / (kPi * weightedArea[node]);
+    };
 
     const size_t nC = bake->caches.size();
     const size_t examined = std::min<size_t>(std::max(params.caches, 1u), nC);
     const uint32_t nL = bake->links.linksPerCache;
     const size_t strideY = size_t{values.bandsY} * values.bandsY;
     const double y00 = 0.5 / std::sqrt(kPi);
-    PathTracer tracer(*scene, **rays, lights);
+    // The first runtime bounce: emission seen directly, punctual light reflected once.
+    std::vector<float> emissiveScale(scene->materials.size());
+    for (size_t m = 0; m < scene->materials.size(); ++m)
+        emissiveScale[m] = lights.emissiveScaleOf(scene->materials[m].name);
+    const float epsilon = (*rays)->epsilon();
+    auto firstBounce = [&](const glm::vec3& origin, const glm::vec3& direction) {
+        const auto hit = (*rays)->intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+        if (!hit) return glm::vec3(0.0f);
+        const uint32_t t = hit->triangle;
+        glm::vec3 radiance(0.0f);
+        if (!hit->backFace)
+            radiance += emissiveScale[scene->triangles[t].material] * scene->emissionAt(t, hit->b1, hit->b2);
+        const glm::vec3 normal = hit->backFace ? -hit->geometricNormal : hit->geometricNormal;
+        const glm::vec3 position = origin + hit->t * direction + epsilon * normal;
+        glm::vec3 irradiance(0.0f);
+        for (const Light& light : lights.lights) {
+            glm::vec3 toLight;
+            float distance = 0.0f;
+            const glm::vec3 e = lightIrradiance(light, position, normal, toLight, distance);
+            if (!(e.r > 0.0f || e.g > 0.0f || e.b > 0.0f)) continue;
+            if (!(*rays)->occluded(position, toLight, 0.0f, distance - epsilon)) irradiance += e;
+        }
+        return radiance + scene->albedoAt(t, hit->b1, hit->b2) * irradiance / float(kPi);
+    };
     std::vector<Estimates> estimates(examined);
     Progress progress("link error", examined);
     parallelFor(0, examined, [&](size_t k) {
@@ -110,7 +146,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
                 if (!view.visible) continue;
                 e.cut += radiance[s] * view.solidAngle * y00;
-                e.mean += radiance[n] * view.solidAngle * y00;
+                e.mean += modelled(n, s) * view.solidAngle * y00;
             }
         }
         // Uniform directions over the cache's sphere (hemisphere for light-map caches).
@@ -119,10 +155,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         for (uint32_t i = 0; i < params.directions; ++i) {
             glm::vec3 w = sampleUniformSphere(rng.uniform(), rng.uniform());
             if (hemisphere && glm::dot(w, cache.normal) < 0.0f) w = -w;
-            // Paths of at most one reflection: emitters seen directly and direct light
-            // reflected once, what the first cache pass gathers.
-            sum += rgbToYCoCg(tracer.traceRadiance(cache.position, w, 1,
-                                                   PathTraceParams::Component::Full, rng)).x;
+            sum += rgbToYCoCg(firstBounce(cache.position, w)).x;
         }
         e.traced = sum / params.directions * (hemisphere ? 2.0 : 4.0) * kPi * y00;
         progress.advance();

@@ -43,6 +43,8 @@ struct BakeParams {
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
     uint32_t linkSamples = 16;       ///< visibility rays per node estimate
+    uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
+                                     ///< (bake/surfel_exposure.h); 0: uniform node radiance
     uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
     uint64_t seed = 1;
 };

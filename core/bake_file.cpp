@@ -302,6 +302,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["link_mode"] = linkModeName(p.linkMode);
     json["hierarchy"] = hierarchyName(p.hierarchy);
     json["link_samples"] = p.linkSamples;
+    json["exposure_rays"] = p.exposureRays;
     json["relax_iterations"] = p.relaxIterations;
     json["seed"] = p.seed;
     json["defaults"] = defaults;
@@ -421,6 +422,7 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     p.linkMode = static_cast<LinkMode>(linkMode);
     p.hierarchy = static_cast<HierarchyMethod>(hierarchy);
     PIC_TRY_ASSIGN(p.linkSamples, reader.u32("link_samples"));
+    PIC_TRY_ASSIGN(p.exposureRays, reader.u32("exposure_rays"));
     PIC_TRY_ASSIGN(p.relaxIterations, reader.u32("relax_iterations"));
     PIC_TRY_ASSIGN(p.seed, reader.unsignedField("seed", std::numeric_limits<uint64_t>::max()));
     PIC_TRY_ASSIGN(parsed.defaults, reader.stringMap("defaults"));

@@ -197,6 +197,7 @@ Result<ImageError> compareImages(const Image& image, const Image& reference) {
     // Doubles throughout: a 4K image sums 25 million values.
     double squaredError = 0.0, referenceSum = 0.0;
     double imageLuminance = 0.0, referenceLuminance = 0.0;
+    glm::dvec3 imageChannel(0.0), referenceChannel(0.0);
     for (uint32_t y = 0; y < image.height; ++y) {
         for (uint32_t x = 0; x < image.width; ++x) {
             const glm::vec3& a = image.at(x, y);
@@ -215,6 +216,8 @@ Result<ImageError> compareImages(const Image& image, const Image& reference) {
             }
             imageLuminance += luminance(a);
             referenceLuminance += luminance(b);
+            imageChannel += glm::dvec3(a);
+            referenceChannel += glm::dvec3(b);
         }
     }
     double valueCount = 3.0 * double(reference.pixels.size());
@@ -227,7 +230,37 @@ Result<ImageError> compareImages(const Image& image, const Image& reference) {
     error.rmse = std::sqrt(squaredError / valueCount);
     error.relativeRmse = error.rmse / referenceMean;
     error.meanRatio = imageLuminance / referenceLuminance;
+    for (int c = 0; c < 3; ++c) error.channelRatio[c] = referenceChannel[c] > 0.0 ? imageChannel[c] / referenceChannel[c] : 0.0;
     return error;
+}
+
+Image blockMean(const Image& image, uint32_t block) {
+    PIC_CHECK(block > 0);
+    const uint32_t width = (image.width + block - 1) / block;
+    const uint32_t height = (image.height + block - 1) / block;
+    Image out(width, height);
+    for (uint32_t by = 0; by < height; ++by) {
+        for (uint32_t bx = 0; bx < width; ++bx) {
+            glm::dvec3 sum(0.0);
+            uint32_t count = 0;
+            for (uint32_t y = by * block; y < std::min(image.height, (by + 1) * block); ++y)
+                for (uint32_t x = bx * block; x < std::min(image.width, (bx + 1) * block); ++x, ++count)
+                    sum += glm::dvec3(image.at(x, y));
+            out.at(bx, by) = glm::vec3(sum / double(count));
+        }
+    }
+    return out;
+}
+
+Result<double> blotchIndex(const Image& image, const Image& reference, uint32_t block) {
+    PIC_TRY_ASSIGN(const ImageError whole, compareImages(image, reference));
+    if (!(whole.meanRatio > 0.0))
+        return fail(ErrorCode::InvalidInput, "image mean luminance ratio is {}: nothing to scale",
+                    whole.meanRatio);
+    Image scaled = blockMean(image, block);
+    for (glm::vec3& p : scaled.pixels) p /= float(whole.meanRatio);
+    PIC_TRY_ASSIGN(const ImageError blocks, compareImages(scaled, blockMean(reference, block)));
+    return blocks.relativeRmse;
 }
 
 }  // namespace pic

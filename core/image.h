@@ -42,7 +42,18 @@ struct ImageError {
     double rmse = 0.0;          ///< root mean square error over all pixels and channels
     double relativeRmse = 0.0;  ///< rmse / mean of the reference
     double meanRatio = 0.0;     ///< mean luminance of image / mean luminance of reference
+    glm::dvec3 channelRatio{0.0};  ///< mean of each channel of image / of reference (0 where
+                                   ///< the reference channel is black)
 };
 Result<ImageError> compareImages(const Image& image, const Image& reference);
+
+/// The image averaged over block × block tiles (edge tiles average the pixels they hold).
+Image blockMean(const Image& image, uint32_t block);
+
+/// Blotch index: the relative RMSE of `image` against `reference` over block × block tiles
+/// after scaling `image` to the reference's mean luminance, so that a global bias does not
+/// count, only disagreement between neighbouring regions (issue 23: linked against ideal
+/// caches, 4 × 4 blocks). Fails like compareImages, and when `image` is black.
+Result<double> blotchIndex(const Image& image, const Image& reference, uint32_t block = 4);
 
 }  // namespace pic

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -461,6 +462,41 @@ TEST(SurfelHierarchy, Builds128kSurfels) {
                     seconds, workerCount(), depth(h));
         expectValidHierarchy(h, surfels);
     }
+}
+
+TEST(SurfelHierarchy, EmittersOfEachMaterialStayInNodesOfTheirOwn) {
+    // A ceiling of 24 × 24 reflector surfels, with two emissive panels of different materials
+    // 1 mm under it, interleaved with it in space: only the nodes that join the three classes
+    // (two of them, the root among them) may hold surfels of more than one.
+    std::vector<Surfel> surfels;
+    for (uint32_t v = 0; v < 24; ++v)
+        for (uint32_t u = 0; u < 24; ++u)
+            surfels.push_back(makeSurfel({u / 24.0f, 1.0f, v / 24.0f}, {0, -1, 0}, 1.0f / 576.0f,
+                                         uint32_t(surfels.size())));
+    for (uint32_t panel = 0; panel < 2; ++panel)
+        for (uint32_t v = 0; v < 6; ++v)
+            for (uint32_t u = 0; u < 6; ++u) {
+                Surfel s = makeSurfel({0.1f + 0.5f * panel + u / 48.0f, 0.999f, 0.4f + v / 48.0f},
+                                      {0, -1, 0}, 1.0f / 576.0f, uint32_t(surfels.size()));
+                s.material = 1 + panel;
+                s.emission = glm::vec3(5.0f);
+                surfels.push_back(s);
+            }
+    HierarchyParams params;
+    params.sceneExtent = std::sqrt(2.0f);
+    auto hierarchy = buildHierarchy(surfels, params);
+    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+    const std::vector<Node>& nodes = hierarchy->nodes;
+    int mixed = 0;
+    for (const Node& node : nodes) {
+        std::set<uint32_t> classes;
+        for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
+            const Surfel& surfel = hierarchy->surfels[s];
+            classes.insert(surfel.emission.r > 0.0f ? surfel.material : 0xFFFFu);
+        }
+        mixed += classes.size() > 1;
+    }
+    EXPECT_EQ(mixed, 2);
 }
 
 }  // namespace

@@ -253,6 +253,39 @@ TEST(CompareImages, MetricsOfHandMadeImages) {
     ASSERT_TRUE(same);
     EXPECT_EQ(same->rmse, 0.0);
     EXPECT_EQ(same->meanRatio, 1.0);
+    // Channel ratios: 2 + 1 against 1 + 1 in red, equal in green and blue.
+    EXPECT_NEAR(error->channelRatio.r, 1.5, 1e-12);
+    EXPECT_NEAR(error->channelRatio.g, 1.0, 1e-12);
+    EXPECT_NEAR(error->channelRatio.b, 1.0, 1e-12);
+}
+
+TEST(BlotchIndex, CountsDisagreementBetweenBlocksNotScaleNorNoiseWithinThem) {
+    // 8 × 4 pixels: two 4 × 4 blocks. Twice the reference everywhere is a scale: index 0.
+    Image reference = filled(8, 4, glm::vec3(1.0f));
+    Image twice = filled(8, 4, glm::vec3(2.0f));
+    auto scaled = blotchIndex(twice, reference);
+    ASSERT_TRUE(scaled) << scaled.error().message;
+    EXPECT_NEAR(*scaled, 0.0, 1e-7);
+    // Noise that averages out within each block: index 0.
+    Image noisy = reference;
+    for (uint32_t y = 0; y < 4; ++y)
+        for (uint32_t x = 0; x < 8; ++x) noisy.at(x, y) = glm::vec3((x + y) % 2 ? 1.5f : 0.5f);
+    auto withinBlocks = blotchIndex(noisy, reference);
+    ASSERT_TRUE(withinBlocks);
+    EXPECT_NEAR(*withinBlocks, 0.0, 1e-7);
+    // One block at 1.5, the other at 0.5: mean-matched already, each block off by 0.5.
+    Image blotchy = reference;
+    for (uint32_t y = 0; y < 4; ++y)
+        for (uint32_t x = 0; x < 8; ++x) blotchy.at(x, y) = glm::vec3(x < 4 ? 1.5f : 0.5f);
+    auto blotches = blotchIndex(blotchy, reference);
+    ASSERT_TRUE(blotches);
+    EXPECT_NEAR(*blotches, 0.5, 1e-6);
+    // Edge blocks average what they hold.
+    const Image means = blockMean(filled(5, 3, glm::vec3(2.0f)), 4);
+    EXPECT_EQ(means.width, 2u);
+    EXPECT_EQ(means.height, 1u);
+    EXPECT_EQ(means.at(1, 0), glm::vec3(2.0f));
+    EXPECT_FALSE(blotchIndex(Image(8, 4), reference));  // black: nothing to scale
 }
 
 TEST(CompareImages, RejectsMismatchedBlackAndNonFiniteImages) {

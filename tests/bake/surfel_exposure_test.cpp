@@ -1,0 +1,161 @@
+// Flux weights (bake/surfel_exposure.h): the free distance against a worked integral, the
+// weights' normalisation and floor, and the links' factors built from them.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "bake/link_generation.h"
+#include "bake/surfel_exposure.h"
+#include "core/color.h"
+#include "rays/embree_scene.h"
+#include "tests/support/baked_scene.h"
+
+namespace pic {
+namespace {
+
+/// Adds the rectangle [x0, x1] × [z0, z1] at height y, facing +y (up) or −y.
+void addRectangle(Scene& scene, float y, float x0, float x1, float z0, float z1, bool up) {
+    const glm::vec3 a(x0, y, z0), b(x1, y, z0), c(x1, y, z1), d(x0, y, z1);
+    auto triangle = [&](glm::vec3 p, glm::vec3 q, glm::vec3 r) {
+        Triangle t;
+        for (int k = 0; k < 3; ++k) {
+            Vertex v;
+            v.position = k == 0 ? p : k == 1 ? q : r;
+            t.v[k] = uint32_t(scene.vertices.size());
+            scene.vertices.push_back(v);
+            scene.bounds.extend(v.position);
+        }
+        scene.triangles.push_back(t);
+    };
+    if (up) {
+        triangle(a, d, c);
+        triangle(a, c, b);
+    } else {
+        triangle(a, b, c);
+        triangle(a, c, d);
+    }
+}
+
+/// The square [−h, h]² at height y.
+void addSquare(Scene& scene, float y, float h, bool up) { addRectangle(scene, y, -h, h, -h, h, up); }
+
+Surfel surfelAt(glm::vec3 position, glm::vec3 normal) {
+    Surfel s{};
+    s.position = position;
+    s.normal = normal;
+    s.area = 1e-4f;
+    s.radius = std::sqrt(s.area / std::numbers::pi_v<float>);
+    s.albedo = glm::vec3(0.5f);
+    return s;
+}
+
+TEST(SurfelExposure, FreeDistanceUnderAPlaneIsTwiceItsHeight) {
+    // Under a plane at height h, t(θ) = h / cosθ, so E_cos[t] = ∫ (h/cosθ)·cosθ/π dω = 2h over
+    // the hemisphere. Plates 200 h wide leave out only directions with tanθ > 100.
+    const float h = 0.1f;
+    Scene scene;
+    scene.sourcePath = "plates.gltf";
+    addSquare(scene, 0.0f, 100.0f * h, true);
+    addSquare(scene, h, 100.0f * h, false);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    const std::vector<Surfel> surfels = {surfelAt({0.0f, 0.0f, 0.0f}, {0, 1, 0}),
+                                         surfelAt({3.0f * h, 0.0f, -h}, {0, 1, 0})};
+    auto free = surfelFreeDistance(**rays, scene.bounds, 1e3f, surfels, ExposureParams{256, 1});
+    ASSERT_TRUE(free) << free.error().message;
+    for (float d : *free) EXPECT_NEAR(d, 2.0f * h, 0.1f * h);
+}
+
+TEST(SurfelExposure, HiddenSurfelsWeighLessAndWeightsAverageOne) {
+    // A 2 m floor under a ceiling 2 m up, with a lid 1 cm over its x < 0 half: the surfel under
+    // the lid sees about 2 cm of free space, the open one metres.
+    Scene scene;
+    scene.sourcePath = "lid.gltf";
+    addSquare(scene, 0.0f, 1.0f, true);
+    addSquare(scene, 2.0f, 1.0f, false);
+    addRectangle(scene, 0.01f, -1.0f, 0.0f, -1.0f, 1.0f, false);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    std::vector<Surfel> surfels = {surfelAt({-0.5f, 0.0f, 0.0f}, {0, 1, 0}),
+                                   surfelAt({0.5f, 0.0f, 0.0f}, {0, 1, 0})};
+    Surfel emitter = surfelAt({0.0f, 1.99f, 0.0f}, {0, -1, 0});
+    emitter.emission = glm::vec3(3.0f);
+    surfels.push_back(emitter);
+    auto free = surfelFreeDistance(**rays, scene.bounds, 1e3f, surfels, ExposureParams{64, 1});
+    ASSERT_TRUE(free);
+    EXPECT_NEAR((*free)[0], 0.02f, 0.005f);  // 2h under the lid
+    EXPECT_GT((*free)[1], 1.0f);
+    EXPECT_LT((*free)[1], 4.0f);
+    const std::vector<float> w = fluxWeights(surfels, *free);
+    // Reflectors: E_cos[min(t, R)], scaled to an area-weighted mean of 1; the emitter alone is 1.
+    EXPECT_NEAR(w[0] + w[1], 2.0f, 1e-5f);
+    EXPECT_NEAR(w[0] / w[1], (*free)[0] / (*free)[1], 1e-4f);
+    EXPECT_LT(w[0], 0.05f * w[1]);
+    EXPECT_NEAR(w[2], 1.0f, 1e-6f);
+}
+
+TEST(SurfelExposure, WeightsHaveAFloorAndNodeAreasSumThem) {
+    std::vector<Surfel> surfels = {surfelAt({0, 0, 0}, {0, 1, 0}), surfelAt({1, 0, 0}, {0, 1, 0})};
+    surfels[1].area = 3e-4f;
+    const std::vector<float> w = fluxWeights(surfels, {0.0f, 2.0f});
+    EXPECT_FLOAT_EQ(w[0], kMinFluxWeight);
+    EXPECT_NEAR(w[1], 4.0f / 3.0f, 1e-5f);  // Σ w·a = Σ a: w₁·3a = 4a
+    std::vector<Node> nodes(3);
+    nodes[0].left = nodes[0].right = kNoNode;
+    nodes[1].left = nodes[1].right = kNoNode;
+    nodes[2].left = 0;
+    nodes[2].right = 1;
+    const std::vector<double> area = weightedNodeArea(surfels, nodes, w);
+    EXPECT_NEAR(area[2], double(w[0]) * surfels[0].area + double(w[1]) * surfels[1].area, 1e-12);
+    // No surfel with any light: every weight is 1.
+    const std::vector<float> dark = fluxWeights(surfels, {0.0f, 0.0f});
+    EXPECT_FLOAT_EQ(dark[0], 1.0f);
+    EXPECT_FLOAT_EQ(dark[1], 1.0f);
+}
+
+TEST(SurfelExposure, LinkFactorsFollowTheWeightsOfTheVisibleSurfels) {
+    // Scaling every weight leaves the links alone; doubling the weight of one surfel raises the
+    // links that see it and lowers those that do not, by Σ_visible w·Ω / (π Σ w·a).
+    const test::BakedScene& b = test::bakedScene("cornell", test::smallBakeOptions(4096, 32, 0.25f, 0.2f));
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
+    LinkParams params;
+    params.linksPerCache = 32;
+    std::vector<float> ones(bake.surfels.size(), 1.0f), threes(bake.surfels.size(), 3.0f);
+    auto uniform = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
+    auto unweighted = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, ones);
+    auto scaled = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, threes);
+    ASSERT_TRUE(uniform && unweighted && scaled);
+    for (size_t i = 0; i < uniform->links.rtp.size(); i += 13) {
+        EXPECT_EQ(uniform->links.rtp[i].node, scaled->links.rtp[i].node);
+        EXPECT_NEAR(uniform->links.rtp[i].factor, unweighted->links.rtp[i].factor,
+                    1e-5f * uniform->links.rtp[i].factor);
+        EXPECT_NEAR(uniform->links.rtp[i].factor, scaled->links.rtp[i].factor,
+                    1e-5f * uniform->links.rtp[i].factor);
+    }
+    // Leaves: the factor is the surfel's own, whatever its weight (Σ_visible w·Ω / (π w·a)).
+    std::vector<float> mixed(bake.surfels.size());
+    for (size_t s = 0; s < mixed.size(); ++s) mixed[s] = s % 2 ? 5.0f : 0.5f;
+    auto weighted = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, mixed);
+    ASSERT_TRUE(weighted);
+    const size_t nS = bake.surfels.size();
+    int leaves = 0;
+    for (size_t i = 0; i < uniform->links.rtp.size(); ++i) {
+        const RtpLink& a = uniform->links.rtp[i];
+        const RtpLink& w = weighted->links.rtp[i];
+        if (a.factor == 0.0f || a.node >= nS || a.node != w.node) continue;
+        ++leaves;
+        EXPECT_NEAR(a.factor, w.factor, 1e-5f * a.factor);
+    }
+    EXPECT_GT(leaves, 0);
+    // Bad weights are refused, naming the surfel.
+    mixed[7] = -1.0f;
+    auto bad = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, mixed);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("surfel 7"), std::string::npos) << bad.error().message;
+}
+
+}  // namespace
+}  // namespace pic
