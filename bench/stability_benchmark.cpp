@@ -140,11 +140,10 @@ Result<ChromaStats> chromaStats(const Image& image, const Image& reference, floa
         const double refSum = ref.r + ref.g + ref.b;
         const double ourSum = ours.r + ours.g + ours.b;
         // A black pixel where the reference has light has lost its colour entirely.
-        const double distance = ourSum > 0.0
-                                    ? 0.5 * (std::abs(ours.r / ourSum - ref.r / refSum) +
-                                             std::abs(ours.g / ourSum - ref.g / refSum) +
-                                             std::abs(ours.b / ourSum - ref.b / refSum))
-                                    : 1.0;
+        const double distance = ourSum > 0.0 ? 0.5 * (std::abs(ours.r / ourSum - ref.r / refSum) +
+                                                      std::abs(ours.g / ourSum - ref.g / refSum) +
+                                                      std::abs(ours.b / ourSum - ref.b / refSum))
+                                             : 1.0;
         weightSum += weight;
         errorSum += weight * distance;
         const double refHue = (ref.r - ref.g) / std::max(ref.r + ref.g, 1e-30);
@@ -160,7 +159,8 @@ Result<ChromaStats> chromaStats(const Image& image, const Image& reference, floa
 
 Result<FlickerSeries> flickerSeries(const std::vector<Image>& frames) {
     if (frames.size() < 2)
-        return fail(ErrorCode::InvalidInput, "flicker needs at least 2 frames, got {}", frames.size());
+        return fail(ErrorCode::InvalidInput, "flicker needs at least 2 frames, got {}",
+                    frames.size());
     FlickerSeries series;
     for (size_t t = 0; t < frames.size(); ++t) {
         const Image& frame = frames[t];
@@ -217,11 +217,11 @@ std::vector<glm::vec3> movingLightPath(const Scene& scene, uint64_t seed, uint32
 }
 
 Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& rays,
-                                         const BakeData& bake, const Camera& camera,
-                                         uint32_t steps, uint64_t pathSeed,
-                                         const StabilitySettings& settings) {
+                                         const BakeData& bake, const Camera& camera, uint32_t steps,
+                                         uint64_t pathSeed, const StabilitySettings& settings) {
     if (steps < 2)
-        return fail(ErrorCode::InvalidInput, "the moving light needs at least 2 steps, got {}", steps);
+        return fail(ErrorCode::InvalidInput, "the moving light needs at least 2 steps, got {}",
+                    steps);
     MovingLightResult result;
     result.path = movingLightPath(scene, pathSeed, steps);
     PIC_TRY_ASSIGN(std::unique_ptr<Runtime> runtime,
@@ -242,7 +242,8 @@ Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& 
     for (uint32_t k = 0; k < steps; ++k) {
         lights.lights[0].position = result.path[k];
         PIC_TRY_ASSIGN(const CacheValues* values, runtime->setLights(lights));
-        PIC_TRY_ASSIGN(Image image, shadeFromCaches(scene, rays, bake, *values, lights, camera, shade));
+        PIC_TRY_ASSIGN(Image image,
+                       shadeFromCaches(scene, rays, bake, *values, lights, camera, shade));
         linked.push_back(std::move(image));
         if (settings.probeSamples > 0) {
             PIC_TRY_ASSIGN(CacheValues probes, pathTraceProbes(scene, rays, bake, lights, probe));
@@ -270,7 +271,8 @@ double minNonNegativeProjection(int bands) {
         double previous = 1.0, current = x, sum = bands >= 1 ? 1.0 : 0.0;
         if (bands >= 2) sum += 3.0 * x;
         for (int l = 1; l + 1 < bands; ++l) {
-            const double next = (double(2 * l + 1) * x * current - double(l) * previous) / double(l + 1);
+            const double next =
+                (double(2 * l + 1) * x * current - double(l) * previous) / double(l + 1);
             previous = current;
             current = next;
             sum += double(2 * (l + 1) + 1) * current;
@@ -292,12 +294,14 @@ std::optional<std::string> invalidCacheValues(const CacheValues& values) {
                            values.cg.size());
     // Every direction's basis values, once.
     static const std::vector<std::vector<float>> basis = [] {
-        std::vector<std::vector<float>> out(kCheckDirections, std::vector<float>(shCount(kMaxShBands)));
+        std::vector<std::vector<float>> out(kCheckDirections,
+                                            std::vector<float>(shCount(kMaxShBands)));
         const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
         for (int k = 0; k < kCheckDirections; ++k) {
             const double z = 1.0 - (2.0 * k + 1.0) / kCheckDirections;
             const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-            const glm::vec3 d(float(r * std::cos(golden * k)), float(r * std::sin(golden * k)), float(z));
+            const glm::vec3 d(float(r * std::cos(golden * k)), float(r * std::sin(golden * k)),
+                              float(z));
             shEvaluate(kMaxShBands, glm::normalize(d), out[k].data());
         }
         return out;
@@ -310,12 +314,14 @@ std::optional<std::string> invalidCacheValues(const CacheValues& values) {
         const float* cg = &values.cg[c * countC];
         double magnitude = 0.0;
         for (size_t i = 0; i < countY; ++i) {
-            if (!std::isfinite(y[i])) return fmt::format("cache {}: luma coefficient {} is {}", c, i, y[i]);
+            if (!std::isfinite(y[i]))
+                return fmt::format("cache {}: luma coefficient {} is {}", c, i, y[i]);
             magnitude += std::abs(y[i]);
         }
         for (size_t i = 0; i < countC; ++i)
             if (!std::isfinite(co[i]) || !std::isfinite(cg[i]))
-                return fmt::format("cache {}: chroma coefficient {} is Co {} Cg {}", c, i, co[i], cg[i]);
+                return fmt::format("cache {}: chroma coefficient {} is Co {} Cg {}", c, i, co[i],
+                                   cg[i]);
         // Band 0 of each RGB channel is that channel's mean radiance: never below 0.
         const glm::vec3 rgb0 = yCoCgToRgb(glm::vec3(y[0], co[0], cg[0]));
         const double tolerance0 =
@@ -331,8 +337,9 @@ std::optional<std::string> invalidCacheValues(const CacheValues& values) {
             double radiance = 0.0;
             for (size_t i = 0; i < countY; ++i) radiance += double(y[i]) * basis[k][i];
             if (radiance < bound)
-                return fmt::format("cache {}: luma {} in direction {} is below {} ({} × its mean {})",
-                                   c, radiance, k, bound, lowest, mean);
+                return fmt::format(
+                    "cache {}: luma {} in direction {} is below {} ({} × its mean {})", c, radiance,
+                    k, bound, lowest, mean);
         }
     }
     return std::nullopt;
@@ -349,12 +356,9 @@ std::optional<std::string> invalidPixels(const Image& image) {
     return std::nullopt;
 }
 
-Result<std::vector<RandomSetFailure>> checkRandomLightSets(const Scene& scene,
-                                                           const EmbreeScene& rays,
-                                                           const BakeData& bake,
-                                                           const std::string& name,
-                                                           const std::vector<uint64_t>& seeds,
-                                                           glm::uvec2 size) {
+Result<std::vector<RandomSetFailure>> checkRandomLightSets(
+    const Scene& scene, const EmbreeScene& rays, const BakeData& bake, const std::string& name,
+    const std::vector<uint64_t>& seeds, glm::uvec2 size) {
     if (scene.cameras.empty())
         return fail(ErrorCode::InvalidInput, "random light sets: scene '{}' has no camera", name);
     PIC_TRY_ASSIGN(std::unique_ptr<Runtime> runtime,
@@ -449,7 +453,8 @@ Result<void> writeViewPng(const std::string& path, const ViewImages& view,
     const Image& exposureImage =
         exposureFrom ? *exposureFrom : (view.reference ? *view.reference : view.linked);
     const double mean = meanLuminance(exposureImage);
-    return writeImage(path, imagesSideBySide(images), gain * (mean > 0.0 ? float(0.25 / mean) : 1.0f));
+    return writeImage(path, imagesSideBySide(images),
+                      gain * (mean > 0.0 ? float(0.25 / mean) : 1.0f));
 }
 
 /// A camera of `scene` by index, or a clear error.
@@ -461,10 +466,10 @@ Result<Camera> sceneCamera(const LoadedScene& loaded, const std::string& name, s
 }
 
 /// Targets the figures are held to (docs/accuracy.md says why each).
-constexpr double kLeakTarget = 0.01;        ///< dark side ≤ 1 % of the lit side
-constexpr double kSpotTarget = 0.85;        ///< linked ÷ path-traced mean ≥ 0.85
-constexpr double kHueTarget = 0.95;         ///< hue kept on ≥ 95 % of the coloured light
-constexpr double kFlickerTarget = 1.2;      ///< linked flicker ≤ 1.2 × the ideal caches'
+constexpr double kLeakTarget = 0.01;    ///< dark side ≤ 1 % of the lit side
+constexpr double kSpotTarget = 0.85;    ///< linked ÷ path-traced mean ≥ 0.85
+constexpr double kHueTarget = 0.95;     ///< hue kept on ≥ 95 % of the coloured light
+constexpr double kFlickerTarget = 1.2;  ///< linked flicker ≤ 1.2 × the ideal caches'
 /// The leak images show the dark side this much brighter than the lit side's exposure.
 constexpr float kLeakImageGain = 10.0f;
 
@@ -477,8 +482,10 @@ struct Runner {
 
     Result<void> leak() {
         Json cases = Json::array();
-        const Camera lowerRoom{"lower_room", {1.8f, 1.6f, 1.8f}, {-1.5f, 0.8f, -1.5f}, {0.0f, 1.0f, 0.0f}, 70.0f};
-        for (const auto& [name, litIndex] : {std::pair{"thin_wall", 1}, std::pair{"two_floors", -1}}) {
+        const Camera lowerRoom{
+            "lower_room", {1.8f, 1.6f, 1.8f}, {-1.5f, 0.8f, -1.5f}, {0.0f, 1.0f, 0.0f}, 70.0f};
+        for (const auto& [name, litIndex] :
+             {std::pair{"thin_wall", 1}, std::pair{"two_floors", -1}}) {
             const Clock::time_point start = Clock::now();
             PIC_TRY_ASSIGN(const LoadedScene* loaded, scenes.get(name));
             PIC_TRY_ASSIGN(Camera dark, sceneCamera(*loaded, name, 0));
@@ -496,24 +503,30 @@ struct Runner {
             PIC_TRY(writeViewPng(png, leak.dark,
                                  leak.lit.reference ? &*leak.lit.reference : &leak.lit.linked,
                                  kLeakImageGain));
-            std::printf("  leak %-16s dark ÷ lit indirect: linked %.5f, ideal %s, path traced %s (target ≤ %.2f)\n",
-                        name, leak.linked, leak.ideal ? fmt::format("{:.5f}", *leak.ideal).c_str() : "—",
-                        leak.reference ? fmt::format("{:.5f}", *leak.reference).c_str() : "—", kLeakTarget);
-            cases.push_back({{"scene", name},
-                             {"dark_camera", dark.name},
-                             {"lit_camera", lit.name},
-                             {"bake", bakeJson(loaded->bake, loaded->bakeSeconds)},
-                             {"dark_over_lit", {{"linked", leak.linked},
-                                                {"ideal", optionalJson(leak.ideal)},
-                                                {"reference", optionalJson(leak.reference)}}},
-                             {"lit_mean", {{"linked", meanLuminance(leak.lit.linked)},
-                                           {"ideal", leak.lit.ideal ? Json(meanLuminance(*leak.lit.ideal)) : Json(nullptr)},
-                                           {"reference", leak.lit.reference ? Json(meanLuminance(*leak.lit.reference)) : Json(nullptr)}}},
-                             {"target_max", kLeakTarget},
-                             {"within_target", leak.linked <= kLeakTarget},
-                             {"image", png},
-                             {"image_gain", kLeakImageGain},
-                             {"seconds", secondsSince(start)}});
+            std::printf(
+                "  leak %-16s dark ÷ lit indirect: linked %.5f, ideal %s, path traced %s (target ≤ "
+                "%.2f)\n",
+                name, leak.linked, leak.ideal ? fmt::format("{:.5f}", *leak.ideal).c_str() : "—",
+                leak.reference ? fmt::format("{:.5f}", *leak.reference).c_str() : "—", kLeakTarget);
+            cases.push_back(
+                {{"scene", name},
+                 {"dark_camera", dark.name},
+                 {"lit_camera", lit.name},
+                 {"bake", bakeJson(loaded->bake, loaded->bakeSeconds)},
+                 {"dark_over_lit",
+                  {{"linked", leak.linked},
+                   {"ideal", optionalJson(leak.ideal)},
+                   {"reference", optionalJson(leak.reference)}}},
+                 {"lit_mean",
+                  {{"linked", meanLuminance(leak.lit.linked)},
+                   {"ideal", leak.lit.ideal ? Json(meanLuminance(*leak.lit.ideal)) : Json(nullptr)},
+                   {"reference", leak.lit.reference ? Json(meanLuminance(*leak.lit.reference))
+                                                    : Json(nullptr)}}},
+                 {"target_max", kLeakTarget},
+                 {"within_target", leak.linked <= kLeakTarget},
+                 {"image", png},
+                 {"image_gain", kLeakImageGain},
+                 {"seconds", secondsSince(start)}});
         }
         json["leak"] = cases;
         return {};
@@ -523,8 +536,9 @@ struct Runner {
         const Clock::time_point start = Clock::now();
         PIC_TRY_ASSIGN(const LoadedScene* loaded, scenes.get("small_spot"));
         PIC_TRY_ASSIGN(Camera camera, sceneCamera(*loaded, "small_spot", 0));
-        PIC_TRY_ASSIGN(RelitScene relit, relightScene(loaded->scene, *loaded->rays, loaded->bake,
-                                                      defaultLightSet(loaded->scene), params.settings));
+        PIC_TRY_ASSIGN(RelitScene relit,
+                       relightScene(loaded->scene, *loaded->rays, loaded->bake,
+                                    defaultLightSet(loaded->scene), params.settings));
         PIC_TRY_ASSIGN(ViewImages view, indirectView(relit, camera, params.settings));
         // Means of the three images and the two ratios to the reference, where there are.
         const double linked = meanLuminance(view.linked);
@@ -537,13 +551,19 @@ struct Runner {
         }
         const std::string png = base + "_spot.png";
         PIC_TRY(writeViewPng(png, view));
-        std::printf("  spot small_spot       indirect mean ÷ path traced: linked %s, ideal %s (target ≥ %.2f)\n",
-                    ratio ? fmt::format("{:.4f}", *ratio).c_str() : "—",
-                    idealRatio ? fmt::format("{:.4f}", *idealRatio).c_str() : "—", kSpotTarget);
+        std::printf(
+            "  spot small_spot       indirect mean ÷ path traced: linked %s, ideal %s (target ≥ "
+            "%.2f)\n",
+            ratio ? fmt::format("{:.4f}", *ratio).c_str() : "—",
+            idealRatio ? fmt::format("{:.4f}", *idealRatio).c_str() : "—", kSpotTarget);
         json["spot"] = {{"scene", "small_spot"},
                         {"bake", bakeJson(loaded->bake, loaded->bakeSeconds)},
-                        {"indirect_mean", {{"linked", linked}, {"ideal", optionalJson(ideal)}, {"reference", optionalJson(reference)}}},
-                        {"over_reference", {{"linked", optionalJson(ratio)}, {"ideal", optionalJson(idealRatio)}}},
+                        {"indirect_mean",
+                         {{"linked", linked},
+                          {"ideal", optionalJson(ideal)},
+                          {"reference", optionalJson(reference)}}},
+                        {"over_reference",
+                         {{"linked", optionalJson(ratio)}, {"ideal", optionalJson(idealRatio)}}},
                         {"target_min", kSpotTarget},
                         {"within_target", ratio ? Json(*ratio >= kSpotTarget) : Json(nullptr)},
                         {"image", png},
@@ -555,11 +575,13 @@ struct Runner {
         const Clock::time_point start = Clock::now();
         PIC_TRY_ASSIGN(const LoadedScene* loaded, scenes.get("opposite_colors"));
         PIC_TRY_ASSIGN(Camera camera, sceneCamera(*loaded, "opposite_colors", 0));
-        PIC_TRY_ASSIGN(RelitScene relit, relightScene(loaded->scene, *loaded->rays, loaded->bake,
-                                                      defaultLightSet(loaded->scene), params.settings));
+        PIC_TRY_ASSIGN(RelitScene relit,
+                       relightScene(loaded->scene, *loaded->rays, loaded->bake,
+                                    defaultLightSet(loaded->scene), params.settings));
         PIC_TRY_ASSIGN(ViewImages view, indirectView(relit, camera, params.settings));
         if (!view.reference)
-            return fail(ErrorCode::InvalidInput, "the colours case needs a path-traced reference (--spp > 0)");
+            return fail(ErrorCode::InvalidInput,
+                        "the colours case needs a path-traced reference (--spp > 0)");
         PIC_TRY_ASSIGN(ChromaStats linked, chromaStats(view.linked, *view.reference));
         std::optional<ChromaStats> ideal;
         if (view.ideal) {
@@ -567,10 +589,12 @@ struct Runner {
         }
         const std::string png = base + "_colors.png";
         PIC_TRY(writeViewPng(png, view));
-        std::printf("  colors opposite_colors chroma error: linked %.4f, ideal %s; hue kept: linked %.4f, ideal %s (target ≥ %.2f)\n",
-                    linked.error, ideal ? fmt::format("{:.4f}", ideal->error).c_str() : "—",
-                    linked.hueAgreement, ideal ? fmt::format("{:.4f}", ideal->hueAgreement).c_str() : "—",
-                    kHueTarget);
+        std::printf(
+            "  colors opposite_colors chroma error: linked %.4f, ideal %s; hue kept: linked %.4f, "
+            "ideal %s (target ≥ %.2f)\n",
+            linked.error, ideal ? fmt::format("{:.4f}", ideal->error).c_str() : "—",
+            linked.hueAgreement, ideal ? fmt::format("{:.4f}", ideal->hueAgreement).c_str() : "—",
+            kHueTarget);
         const auto statsJson = [](const ChromaStats& s) {
             return Json{{"chroma_error", s.error}, {"hue_agreement", s.hueAgreement}};
         };
@@ -604,7 +628,8 @@ struct Runner {
                                   params.steps, params.movingScene);
         chart.xLabel = "step";
         chart.yLabel = "frame mean / sequence mean; mean |change| / frame mean";
-        const auto addSeries = [&](const FlickerSeries& s, const std::string& name, glm::vec3 color) {
+        const auto addSeries = [&](const FlickerSeries& s, const std::string& name,
+                                   glm::vec3 color) {
             double average = 0.0;
             for (double m : s.mean) average += m;
             average /= double(s.mean.size());
@@ -620,7 +645,8 @@ struct Runner {
         addSeries(moving.linked, "linked", glm::vec3(0.15f, 0.4f, 0.8f));
         if (moving.ideal) {
             addSeries(*moving.ideal, "ideal", glm::vec3(0.85f, 0.45f, 0.1f));
-            const double ratio = moving.ideal->index > 0.0 ? moving.linked.index / moving.ideal->index : 0.0;
+            const double ratio =
+                moving.ideal->index > 0.0 ? moving.linked.index / moving.ideal->index : 0.0;
             out["ideal_flicker"] = moving.ideal->index;
             out["excess"] = moving.linked.index - moving.ideal->index;
             out["ratio"] = ratio;
@@ -631,16 +657,18 @@ struct Runner {
                                          : 0.0;
             out["target_ratio_max"] = kFlickerTarget;
             out["within_target"] = ratio <= kFlickerTarget;
-            std::printf("  moving %-15s flicker: linked %.5f, ideal %.5f, ratio %.3f (target ≤ %.1f); "
-                        "roughness: linked %.5f, ideal %.5f\n",
-                        params.movingScene.c_str(), moving.linked.index, moving.ideal->index, ratio,
-                        kFlickerTarget, moving.linked.roughness, moving.ideal->roughness);
+            std::printf(
+                "  moving %-15s flicker: linked %.5f, ideal %.5f, ratio %.3f (target ≤ %.1f); "
+                "roughness: linked %.5f, ideal %.5f\n",
+                params.movingScene.c_str(), moving.linked.index, moving.ideal->index, ratio,
+                kFlickerTarget, moving.linked.roughness, moving.ideal->roughness);
         } else {
             std::printf("  moving %-15s flicker: linked %.5f (no ideal caches)\n",
                         params.movingScene.c_str(), moving.linked.index);
         }
         out["linked_roughness"] = moving.linked.roughness;
-        out["frames"] = {{"linked_mean", moving.linked.mean}, {"linked_change", moving.linked.change}};
+        out["frames"] = {{"linked_mean", moving.linked.mean},
+                         {"linked_change", moving.linked.change}};
         if (moving.ideal) {
             out["frames"]["ideal_mean"] = moving.ideal->mean;
             out["frames"]["ideal_change"] = moving.ideal->change;
@@ -649,7 +677,8 @@ struct Runner {
         for (const glm::vec3& p : moving.path) path.push_back({p.x, p.y, p.z});
         out["path"] = path;
         const std::string chartPath = base + "_moving.png";
-        if (auto written = writeChart(chart, chartPath); !written) return std::unexpected(written.error());
+        if (auto written = writeChart(chart, chartPath); !written)
+            return std::unexpected(written.error());
         out["chart"] = chartPath;
         out["seconds"] = secondsSince(start);
         json["moving"] = out;
@@ -659,20 +688,23 @@ struct Runner {
     Result<void> random() {
         const Clock::time_point start = Clock::now();
         const size_t sceneCount = params.randomScenes.size();
-        if (sceneCount == 0) return fail(ErrorCode::InvalidInput, "no scenes for the random light sets");
+        if (sceneCount == 0)
+            return fail(ErrorCode::InvalidInput, "no scenes for the random light sets");
         std::vector<RandomSetFailure> failures;
         Json perScene = Json::object();
         for (size_t s = 0; s < sceneCount; ++s) {
             const std::string& name = params.randomScenes[s];
             std::vector<uint64_t> seeds;
-            for (uint64_t i = s; i < params.randomSets; i += sceneCount) seeds.push_back(params.settings.seed + i);
+            for (uint64_t i = s; i < params.randomSets; i += sceneCount)
+                seeds.push_back(params.settings.seed + i);
             if (seeds.empty()) continue;
             PIC_TRY_ASSIGN(const LoadedScene* loaded, scenes.get(name));
             const Clock::time_point sceneStart = Clock::now();
             PIC_TRY_ASSIGN(std::vector<RandomSetFailure> found,
                            checkRandomLightSets(loaded->scene, *loaded->rays, loaded->bake, name,
                                                 seeds, params.randomSize));
-            perScene[name] = {{"sets", seeds.size()}, {"failures", found.size()},
+            perScene[name] = {{"sets", seeds.size()},
+                              {"failures", found.size()},
                               {"seconds", secondsSince(sceneStart)}};
             std::fprintf(stderr, "picbench: %s: %zu random light sets, %zu failed\n", name.c_str(),
                          seeds.size(), found.size());
@@ -684,14 +716,16 @@ struct Runner {
         std::printf("  random %u light sets over %zu scenes: %zu failed (NaN, Inf or negative)\n",
                     params.randomSets, sceneCount, failures.size());
         for (const RandomSetFailure& f : failures)
-            std::printf("    %s seed %llu: %s\n", f.scene.c_str(), (unsigned long long)f.seed, f.reason.c_str());
-        json["random"] = {{"sets", params.randomSets},
-                          {"first_seed", params.settings.seed},
-                          {"image_size", fmt::format("{}x{}", params.randomSize.x, params.randomSize.y)},
-                          {"scenes", perScene},
-                          {"failures", failures.size()},
-                          {"failing", failing},
-                          {"seconds", secondsSince(start)}};
+            std::printf("    %s seed %llu: %s\n", f.scene.c_str(), (unsigned long long)f.seed,
+                        f.reason.c_str());
+        json["random"] = {
+            {"sets", params.randomSets},
+            {"first_seed", params.settings.seed},
+            {"image_size", fmt::format("{}x{}", params.randomSize.x, params.randomSize.y)},
+            {"scenes", perScene},
+            {"failures", failures.size()},
+            {"failing", failing},
+            {"seconds", secondsSince(start)}};
         randomFailed = !failures.empty();
         return {};
     }
@@ -711,15 +745,14 @@ int runStabilityBenchmark(const StabilityParams& params) {
     const std::filesystem::path parent = std::filesystem::path(jsonPath).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
     const std::string suffix = ".json";
-    const std::string base = jsonPath.ends_with(suffix) ? jsonPath.substr(0, jsonPath.size() - suffix.size()) : jsonPath;
+    const std::string base =
+        jsonPath.ends_with(suffix) ? jsonPath.substr(0, jsonPath.size() - suffix.size()) : jsonPath;
     Runner runner{params, SceneCache(params.sceneDir, params.bake), base, Json::object(), false};
     const StabilitySettings& s = params.settings;
-    runner.json["settings"] = {{"scene_dir", params.sceneDir},
-                               {"size", fmt::format("{}x{}", s.size.x, s.size.y)},
-                               {"reference_spp", s.spp},
-                               {"probe_samples", s.probeSamples},
-                               {"shade_spp", s.shadeSpp},
-                               {"seed", s.seed}};
+    runner.json["settings"] = {
+        {"scene_dir", params.sceneDir}, {"size", fmt::format("{}x{}", s.size.x, s.size.y)},
+        {"reference_spp", s.spp},       {"probe_samples", s.probeSamples},
+        {"shade_spp", s.shadeSpp},      {"seed", s.seed}};
     const Clock::time_point start = Clock::now();
     std::printf("picbench stability (%ux%u, reference %u spp, %u directions per ideal cache)\n",
                 s.size.x, s.size.y, s.spp, s.probeSamples);

@@ -44,6 +44,7 @@ struct RelitScene {
     std::optional<CacheValues> ideal;
 };
 
+/// Relights `scene` with `lights` on a fresh CPU twin, and path-traces its ideal caches if asked.
 Result<RelitScene> relightScene(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
                                 const LightSet& lights, const StabilitySettings& settings);
 
@@ -55,6 +56,7 @@ struct ViewImages {
     std::optional<Image> reference;
 };
 
+/// The indirect images of `camera`'s view at settings.size.
 Result<ViewImages> indirectView(const RelitScene& relit, const Camera& camera,
                                 const StabilitySettings& settings);
 
@@ -69,6 +71,7 @@ struct LeakResult {
     std::optional<double> ideal, reference;
 };
 
+/// The leak of `relit` seen from a camera in the dark room and one in the lit room.
 Result<LeakResult> measureLeak(const RelitScene& relit, const Camera& darkSide,
                                const Camera& litSide, const StabilitySettings& settings);
 
@@ -82,6 +85,7 @@ struct ChromaStats {
     double hueAgreement = 0.0;
 };
 
+/// The chroma error and hue agreement of `image` against `reference` (same size).
 Result<ChromaStats> chromaStats(const Image& image, const Image& reference, float minShare = 0.05f);
 
 /// The per-frame figures of an image sequence: mean luminance of each frame and the mean
@@ -117,10 +121,10 @@ struct MovingLightResult {
     Image firstLinked;  ///< the first linked frame, for people
 };
 
+/// Moves the light `steps` steps along movingLightPath(scene, pathSeed) seen from `camera`.
 Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& rays,
-                                         const BakeData& bake, const Camera& camera,
-                                         uint32_t steps, uint64_t pathSeed,
-                                         const StabilitySettings& settings);
+                                         const BakeData& bake, const Camera& camera, uint32_t steps,
+                                         uint64_t pathSeed, const StabilitySettings& settings);
 
 /// Why cache values are invalid, or nullopt when they are valid: every coefficient finite;
 /// each RGB channel's band 0 (its mean radiance) ≥ 0; the luma evaluated in 256 directions
@@ -147,12 +151,9 @@ struct RandomSetFailure {
 /// progressive bounces), checks the caches (invalidCacheValues) and a `size` image shaded at
 /// full (invalidPixels) from the scene's camera 0, and reports every failing seed. An error
 /// only when something cannot run at all.
-Result<std::vector<RandomSetFailure>> checkRandomLightSets(const Scene& scene,
-                                                           const EmbreeScene& rays,
-                                                           const BakeData& bake,
-                                                           const std::string& name,
-                                                           const std::vector<uint64_t>& seeds,
-                                                           glm::uvec2 size);
+Result<std::vector<RandomSetFailure>> checkRandomLightSets(
+    const Scene& scene, const EmbreeScene& rays, const BakeData& bake, const std::string& name,
+    const std::vector<uint64_t>& seeds, glm::uvec2 size);
 
 /// What `picbench stability` runs.
 struct StabilityParams {
@@ -160,14 +161,14 @@ struct StabilityParams {
     std::vector<std::string> cases{"leak", "spot", "colors", "moving", "random"};
     BakeOptions bake;
     StabilitySettings settings;
-    uint32_t steps = 60;               ///< moving light
+    uint32_t steps = 60;  ///< moving light
     std::string movingScene = "furnished_room";
-    uint32_t movingProbeSamples = 128; ///< directions per ideal cache at each moving-light step
+    uint32_t movingProbeSamples = 128;  ///< directions per ideal cache at each moving-light step
     uint32_t randomSets = 1000;
     glm::uvec2 randomSize{32, 24};
-    std::vector<std::string> randomScenes{"cornell",   "cornell_area",    "closed_box",
+    std::vector<std::string> randomScenes{"cornell",    "cornell_area",    "closed_box",
                                           "two_floors", "opposite_colors", "small_spot",
-                                          "thin_wall", "furnished_room",  "furnished_study"};
+                                          "thin_wall",  "furnished_room",  "furnished_study"};
     std::string jsonPath = "stability/stability.json";
 };
 

@@ -37,12 +37,13 @@ glm::vec3 randomColor(Rng& rng, float saturatedShare) {
 
 Result<void> checkRanges(const RandomLightRanges& r) {
     if (r.minLights < 1 || r.minLights > r.maxLights || r.maxLights > kMaxLights)
-        return fail(ErrorCode::InvalidInput, "random lights: need 1 ≤ minLights ≤ maxLights ≤ {}, got {} and {}",
-                    kMaxLights, r.minLights, r.maxLights);
+        return fail(ErrorCode::InvalidInput,
+                    "random lights: need 1 ≤ minLights ≤ maxLights ≤ {}, got {} and {}", kMaxLights,
+                    r.minLights, r.maxLights);
     const auto positiveRange = [](const char* name, float lo, float hi) -> Result<void> {
         if (!(lo > 0.0f) || !(hi >= lo) || !std::isfinite(hi))
-            return fail(ErrorCode::InvalidInput, "random lights: {} needs 0 < min ≤ max < ∞, got {} and {}",
-                        name, lo, hi);
+            return fail(ErrorCode::InvalidInput,
+                        "random lights: {} needs 0 < min ≤ max < ∞, got {} and {}", name, lo, hi);
         return {};
     };
     PIC_TRY(positiveRange("intensity", r.minIntensity, r.maxIntensity));
@@ -50,25 +51,29 @@ Result<void> checkRanges(const RandomLightRanges& r) {
     PIC_TRY(positiveRange("emissive scale", r.minEmissiveScale, r.maxEmissiveScale));
     if (!(r.minOuterConeDegrees > 0.0f) || !(r.maxOuterConeDegrees >= r.minOuterConeDegrees) ||
         !(r.maxOuterConeDegrees <= 90.0f))
-        return fail(ErrorCode::InvalidInput,
-                    "random lights: outer cone angles need 0 < min ≤ max ≤ 90 degrees, got {} and {}",
-                    r.minOuterConeDegrees, r.maxOuterConeDegrees);
-    for (const auto& [name, share] : {std::pair{"rangedShare", r.rangedShare},
-                                      std::pair{"saturatedShare", r.saturatedShare},
-                                      std::pair{"zeroEmissionShare", r.zeroEmissionShare}})
+        return fail(
+            ErrorCode::InvalidInput,
+            "random lights: outer cone angles need 0 < min ≤ max ≤ 90 degrees, got {} and {}",
+            r.minOuterConeDegrees, r.maxOuterConeDegrees);
+    for (const auto& [name, share] :
+         {std::pair{"rangedShare", r.rangedShare}, std::pair{"saturatedShare", r.saturatedShare},
+          std::pair{"zeroEmissionShare", r.zeroEmissionShare}})
         if (!(share >= 0.0f && share <= 1.0f))
-            return fail(ErrorCode::InvalidInput, "random lights: {} must be in [0, 1], got {}", name, share);
+            return fail(ErrorCode::InvalidInput, "random lights: {} must be in [0, 1], got {}",
+                        name, share);
     return {};
 }
 
 }  // namespace
 
-Result<LightSet> randomLightSet(const Scene& scene, uint64_t seed, const RandomLightRanges& ranges) {
+Result<LightSet> randomLightSet(const Scene& scene, uint64_t seed,
+                                const RandomLightRanges& ranges) {
     PIC_TRY(checkRanges(ranges));
     const float diagonal = scene.bounds.diagonal();
     if (!(diagonal > 0.0f) || !std::isfinite(diagonal))
-        return fail(ErrorCode::InvalidInput, "random lights: scene '{}' has no extent (diagonal {} m)",
-                    scene.sourcePath, diagonal);
+        return fail(ErrorCode::InvalidInput,
+                    "random lights: scene '{}' has no extent (diagonal {} m)", scene.sourcePath,
+                    diagonal);
     // One stream per seed; the draws below happen in a fixed order.
     Rng rng(seed, 0x6c69676874736574ull);
     const glm::vec3 margin = 0.02f * scene.bounds.extent();
@@ -79,7 +84,8 @@ Result<LightSet> randomLightSet(const Scene& scene, uint64_t seed, const RandomL
 
     LightSet set;
     const uint32_t span = ranges.maxLights - ranges.minLights + 1;
-    const uint32_t count = ranges.minLights + std::min(span - 1, uint32_t(rng.uniform() * float(span)));
+    const uint32_t count =
+        ranges.minLights + std::min(span - 1, uint32_t(rng.uniform() * float(span)));
     for (uint32_t k = 0; k < count; ++k) {
         Light light;
         light.id = "random_" + std::to_string(k);
@@ -91,11 +97,13 @@ Result<LightSet> randomLightSet(const Scene& scene, uint64_t seed, const RandomL
         light.position = lo + at * size;
         light.direction = randomDirection(rng);
         light.color = randomColor(rng, ranges.saturatedShare);
-        const float intensity = logUniform(rng, ranges.minIntensity, ranges.maxIntensity) * areaScale;
+        const float intensity =
+            logUniform(rng, ranges.minIntensity, ranges.maxIntensity) * areaScale;
         const float irradiance = logUniform(rng, ranges.minIrradiance, ranges.maxIrradiance);
         light.intensity = light.type == LightType::Directional ? irradiance : intensity;
-        const float outer = ranges.minOuterConeDegrees +
-                            (ranges.maxOuterConeDegrees - ranges.minOuterConeDegrees) * rng.uniform();
+        const float outer =
+            ranges.minOuterConeDegrees +
+            (ranges.maxOuterConeDegrees - ranges.minOuterConeDegrees) * rng.uniform();
         const float inner = outer * rng.uniform();
         if (light.type == LightType::Spot) {
             light.outerConeAngle = outer * degrees;

@@ -57,8 +57,8 @@ TEST_F(PicbenchStability, RefusesUnknownCasesAndMissingScenes) {
     std::string err;
     EXPECT_EQ(run("stability --cases glare", err), 2);
     EXPECT_NE(err.find("glare"), std::string::npos) << err;
-    EXPECT_EQ(run("stability --cases spot --scene-dir " + (mDir / "none").string() +
-                      " --json " + (mDir / "s.json").string(),
+    EXPECT_EQ(run("stability --cases spot --scene-dir " + (mDir / "none").string() + " --json " +
+                      (mDir / "s.json").string(),
                   err),
               2);
     EXPECT_NE(err.find("small_spot"), std::string::npos) << err;

@@ -263,9 +263,9 @@ TEST(StabilitySuite, MovingLightFlickersNoMoreThanIdealCaches) {
 
 TEST(StabilitySuite, RandomLightSetsGiveNoNanInfOrNegativeLight) {
     // 99 seeded light sets, 11 per small scene; the full 1,000 are `picbench stability`'s.
-    const std::vector<std::string> scenes{"cornell",         "cornell_area", "closed_box",
-                                          "two_floors",      "opposite_colors", "small_spot",
-                                          "thin_wall",       "furnished_room",  "furnished_study"};
+    const std::vector<std::string> scenes{"cornell",    "cornell_area",    "closed_box",
+                                          "two_floors", "opposite_colors", "small_spot",
+                                          "thin_wall",  "furnished_room",  "furnished_study"};
     for (size_t s = 0; s < scenes.size(); ++s) {
         const test::BakedScene& b = small(scenes[s]);
         ASSERT_TRUE(b.ok) << scenes[s];

@@ -81,7 +81,8 @@ TEST(RandomLightSet, SetsAreValidAndCoverTheRanges) {
         }
         ASSERT_EQ(set->emissiveScale.size(), 1u) << "only 'panel' emits";
         const float scale = set->emissiveScale.at("panel");
-        if (scale == 0.0f) ++darkEmission;
+        if (scale == 0.0f)
+            ++darkEmission;
         else {
             EXPECT_GE(scale, 0.00999f);
             EXPECT_LE(scale, 10.001f);

@@ -303,8 +303,8 @@ namespace furnished {
 
 /// The wall on `side` of room [lo, hi] with a rectangular opening: `openLo`, `openHi` give the
 /// opening's corners (only their coordinates along the wall's two in-plane axes are read).
-void addWallWithOpening(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi,
-                        RoomSide side, const glm::vec3& openLo, const glm::vec3& openHi) {
+void addWallWithOpening(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi, RoomSide side,
+                        const glm::vec3& openLo, const glm::vec3& openHi) {
     const SideFrame f = sideFrame(side);
     PIC_CHECK(lo[f.u] < openLo[f.u] && openLo[f.u] < openHi[f.u] && openHi[f.u] < hi[f.u]);
     PIC_CHECK(lo[f.v] < openLo[f.v] && openLo[f.v] < openHi[f.v] && openHi[f.v] < hi[f.v]);
@@ -366,9 +366,11 @@ Result<void> buildFurnishedRoom(GltfBuilder& gltf, const SceneOptions&) {
     const uint32_t white = addWhite(gltf);
     const uint32_t floor = gltf.addMaterial({.name = "oak_floor", .baseColor = {0.5, 0.34, 0.2}});
     const uint32_t wood = gltf.addMaterial({.name = "walnut", .baseColor = {0.35, 0.22, 0.13}});
-    const uint32_t fabric = gltf.addMaterial({.name = "blue_fabric", .baseColor = {0.12, 0.2, 0.5}});
+    const uint32_t fabric =
+        gltf.addMaterial({.name = "blue_fabric", .baseColor = {0.12, 0.2, 0.5}});
     const uint32_t red = gltf.addMaterial({.name = "red_box", .baseColor = {0.63, 0.065, 0.05}});
-    const uint32_t green = gltf.addMaterial({.name = "green_box", .baseColor = {0.14, 0.45, 0.091}});
+    const uint32_t green =
+        gltf.addMaterial({.name = "green_box", .baseColor = {0.14, 0.45, 0.091}});
     addMesh(gltf, "floor", floor,
             [&](MeshBuilder& mesh) { addRoomSide(mesh, lo, hi, RoomSide::Floor); });
     addMesh(gltf, "walls", white, [&](MeshBuilder& mesh) {
@@ -432,8 +434,10 @@ Result<void> buildFurnishedStudy(GltfBuilder& gltf, const SceneOptions&) {
     const uint32_t accent = gltf.addMaterial({.name = "sage_wall", .baseColor = {0.35, 0.5, 0.3}});
     const uint32_t floor = gltf.addMaterial({.name = "grey_carpet", .baseColor = {0.3, 0.3, 0.32}});
     const uint32_t wood = gltf.addMaterial({.name = "pine", .baseColor = {0.65, 0.5, 0.3}});
-    const uint32_t leather = gltf.addMaterial({.name = "red_leather", .baseColor = {0.45, 0.08, 0.05}});
-    const uint32_t cardboard = gltf.addMaterial({.name = "cardboard", .baseColor = {0.55, 0.42, 0.26}});
+    const uint32_t leather =
+        gltf.addMaterial({.name = "red_leather", .baseColor = {0.45, 0.08, 0.05}});
+    const uint32_t cardboard =
+        gltf.addMaterial({.name = "cardboard", .baseColor = {0.55, 0.42, 0.26}});
     addMesh(gltf, "floor", floor,
             [&](MeshBuilder& mesh) { addRoomSide(mesh, lo, hi, RoomSide::Floor); });
     addMesh(gltf, "walls", white, [&](MeshBuilder& mesh) {
@@ -912,12 +916,18 @@ struct SceneEntry {
 };
 
 constexpr SceneEntry kScenes[] = {
-    {"cornell", buildCornell},      {"cornell_area", buildCornellArea},
-    {"two_floors", buildTwoFloors}, {"opposite_colors", buildOppositeColors},
-    {"small_spot", buildSmallSpot}, {"atrium", buildAtrium},
-    {"closed_box", buildClosedBox}, {"bad_points", buildBadPoints},
-    {"bad_empty", buildBadEmpty},   {"textured_quad", buildTexturedQuad},
-    {"thin_wall", buildThinWall},   {"furnished_room", buildFurnishedRoom},
+    {"cornell", buildCornell},
+    {"cornell_area", buildCornellArea},
+    {"two_floors", buildTwoFloors},
+    {"opposite_colors", buildOppositeColors},
+    {"small_spot", buildSmallSpot},
+    {"atrium", buildAtrium},
+    {"closed_box", buildClosedBox},
+    {"bad_points", buildBadPoints},
+    {"bad_empty", buildBadEmpty},
+    {"textured_quad", buildTexturedQuad},
+    {"thin_wall", buildThinWall},
+    {"furnished_room", buildFurnishedRoom},
     {"furnished_study", buildFurnishedStudy},
 };
 
