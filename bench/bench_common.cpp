@@ -86,6 +86,22 @@ int writeChartFile(const Chart& chart, const std::string& path) {
     return 0;
 }
 
+Image imagesSideBySide(const std::vector<const Image*>& images) {
+    uint32_t width = 0, height = 0;
+    for (const Image* image : images) {
+        width += image->width;
+        height = std::max(height, image->height);
+    }
+    Image out(width, height);
+    uint32_t left = 0;
+    for (const Image* image : images) {
+        for (uint32_t y = 0; y < image->height; ++y)
+            for (uint32_t x = 0; x < image->width; ++x) out.at(left + x, y) = image->at(x, y);
+        left += image->width;
+    }
+    return out;
+}
+
 int writeJson(const nlohmann::ordered_json& json, const std::string& path) {
     std::ofstream out(path);
     out << json.dump(2) << "\n";

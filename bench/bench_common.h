@@ -12,6 +12,7 @@
 #include "bake/bake.h"
 #include "core/chart.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "rays/embree_scene.h"
@@ -50,6 +51,9 @@ std::string chartPathFor(const std::string& jsonPath);
 
 /// Writes `chart` to `path` and says so; returns the exit code.
 int writeChartFile(const Chart& chart, const std::string& path);
+
+/// The images placed left to right, top-aligned, on black (for side-by-side PNGs).
+Image imagesSideBySide(const std::vector<const Image*>& images);
 
 /// Writes `json` to `path` and says so; returns the exit code.
 int writeJson(const nlohmann::ordered_json& json, const std::string& path);

@@ -9,6 +9,7 @@
 #include "bench/codec_benchmark.h"
 #include "bench/link_error_benchmark.h"
 #include "bench/runtime_benchmark.h"
+#include "bench/stability_benchmark.h"
 #include "bench/stream_benchmark.h"
 #include "core/cli.h"
 
@@ -176,7 +177,54 @@ int picbenchMain(int argc, char** argv) {
     stream->add_option("--picserver", streamParams.picserver, "picserver binary (default: the build tree's)");
     stream->add_option("--json", streamParams.jsonPath, "JSON file (default stream_benchmark.json)");
 
+    CLI::App* stability = app.add_subcommand(
+        "stability", "paper 000 §5.2 / 001 §7 failure cases against path tracing, a moving "
+                     "light's flicker, random light sets checked for NaN, Inf and negative light");
+    StabilityParams stabilityParams;
+    BakeOptionFlags stabilityFlags;
+    std::string stabilitySize = "64x48", randomSize = "32x24";
+    stability->add_option("--scene-dir", stabilityParams.sceneDir,
+                          "folder of the generated test scenes (default build/scenes)");
+    stability->add_option("--cases", stabilityParams.cases,
+                          "cases to run: leak spot colors moving random (default: all)")
+        ->check(CLI::IsMember({"leak", "spot", "colors", "moving", "random"}));
+    stability->add_option("--size", stabilitySize, "image size of the cases and the moving light (default 64x48)");
+    stability->add_option("--spp", stabilityParams.settings.spp,
+                          "path-traced reference samples per pixel; 0: none (default 256)");
+    stability->add_option("--probe-samples", stabilityParams.settings.probeSamples,
+                          "directions per ideal cache for the failure cases; 0: none (default 256)");
+    stability->add_option("--shade-spp", stabilityParams.settings.shadeSpp,
+                          "subsamples per pixel shading from the caches (default 2)")
+        ->check(CLI::Range(1u, 4096u));
+    stability->add_option("--steps", stabilityParams.steps, "moving-light steps (default 60)")
+        ->check(CLI::Range(2u, 100000u));
+    stability->add_option("--moving-scene", stabilityParams.movingScene,
+                          "generated scene the light moves through (default furnished_room)");
+    stability->add_option("--moving-probe-samples", stabilityParams.movingProbeSamples,
+                          "directions per ideal cache at each moving-light step; 0: no ideal "
+                          "sequence (default 128)");
+    stability->add_option("--random-sets", stabilityParams.randomSets,
+                          "random light sets, spread over the scenes in turn (default 1000)");
+    stability->add_option("--random-scenes", stabilityParams.randomScenes,
+                          "generated scenes the random sets relight (default: the nine small ones)");
+    stability->add_option("--random-size", randomSize, "image size shaded per random set (default 32x24)");
+    stability->add_option("--ref-seed", stabilityParams.settings.seed,
+                          "first random-set seed, path seed of the moving light, path tracer seed (default 1)");
+    stability->add_option("--json", stabilityParams.jsonPath,
+                          "JSON file; PNGs go beside it (default stability/stability.json)");
+    stabilityFlags.addTo(*stability);
+
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
+    if (stability->parsed()) {
+        auto size = parseImageSize(stabilitySize);
+        if (!size) return reportError(size.error());
+        auto small = parseImageSize(randomSize);
+        if (!small) return reportError(small.error());
+        stabilityParams.settings.size = *size;
+        stabilityParams.randomSize = *small;
+        stabilityParams.bake = stabilityFlags.toOptions();
+        return runStabilityBenchmark(stabilityParams);
+    }
     if (accuracy->parsed()) {
         auto view = accuracyView.toView();
         if (!view) return reportError(view.error());

@@ -267,6 +267,233 @@ Result<void> buildClosedBox(GltfBuilder& gltf, const SceneOptions&) {
     return {};
 }
 
+/// `thin_wall`: a 6 × 2.5 × 4 m room split at x = 0 by a 2 cm partition; only the left (−x) half
+/// has a light (paper 000 §5.2: caches next to a thin wall, clusters straddling it).
+Result<void> buildThinWall(GltfBuilder& gltf, const SceneOptions&) {
+    const uint32_t white = addWhite(gltf);
+    constexpr float kThickness = 0.02f;
+    addRoom(gltf, "room", white, {-3.0f, 0.0f, -2.0f}, {3.0f, 2.5f, 2.0f}, kAllSides);
+    // The partition reaches 5 cm past the floor, ceiling and walls, so no seam can leak.
+    addMesh(gltf, "partition", white, [&](MeshBuilder& mesh) {
+        mesh.addBox({0.0f, 1.25f, 0.0f}, {0.5f * kThickness, 1.3f, 2.05f});
+    });
+    gltf.addLight({.name = "lit_side_lamp",
+                   .type = LightType::Point,
+                   .position = {-1.5, 1.8, 0.0},
+                   .intensity = 5.0});
+    // Camera 0 looks at the partition from the dark side, camera 1 from the lit side.
+    gltf.addCamera({.name = "dark_side",
+                    .eye = {2.8, 1.6, 1.8},
+                    .target = {0.0, 1.0, -0.6},
+                    .yfovDegrees = 70.0,
+                    .aspectRatio = 4.0 / 3.0});
+    gltf.addCamera({.name = "lit_side",
+                    .eye = {-2.8, 1.6, 1.8},
+                    .target = {0.0, 1.0, -0.6},
+                    .yfovDegrees = 70.0,
+                    .aspectRatio = 4.0 / 3.0});
+    return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Furnished rooms: real-sized rooms with furniture that hides surfaces, a window the sun comes
+// through, white and coloured diffuse materials and lamps of every kind.
+
+namespace furnished {
+
+/// The wall on `side` of room [lo, hi] with a rectangular opening: `openLo`, `openHi` give the
+/// opening's corners (only their coordinates along the wall's two in-plane axes are read).
+void addWallWithOpening(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi, RoomSide side,
+                        const glm::vec3& openLo, const glm::vec3& openHi) {
+    const SideFrame f = sideFrame(side);
+    PIC_CHECK(lo[f.u] < openLo[f.u] && openLo[f.u] < openHi[f.u] && openHi[f.u] < hi[f.u]);
+    PIC_CHECK(lo[f.v] < openLo[f.v] && openLo[f.v] < openHi[f.v] && openHi[f.v] < hi[f.v]);
+    // Four pieces around the opening: below and above it over the full width, beside it.
+    const auto piece = [&](float u0, float u1, float v0, float v1) {
+        glm::vec3 a = lo, b = hi;
+        a[f.u] = u0;
+        b[f.u] = u1;
+        a[f.v] = v0;
+        b[f.v] = v1;
+        addRoomSide(mesh, a, b, side);
+    };
+    piece(lo[f.u], hi[f.u], lo[f.v], openLo[f.v]);
+    piece(lo[f.u], hi[f.u], openHi[f.v], hi[f.v]);
+    piece(lo[f.u], openLo[f.u], openLo[f.v], openHi[f.v]);
+    piece(openHi[f.u], hi[f.u], openLo[f.v], openHi[f.v]);
+}
+
+/// A box given by its min and max corners.
+void addSlab(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi) {
+    mesh.addBox(0.5f * (lo + hi), 0.5f * (hi - lo));
+}
+
+/// A table of top [x0, x1] × [z0, z1] at `height`, 4 cm thick, on four 5 cm legs.
+void addTable(MeshBuilder& mesh, float x0, float x1, float z0, float z1, float height) {
+    constexpr float kTop = 0.04f, kLeg = 0.05f;
+    addSlab(mesh, {x0, height - kTop, z0}, {x1, height, z1});
+    for (float x : {x0 + 0.03f, x1 - 0.03f - kLeg})
+        for (float z : {z0 + 0.03f, z1 - 0.03f - kLeg})
+            addSlab(mesh, {x, 0.0f, z}, {x + kLeg, height - kTop, z + kLeg});
+}
+
+/// An open bookcase over [lo, hi]: a back on the low-x side (`backAtLowX`) or the high-x side,
+/// open towards the other, two sides and `boards` shelves (bottom and top included), all 2 cm
+/// thick.
+void addBookcase(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi, bool backAtLowX,
+                 int boards) {
+    constexpr float kBoard = 0.02f;
+    const float backX0 = backAtLowX ? lo.x : hi.x - kBoard;
+    addSlab(mesh, {backX0, lo.y, lo.z}, {backX0 + kBoard, hi.y, hi.z});
+    addSlab(mesh, {lo.x, lo.y, lo.z}, {hi.x, hi.y, lo.z + kBoard});
+    addSlab(mesh, {lo.x, lo.y, hi.z - kBoard}, {hi.x, hi.y, hi.z});
+    const float innerX0 = backAtLowX ? lo.x + kBoard : lo.x;
+    const float innerX1 = backAtLowX ? hi.x : hi.x - kBoard;
+    for (int k = 0; k < boards; ++k) {
+        const float y = lo.y + (hi.y - lo.y - kBoard) * float(k) / float(boards - 1);
+        addSlab(mesh, {innerX0, y, lo.z + kBoard}, {innerX1, y + kBoard, hi.z - kBoard});
+    }
+}
+
+}  // namespace furnished
+
+/// `furnished_room`: a 4 × 2.7 × 5 m living room (x ∈ [−2, 2], z ∈ [−2.5, 2.5]) with a window in
+/// the +x wall, a table, a bookcase, a sofa, boxes against the walls; a sun through the window,
+/// a ceiling lamp and a narrow spot on the table.
+Result<void> buildFurnishedRoom(GltfBuilder& gltf, const SceneOptions&) {
+    using namespace furnished;
+    const glm::vec3 lo(-2.0f, 0.0f, -2.5f), hi(2.0f, 2.7f, 2.5f);
+    const uint32_t white = addWhite(gltf);
+    const uint32_t floor = gltf.addMaterial({.name = "oak_floor", .baseColor = {0.5, 0.34, 0.2}});
+    const uint32_t wood = gltf.addMaterial({.name = "walnut", .baseColor = {0.35, 0.22, 0.13}});
+    const uint32_t fabric =
+        gltf.addMaterial({.name = "blue_fabric", .baseColor = {0.12, 0.2, 0.5}});
+    const uint32_t red = gltf.addMaterial({.name = "red_box", .baseColor = {0.63, 0.065, 0.05}});
+    const uint32_t green =
+        gltf.addMaterial({.name = "green_box", .baseColor = {0.14, 0.45, 0.091}});
+    addMesh(gltf, "floor", floor,
+            [&](MeshBuilder& mesh) { addRoomSide(mesh, lo, hi, RoomSide::Floor); });
+    addMesh(gltf, "walls", white, [&](MeshBuilder& mesh) {
+        for (RoomSide side : {RoomSide::Ceiling, RoomSide::NegX, RoomSide::NegZ, RoomSide::PosZ})
+            addRoomSide(mesh, lo, hi, side);
+        // The window: 1.6 m wide, 1.2 m high, its sill at 0.9 m.
+        addWallWithOpening(mesh, lo, hi, RoomSide::PosX, {0.0f, 0.9f, -0.8f}, {0.0f, 2.1f, 0.8f});
+    });
+    addMesh(gltf, "table", wood,
+            [](MeshBuilder& mesh) { addTable(mesh, -0.2f, 1.2f, 0.6f, 1.4f, 0.75f); });
+    addMesh(gltf, "bookcase", wood, [&](MeshBuilder& mesh) {
+        addBookcase(mesh, {-2.0f, 0.0f, -1.2f}, {-1.65f, 1.9f, 0.4f}, true, 5);
+    });
+    // The sofa against the −z wall: seat, back rest and two arms, closed boxes on the floor.
+    addMesh(gltf, "sofa", fabric, [](MeshBuilder& mesh) {
+        addSlab(mesh, {-1.0f, 0.0f, -2.5f}, {1.0f, 0.45f, -1.6f});
+        addSlab(mesh, {-1.0f, 0.45f, -2.5f}, {1.0f, 0.85f, -2.25f});
+        addSlab(mesh, {-1.2f, 0.0f, -2.5f}, {-1.0f, 0.65f, -1.6f});
+        addSlab(mesh, {1.0f, 0.0f, -2.5f}, {1.2f, 0.65f, -1.6f});
+    });
+    // Boxes standing against the walls hide the floor and wall behind them.
+    addMesh(gltf, "boxes", red, [&](MeshBuilder& mesh) {
+        addSlab(mesh, {1.45f, 0.0f, 1.95f}, {2.0f, 0.55f, 2.5f});
+        mesh.setMaterial(green);
+        addSlab(mesh, {-2.0f, 0.0f, 1.9f}, {-1.4f, 0.4f, 2.5f});
+        addSlab(mesh, {-1.9f, 0.4f, 2.0f}, {-1.5f, 0.8f, 2.4f});
+    });
+    gltf.addLight({.name = "sun",
+                   .type = LightType::Directional,
+                   .direction = glm::normalize(glm::dvec3(-0.7, -0.55, -0.25)),
+                   .color = {1.0, 0.95, 0.85},
+                   .intensity = 4.0});
+    gltf.addLight({.name = "ceiling_lamp",
+                   .type = LightType::Point,
+                   .position = {0.0, 2.55, 0.0},
+                   .color = {1.0, 0.9, 0.75},
+                   .intensity = 3.0});
+    // 12 W/sr from 1.85 m above the table: a 10° cone lights a disc of radius ≈ 0.33 m.
+    gltf.addLight({.name = "table_spot",
+                   .type = LightType::Spot,
+                   .position = {0.5, 2.6, 1.0},
+                   .direction = {0.0, -1.0, 0.0},
+                   .intensity = 12.0,
+                   .innerConeAngle = 7.0 * kDegrees,
+                   .outerConeAngle = 10.0 * kDegrees});
+    gltf.addCamera({.name = "camera",
+                    .eye = {-1.7, 1.6, 2.2},
+                    .target = {0.8, 0.8, -1.2},
+                    .yfovDegrees = 70.0,
+                    .aspectRatio = 4.0 / 3.0});
+    return {};
+}
+
+/// `furnished_study`: a 3.5 × 2.6 × 4.5 m study (x ∈ [−1.75, 1.75], z ∈ [−2.25, 2.25]) with a
+/// window in the −z wall, a green accent wall, a desk and chair, two bookcases, a cabinet and
+/// stacked boxes in a corner; a low sun through the window, a ceiling lamp and a desk spot.
+Result<void> buildFurnishedStudy(GltfBuilder& gltf, const SceneOptions&) {
+    using namespace furnished;
+    const glm::vec3 lo(-1.75f, 0.0f, -2.25f), hi(1.75f, 2.6f, 2.25f);
+    const uint32_t white = addWhite(gltf);
+    const uint32_t accent = gltf.addMaterial({.name = "sage_wall", .baseColor = {0.35, 0.5, 0.3}});
+    const uint32_t floor = gltf.addMaterial({.name = "grey_carpet", .baseColor = {0.3, 0.3, 0.32}});
+    const uint32_t wood = gltf.addMaterial({.name = "pine", .baseColor = {0.65, 0.5, 0.3}});
+    const uint32_t leather =
+        gltf.addMaterial({.name = "red_leather", .baseColor = {0.45, 0.08, 0.05}});
+    const uint32_t cardboard =
+        gltf.addMaterial({.name = "cardboard", .baseColor = {0.55, 0.42, 0.26}});
+    addMesh(gltf, "floor", floor,
+            [&](MeshBuilder& mesh) { addRoomSide(mesh, lo, hi, RoomSide::Floor); });
+    addMesh(gltf, "walls", white, [&](MeshBuilder& mesh) {
+        for (RoomSide side : {RoomSide::Ceiling, RoomSide::NegX, RoomSide::PosZ})
+            addRoomSide(mesh, lo, hi, side);
+        // The window: 1.4 m wide, 1.3 m high, its sill at 0.8 m, left of the wall's centre.
+        addWallWithOpening(mesh, lo, hi, RoomSide::NegZ, {-0.9f, 0.8f, 0.0f}, {0.5f, 2.1f, 0.0f});
+        mesh.setMaterial(accent);
+        addRoomSide(mesh, lo, hi, RoomSide::PosX);
+    });
+    // The desk under the window and the chair in front of it.
+    addMesh(gltf, "desk", wood,
+            [](MeshBuilder& mesh) { addTable(mesh, -1.0f, 0.6f, -2.25f, -1.55f, 0.74f); });
+    addMesh(gltf, "chair", leather, [](MeshBuilder& mesh) {
+        addSlab(mesh, {-0.45f, 0.0f, -1.35f}, {0.05f, 0.46f, -0.85f});
+        addSlab(mesh, {-0.45f, 0.46f, -0.9f}, {0.05f, 1.0f, -0.8f});
+    });
+    // Two bookcases along the green wall, their backs against it, and a cabinet on the −x wall.
+    addMesh(gltf, "bookcases", wood, [](MeshBuilder& mesh) {
+        addBookcase(mesh, {1.4f, 0.0f, -1.6f}, {1.75f, 2.0f, -0.4f}, false, 6);
+        addBookcase(mesh, {1.4f, 0.0f, -0.2f}, {1.75f, 2.0f, 1.0f}, false, 6);
+        addSlab(mesh, {-1.75f, 0.0f, 0.2f}, {-1.3f, 0.9f, 1.6f});
+    });
+    // Boxes stacked in the far corner hide the corner and each other's faces.
+    addMesh(gltf, "boxes", cardboard, [](MeshBuilder& mesh) {
+        addSlab(mesh, {0.95f, 0.0f, 1.65f}, {1.75f, 0.5f, 2.25f});
+        addSlab(mesh, {1.05f, 0.5f, 1.75f}, {1.65f, 0.9f, 2.25f});
+        addSlab(mesh, {0.3f, 0.0f, 1.85f}, {0.9f, 0.35f, 2.25f});
+    });
+    gltf.addLight({.name = "low_sun",
+                   .type = LightType::Directional,
+                   .direction = glm::normalize(glm::dvec3(0.3, -0.45, 0.85)),
+                   .color = {1.0, 0.85, 0.65},
+                   .intensity = 5.0});
+    gltf.addLight({.name = "ceiling_lamp",
+                   .type = LightType::Point,
+                   .position = {0.0, 2.45, 0.5},
+                   .color = {0.95, 0.95, 1.0},
+                   .intensity = 2.5});
+    // 8 W/sr from 1.0 m above the desk: an 8° cone lights a disc of radius ≈ 0.14 m.
+    gltf.addLight({.name = "desk_spot",
+                   .type = LightType::Spot,
+                   .position = {-0.2, 1.74, -1.9},
+                   .direction = {0.0, -1.0, 0.0},
+                   .color = {1.0, 0.9, 0.7},
+                   .intensity = 8.0,
+                   .innerConeAngle = 5.0 * kDegrees,
+                   .outerConeAngle = 8.0 * kDegrees});
+    gltf.addCamera({.name = "camera",
+                    .eye = {-1.4, 1.6, 2.0},
+                    .target = {0.6, 0.8, -1.6},
+                    .yfovDegrees = 70.0,
+                    .aspectRatio = 4.0 / 3.0});
+    return {};
+}
+
 // ---------------------------------------------------------------------------------------------
 // Error cases and textures.
 
@@ -689,11 +916,19 @@ struct SceneEntry {
 };
 
 constexpr SceneEntry kScenes[] = {
-    {"cornell", buildCornell},      {"cornell_area", buildCornellArea},
-    {"two_floors", buildTwoFloors}, {"opposite_colors", buildOppositeColors},
-    {"small_spot", buildSmallSpot}, {"atrium", buildAtrium},
-    {"closed_box", buildClosedBox}, {"bad_points", buildBadPoints},
-    {"bad_empty", buildBadEmpty},   {"textured_quad", buildTexturedQuad},
+    {"cornell", buildCornell},
+    {"cornell_area", buildCornellArea},
+    {"two_floors", buildTwoFloors},
+    {"opposite_colors", buildOppositeColors},
+    {"small_spot", buildSmallSpot},
+    {"atrium", buildAtrium},
+    {"closed_box", buildClosedBox},
+    {"bad_points", buildBadPoints},
+    {"bad_empty", buildBadEmpty},
+    {"textured_quad", buildTexturedQuad},
+    {"thin_wall", buildThinWall},
+    {"furnished_room", buildFurnishedRoom},
+    {"furnished_study", buildFurnishedStudy},
 };
 
 }  // namespace
