@@ -230,4 +230,22 @@ Result<ImageError> compareImages(const Image& image, const Image& reference) {
     return error;
 }
 
+Result<Image> blockAverage(const Image& image, uint32_t block) {
+    if (block == 0) return fail(ErrorCode::InvalidInput, "block size 0: blocks need ≥ 1 pixel");
+    if (image.pixels.empty()) return fail(ErrorCode::InvalidInput, "cannot average an empty image");
+    Image averaged((image.width + block - 1) / block, (image.height + block - 1) / block);
+    for (uint32_t by = 0; by < averaged.height; ++by)
+        for (uint32_t bx = 0; bx < averaged.width; ++bx) {
+            glm::dvec3 sum(0.0);
+            uint32_t count = 0;
+            for (uint32_t y = by * block; y < std::min(image.height, (by + 1) * block); ++y)
+                for (uint32_t x = bx * block; x < std::min(image.width, (bx + 1) * block); ++x) {
+                    sum += glm::dvec3(image.at(x, y));
+                    ++count;
+                }
+            averaged.at(bx, by) = glm::vec3(sum / double(count));
+        }
+    return averaged;
+}
+
 }  // namespace pic

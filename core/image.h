@@ -45,4 +45,10 @@ struct ImageError {
 };
 Result<ImageError> compareImages(const Image& image, const Image& reference);
 
+/// The image averaged over block × block pixel blocks, ⌈width/block⌉ × ⌈height/block⌉ pixels
+/// (blocks cut by the right or bottom edge average the pixels they hold): compared with a
+/// reference averaged the same way, it gives the error at a coarser scale. InvalidInput for
+/// block 0 or an empty image.
+Result<Image> blockAverage(const Image& image, uint32_t block);
+
 }  // namespace pic
