@@ -17,11 +17,10 @@ int runImageCompare(const ImageCompareParams& params) {
     if (!reference) return reportError(reference.error());
     // Sizes before any averaging, so that the message names the files' own sizes.
     if (image->width != reference->width || image->height != reference->height)
-        return reportError(Error{ErrorCode::InvalidInput,
-                                 fmt::format("{} is {}x{} but the reference {} is {}x{}",
-                                             params.imagePath, image->width, image->height,
-                                             params.referencePath, reference->width,
-                                             reference->height)});
+        return reportError(Error{
+            ErrorCode::InvalidInput,
+            fmt::format("{} is {}x{} but the reference {} is {}x{}", params.imagePath, image->width,
+                        image->height, params.referencePath, reference->width, reference->height)});
 
     nlohmann::ordered_json json;
     json["image"] = params.imagePath;

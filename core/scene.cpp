@@ -19,8 +19,7 @@ glm::vec2 uvAt(const Scene& scene, const Triangle& tri, int texCoord, float b0, 
 }
 
 /// baseColorFactor × the interpolated vertex colour: the albedo before its texture.
-glm::vec3 untexturedAlbedo(const Scene& scene, const Triangle& tri, float b0, float b1,
-                           float b2) {
+glm::vec3 untexturedAlbedo(const Scene& scene, const Triangle& tri, float b0, float b1, float b2) {
     return glm::vec3(scene.materials[tri.material].baseColorFactor) *
            glm::vec3(b0 * scene.vertices[tri.v[0]].color + b1 * scene.vertices[tri.v[1]].color +
                      b2 * scene.vertices[tri.v[2]].color);

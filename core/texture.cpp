@@ -114,7 +114,9 @@ void buildMipChain(Texture& texture) {
     }
 }
 
-glm::vec4 Texture::sample(glm::vec2 uv) const { return sampleLevel(uv, 0); }
+glm::vec4 Texture::sample(glm::vec2 uv) const {
+    return sampleLevel(uv, 0);
+}
 
 glm::vec4 Texture::sampleLevel(glm::vec2 uv, int level) const {
     PIC_DCHECK(width > 0 && height > 0 && texels.size() == size_t(width) * size_t(height));
@@ -173,9 +175,8 @@ TextureFootprint textureFootprint(glm::vec2 dUvdx, glm::vec2 dUvdy, int width, i
     // footprint is longer than wide, each one covering major / taps texels; never more taps
     // than texels along the major side, so magnified footprints stay one bilinear lookup.
     const float ratio = minor > 0.0f ? major / minor : float(kMaxAnisotropy);
-    const float taps =
-        std::fmax(1.0f, std::fmin(std::ceil(std::fmin(ratio, float(kMaxAnisotropy))),
-                                  std::ceil(major)));
+    const float taps = std::fmax(
+        1.0f, std::fmin(std::ceil(std::fmin(ratio, float(kMaxAnisotropy))), std::ceil(major)));
     footprint.taps = int(taps);
     footprint.lod = std::clamp(std::log2(major / taps), 0.0f, float(levels - 1));
     if (footprint.taps > 1) footprint.axis = lengthX >= lengthY ? dUvdx : dUvdy;

@@ -163,8 +163,8 @@ Result<Image> shadeFromCaches(const Scene& scene, const EmbreeScene& rays, const
 
     const CameraRays cameraRays(camera, params.width, params.height);
     const uint32_t n = params.samplesPerPixel;
-    ShadingContext context{scene,      rays,       bake, values, lights, params, cameraRays,
-                           1.0f / std::sqrt(float(n)), {}};
+    ShadingContext context{
+        scene, rays, bake, values, lights, params, cameraRays, 1.0f / std::sqrt(float(n)), {}};
     // The light set scales emission per material name; resolve the names once, not per pixel.
     context.emissiveScale.resize(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m)

@@ -215,7 +215,7 @@ Result<void> GbufferPass::createPipeline() {
     const VkDescriptorSetLayout setLayout = mSetLayout.get();
     allocInfo.pSetLayouts = &setLayout;
     PIC_VK_TRY(vkAllocateDescriptorSets(device, &allocInfo, &mSet));
-    const Buffer* buffers[kBindingCount] = {&mTriangles, &mMaterials,      &mTextures,
+    const Buffer* buffers[kBindingCount] = {&mTriangles, &mMaterials,     &mTextures,
                                             &mTexels,    &mEmissiveScale, &mLevels};
     std::array<VkDescriptorBufferInfo, kBindingCount> infos;
     std::array<VkWriteDescriptorSet, kBindingCount> writes;

@@ -39,10 +39,10 @@ TEST_F(PicbenchCompare, PixelErrorOfComplementaryCheckersVanishesOverBlocks) {
     const fs::path b = writeChecker("b.ppm", 8, 6, 1);
     const fs::path json = mDir / "compare.json";
     std::string err;
-    ASSERT_EQ(run("compare " + a.string() + " " + b.string() + " --blocks 1 2 --json " +
-                      json.string(),
-                  err),
-              0)
+    ASSERT_EQ(
+        run("compare " + a.string() + " " + b.string() + " --blocks 1 2 --json " + json.string(),
+            err),
+        0)
         << err;
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);

@@ -295,8 +295,8 @@ TEST(BlockAverage, AveragesWholeAndEdgeBlocks) {
             grey.at(x, y) = glm::vec3(0.5f);
         }
     EXPECT_NEAR(compareImages(checker, grey)->relativeRmse, 1.0, 1e-9);
-    EXPECT_NEAR(compareImages(*blockAverage(checker, 2), *blockAverage(grey, 2))->relativeRmse,
-                0.0, 1e-9);
+    EXPECT_NEAR(compareImages(*blockAverage(checker, 2), *blockAverage(grey, 2))->relativeRmse, 0.0,
+                1e-9);
     EXPECT_FALSE(blockAverage(image, 0));
     EXPECT_FALSE(blockAverage(Image(), 4));
 }

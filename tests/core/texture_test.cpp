@@ -141,13 +141,13 @@ TEST(TextureFootprint, LongFootprintsTakeTapsAlongTheirMajorSide) {
         bool majorIsX;
     };
     const Case cases[] = {
-        {{8, 0}, {0, 1}, 8, 0.0f, true},                   // 8:1, one texel per tap
-        {{0, 2}, {24, 0}, 12, 1.0f, false},                // 12:1 of two-texel taps, major y
-        {{64, 0}, {0, 1}, 16, 2.0f, true},                 // 64:1 capped at 16 taps of 4 texels
-        {{6, 8}, {-0.8f, 0.6f}, 10, 0.0f, true},           // rotated: |dx| 10, |dy| 1
-        {{5, 0}, {0, 0}, 5, 0.0f, true},                   // a line: ⌈major⌉ taps
-        {{3, 0}, {0, 0.01f}, 3, 0.0f, true},               // never more taps than texels
-        {{0.9f, 0}, {0, 0.01f}, 1, 0.0f, true},            // under a texel: one bilinear tap
+        {{8, 0}, {0, 1}, 8, 0.0f, true},          // 8:1, one texel per tap
+        {{0, 2}, {24, 0}, 12, 1.0f, false},       // 12:1 of two-texel taps, major y
+        {{64, 0}, {0, 1}, 16, 2.0f, true},        // 64:1 capped at 16 taps of 4 texels
+        {{6, 8}, {-0.8f, 0.6f}, 10, 0.0f, true},  // rotated: |dx| 10, |dy| 1
+        {{5, 0}, {0, 0}, 5, 0.0f, true},          // a line: ⌈major⌉ taps
+        {{3, 0}, {0, 0.01f}, 3, 0.0f, true},      // never more taps than texels
+        {{0.9f, 0}, {0, 0.01f}, 1, 0.0f, true},   // under a texel: one bilinear tap
     };
     for (const Case& c : cases) {
         const TextureFootprint f = textureFootprint(c.dx * texel, c.dy * texel, 256, 256, 9);
@@ -220,8 +220,8 @@ struct TiltedChecker {
         buildMipChain(checker);
         scene.textures.push_back(std::move(checker));
         scene.materials.push_back(Material{.name = "floor", .baseColorTexture = 0});
-        for (const glm::vec3 p : {glm::vec3(-200, 0, 20), glm::vec3(200, 0, 20),
-                                  glm::vec3(0, 0, -400)}) {
+        for (const glm::vec3 p :
+             {glm::vec3(-200, 0, 20), glm::vec3(200, 0, 20), glm::vec3(0, 0, -400)}) {
             Vertex v;
             v.position = p;
             v.normal = {0, 1, 0};
@@ -296,9 +296,10 @@ TEST(TextureFiltering, TiltedCheckerMatchesThePixelFootprintAverage) {
     EXPECT_GT(grazing, 100);
     const double filteredRmse = std::sqrt(filteredSquared / pixels);
     const double pointRmse = std::sqrt(pointSquared / pixels);
-    std::printf("tilted checker, %d pixels: RMSE against the footprint average %.4f filtered, "
-                "%.4f point-sampled\n",
-                pixels, filteredRmse, pointRmse);
+    std::printf(
+        "tilted checker, %d pixels: RMSE against the footprint average %.4f filtered, "
+        "%.4f point-sampled\n",
+        pixels, filteredRmse, pointRmse);
     EXPECT_LT(filteredRmse, 0.1);
     EXPECT_LT(filteredRmse, 0.4 * pointRmse);
 }

@@ -223,7 +223,7 @@ TEST(RendererAlbedo, TexturesMatchTheScene) {
     grazing.target = {0.0f, 0.02f, -0.5f};
     grazing.fovyDegrees = 50.0f;
     const std::pair<Camera, const char*> views[] = {{scene.cameras.at(0), "scene camera"},
-                                                   {grazing, "grazing"}};
+                                                    {grazing, "grazing"}};
     for (const auto& [camera, name] : views) {
         ShadeParams params;
         params.width = 96;

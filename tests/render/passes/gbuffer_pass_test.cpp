@@ -255,8 +255,8 @@ TEST(GbufferPass, TexturedAlbedoIsTheCpuFootprintAverage) {
     }
     buildMipChain(random);
     scene.textures.push_back(std::move(random));
-    scene.materials = {Material{.name = "floor", .baseColorFactor = {0.9f, 0.8f, 1.0f, 1.0f},
-                                .baseColorTexture = 0}};
+    scene.materials = {Material{
+        .name = "floor", .baseColorFactor = {0.9f, 0.8f, 1.0f, 1.0f}, .baseColorTexture = 0}};
     const glm::vec2 corners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     for (const glm::vec2& c : corners) {
         Vertex v;
