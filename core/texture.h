@@ -29,8 +29,8 @@ struct Texture {
     std::vector<glm::vec4> texels;  ///< level 0: row-major, row 0 at v = 0
     bool repeatS = true;            ///< wrap mode along u: repeat, else clamp
     bool repeatT = true;            ///< wrap mode along v: repeat, else clamp
-    /// Levels 1, 2, … down to 1×1 (buildMipChain); empty until built, and then every lookup
-    /// reads level 0 only.
+    /// Levels 1, 2, … down to 1×1 (buildMipChain; the glTF loader builds them). While it is
+    /// empty every lookup reads level 0.
     std::vector<MipLevel> mips;
 
     /// Levels in the chain, level 0 included.

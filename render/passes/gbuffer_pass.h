@@ -42,7 +42,7 @@ public:
     /// UVs, kNotLightmapped for grid-shaded triangles), materials and textures with their mip
     /// chains (as the scene holds them: core/texture.h buildMipChain), and builds
     /// the raster pipeline. InvalidInput for a scene whose triangles, materials or textures
-    /// do not index each other; Unsupported when its textures or triangle records exceed one
+    /// do not index each other or whose texels do not fill a texture's or a mip level's size; Unsupported when its textures or triangle records exceed one
     /// storage buffer.
     static Result<std::unique_ptr<GbufferPass>> create(Context& context, const Scene& scene,
                                                        std::span<const glm::vec2> triangleUvs);
