@@ -7,6 +7,7 @@
 #include "bench/bake_benchmark.h"
 #include "bench/bench_common.h"
 #include "bench/codec_benchmark.h"
+#include "bench/image_compare.h"
 #include "bench/link_error_benchmark.h"
 #include "bench/runtime_benchmark.h"
 #include "bench/stability_benchmark.h"
@@ -214,7 +215,20 @@ int picbenchMain(int argc, char** argv) {
                           "JSON file; PNGs go beside it (default stability/stability.json)");
     stabilityFlags.addTo(*stability);
 
+    CLI::App* compare = app.add_subcommand(
+        "compare", "relative RMSE of an image against a reference, per pixel and over blocks");
+    ImageCompareParams compareParams;
+    compare->add_option("image", compareParams.imagePath, "image to measure (.exr, .png, …)")
+        ->required();
+    compare->add_option("reference", compareParams.referencePath, "reference of the same size")
+        ->required();
+    compare->add_option("--blocks", compareParams.blocks,
+                        "block sides in pixels the images are averaged over first (default 1 4 16)")
+        ->check(CLI::PositiveNumber);
+    compare->add_option("--json", compareParams.jsonPath, "write the figures to this JSON file");
+
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
+    if (compare->parsed()) return runImageCompare(compareParams);
     if (stability->parsed()) {
         auto size = parseImageSize(stabilitySize);
         if (!size) return reportError(size.error());

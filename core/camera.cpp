@@ -116,4 +116,28 @@ glm::vec3 CameraRays::direction(float x, float y) const {
                           (ndcY * mTanHalfFovy) * mUp);
 }
 
+glm::vec3 CameraRays::directionPerPixelX() const {
+    // d/dx of ndcX·aspect·tan·right with ndcX = 2x/width − 1; aspect/width = 1/height.
+    return (2.0f * mTanHalfFovy / float(mHeight)) * mRight;
+}
+
+glm::vec3 CameraRays::directionPerPixelY() const {
+    return (-2.0f * mTanHalfFovy / float(mHeight)) * mUp;
+}
+
+PixelFootprint CameraRays::footprintOnPlane(const glm::vec3& hit, const glm::vec3& normal) const {
+    // The ray eye + t·D (D·forward = 1) meets the plane at t = depth = (hit − eye)·forward.
+    // Differentiating n·(eye + t·D − hit) = 0 gives dP = t·dD − (hit − eye)·(n·t·dD)/(n·(hit −
+    // eye)) for a change dD of the direction: the change of t·dD projected along the ray
+    // onto the plane.
+    const glm::vec3 toHit = hit - mEye;
+    const float depth = glm::dot(toHit, mForward);
+    const float along = glm::dot(normal, toHit);
+    const auto onPlane = [&](const glm::vec3& dDirection) {
+        const glm::vec3 s = depth * dDirection;
+        return s - toHit * (glm::dot(normal, s) / along);
+    };
+    return {onPlane(directionPerPixelX()), onPlane(directionPerPixelY())};
+}
+
 }  // namespace pic

@@ -24,6 +24,12 @@ Result<void> checkCamera(const Camera& camera);
 /// The scene's N-th camera (0-based); InvalidInput if it has fewer.
 Result<Camera> sceneCamera(const Scene& scene, int index);
 
+/// A pixel's footprint on a surface: the hit point's changes per pixel along x and along y.
+struct PixelFootprint {
+    glm::vec3 dPdx{0.0f};  ///< metres per pixel along image x
+    glm::vec3 dPdy{0.0f};  ///< metres per pixel along image y (downward)
+};
+
 /// Primary rays of a camera for an image of width × height pixels (square pixels,
 /// vertical field of view fovy).
 class CameraRays {
@@ -33,6 +39,17 @@ public:
     /// top-left pixel; pixel centres are at +0.5.
     glm::vec3 direction(float x, float y) const;
     const glm::vec3& origin() const { return mEye; }
+    /// Unit view direction (the image centre's).
+    const glm::vec3& forward() const { return mForward; }
+    /// How the unnormalised direction forward + … through image point (x, y), whose component
+    /// along forward is 1, changes per pixel along x and along y (constant for a pinhole).
+    glm::vec3 directionPerPixelX() const;
+    glm::vec3 directionPerPixelY() const;
+    /// The sides of a pixel's footprint on the plane through `hit` with normal `normal` (any
+    /// sign): how the point where this camera's rays meet that plane moves per pixel along x
+    /// and y, in metres (ray differentials). Infinite or NaN when the ray through `hit` runs
+    /// along the plane.
+    PixelFootprint footprintOnPlane(const glm::vec3& hit, const glm::vec3& normal) const;
 
 private:
     glm::vec3 mEye, mForward, mRight, mUp;

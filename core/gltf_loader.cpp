@@ -775,7 +775,8 @@ private:
     }
 
     /// Decodes each image the used textures refer to once, in parallel, all as sRGB (base
-    /// colour and emissive textures are sRGB-encoded by the glTF specification).
+    /// colour and emissive textures are sRGB-encoded by the glTF specification), and builds
+    /// each texture's mip chain in linear RGBA.
     Result<void> decodeTextures() {
         std::vector<int> images = mTextureImage;
         std::sort(images.begin(), images.end());
@@ -801,6 +802,9 @@ private:
             texture.height = image.height;
             texture.texels = image.texels;
         }
+        // The mip chains every footprint lookup reads, built once here (core/texture.h).
+        parallelFor(
+            0, mScene.textures.size(), [&](size_t t) { buildMipChain(mScene.textures[t]); }, 1);
         return {};
     }
 

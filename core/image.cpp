@@ -234,22 +234,22 @@ Result<ImageError> compareImages(const Image& image, const Image& reference) {
     return error;
 }
 
-Image blockMean(const Image& image, uint32_t block) {
-    PIC_CHECK(block > 0);
-    const uint32_t width = (image.width + block - 1) / block;
-    const uint32_t height = (image.height + block - 1) / block;
-    Image out(width, height);
-    for (uint32_t by = 0; by < height; ++by) {
-        for (uint32_t bx = 0; bx < width; ++bx) {
+Result<Image> blockAverage(const Image& image, uint32_t block) {
+    if (block == 0) return fail(ErrorCode::InvalidInput, "block size 0: blocks need ≥ 1 pixel");
+    if (image.pixels.empty()) return fail(ErrorCode::InvalidInput, "cannot average an empty image");
+    Image averaged((image.width + block - 1) / block, (image.height + block - 1) / block);
+    for (uint32_t by = 0; by < averaged.height; ++by)
+        for (uint32_t bx = 0; bx < averaged.width; ++bx) {
             glm::dvec3 sum(0.0);
             uint32_t count = 0;
             for (uint32_t y = by * block; y < std::min(image.height, (by + 1) * block); ++y)
-                for (uint32_t x = bx * block; x < std::min(image.width, (bx + 1) * block); ++x, ++count)
+                for (uint32_t x = bx * block; x < std::min(image.width, (bx + 1) * block); ++x) {
                     sum += glm::dvec3(image.at(x, y));
-            out.at(bx, by) = glm::vec3(sum / double(count));
+                    ++count;
+                }
+            averaged.at(bx, by) = glm::vec3(sum / double(count));
         }
-    }
-    return out;
+    return averaged;
 }
 
 Result<double> blotchIndex(const Image& image, const Image& reference, uint32_t block) {
@@ -257,9 +257,10 @@ Result<double> blotchIndex(const Image& image, const Image& reference, uint32_t 
     if (!(whole.meanRatio > 0.0))
         return fail(ErrorCode::InvalidInput, "image mean luminance ratio is {}: nothing to scale",
                     whole.meanRatio);
-    Image scaled = blockMean(image, block);
+    PIC_TRY_ASSIGN(Image scaled, blockAverage(image, block));
     for (glm::vec3& p : scaled.pixels) p /= float(whole.meanRatio);
-    PIC_TRY_ASSIGN(const ImageError blocks, compareImages(scaled, blockMean(reference, block)));
+    PIC_TRY_ASSIGN(const Image referenceBlocks, blockAverage(reference, block));
+    PIC_TRY_ASSIGN(const ImageError blocks, compareImages(scaled, referenceBlocks));
     return blocks.relativeRmse;
 }
 

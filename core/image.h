@@ -47,8 +47,11 @@ struct ImageError {
 };
 Result<ImageError> compareImages(const Image& image, const Image& reference);
 
-/// The image averaged over block × block tiles (edge tiles average the pixels they hold).
-Image blockMean(const Image& image, uint32_t block);
+/// The image averaged over block × block pixel blocks, ⌈width/block⌉ × ⌈height/block⌉ pixels
+/// (blocks cut by the right or bottom edge average the pixels they hold): compared with a
+/// reference averaged the same way, it gives the error at a coarser scale. InvalidInput for
+/// block 0 or an empty image.
+Result<Image> blockAverage(const Image& image, uint32_t block);
 
 /// Blotch index: the relative RMSE of `image` against `reference` over block × block tiles
 /// after scaling `image` to the reference's mean luminance, so that a global bias does not

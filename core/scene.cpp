@@ -8,44 +8,24 @@ namespace pic {
 
 namespace {
 
-/// Maps a texel coordinate (in texel units, centres at i + 0.5) to the index of the texel at or
-/// left of it, and the next one, under the wrap mode; `fraction` is the weight of the second.
-struct TexelPair {
-    int i0;
-    int i1;
-    float fraction;
-};
+/// The UV of set `texCoord` at barycentric (b0, b1, b2) of triangle `tri`.
+glm::vec2 uvAt(const Scene& scene, const Triangle& tri, int texCoord, float b0, float b1,
+               float b2) {
+    const Vertex& v0 = scene.vertices[tri.v[0]];
+    const Vertex& v1 = scene.vertices[tri.v[1]];
+    const Vertex& v2 = scene.vertices[tri.v[2]];
+    return texCoord == 1 ? b0 * v0.uv1 + b1 * v1.uv1 + b2 * v2.uv1
+                         : b0 * v0.uv0 + b1 * v1.uv0 + b2 * v2.uv0;
+}
 
-TexelPair texelPair(float coord, int size, bool repeat) {
-    // Reduce before scaling so huge or negative coordinates never overflow the int conversion;
-    // a non-finite coordinate reads texel 0 rather than spreading NaN into lighting.
-    if (!std::isfinite(coord)) coord = 0.0f;
-    coord = repeat ? coord - std::floor(coord) : std::fmin(std::fmax(coord, 0.0f), 1.0f);
-    float x = coord * static_cast<float>(size) - 0.5f;
-    float base = std::floor(x);
-    int i0 = static_cast<int>(base);
-    int i1 = i0 + 1;
-    if (repeat) {
-        if (i0 < 0) i0 += size;
-        if (i1 >= size) i1 -= size;
-    } else {
-        i0 = i0 < 0 ? 0 : i0;
-        i1 = i1 >= size ? size - 1 : i1;
-    }
-    return {i0, i1, x - base};
+/// baseColorFactor × the interpolated vertex colour: the albedo before its texture.
+glm::vec3 untexturedAlbedo(const Scene& scene, const Triangle& tri, float b0, float b1, float b2) {
+    return glm::vec3(scene.materials[tri.material].baseColorFactor) *
+           glm::vec3(b0 * scene.vertices[tri.v[0]].color + b1 * scene.vertices[tri.v[1]].color +
+                     b2 * scene.vertices[tri.v[2]].color);
 }
 
 }  // namespace
-
-glm::vec4 Texture::sample(glm::vec2 uv) const {
-    PIC_DCHECK(width > 0 && height > 0 && texels.size() == size_t(width) * size_t(height));
-    TexelPair s = texelPair(uv.x, width, repeatS);
-    TexelPair t = texelPair(uv.y, height, repeatT);
-    auto at = [&](int x, int y) { return texels[size_t(y) * size_t(width) + size_t(x)]; };
-    glm::vec4 top = glm::mix(at(s.i0, t.i0), at(s.i1, t.i0), s.fraction);
-    glm::vec4 bottom = glm::mix(at(s.i0, t.i1), at(s.i1, t.i1), s.fraction);
-    return glm::mix(top, bottom, t.fraction);
-}
 
 float Scene::triangleArea(uint32_t t) const {
     const Triangle& tri = triangles[t];
@@ -64,16 +44,45 @@ glm::vec3 Scene::triangleNormal(uint32_t t) const {
 glm::vec3 Scene::albedoAt(uint32_t t, float b1, float b2) const {
     const Triangle& tri = triangles[t];
     const Material& material = materials[tri.material];
-    const Vertex& v0 = vertices[tri.v[0]];
-    const Vertex& v1 = vertices[tri.v[1]];
-    const Vertex& v2 = vertices[tri.v[2]];
-    float b0 = 1.0f - b1 - b2;
-    glm::vec3 albedo = glm::vec3(material.baseColorFactor) *
-                       glm::vec3(b0 * v0.color + b1 * v1.color + b2 * v2.color);
+    const float b0 = 1.0f - b1 - b2;
+    glm::vec3 albedo = untexturedAlbedo(*this, tri, b0, b1, b2);
+    if (material.baseColorTexture >= 0)
+        albedo *= glm::vec3(textures[size_t(material.baseColorTexture)].sample(
+            uvAt(*this, tri, material.baseColorTexCoord, b0, b1, b2)));
+    return albedo;
+}
+
+UvGradients Scene::uvGradients(uint32_t t, int texCoord) const {
+    const Triangle& tri = triangles[t];
+    const glm::dvec3 p0 = vertices[tri.v[0]].position;
+    const glm::dvec3 e1 = glm::dvec3(vertices[tri.v[1]].position) - p0;
+    const glm::dvec3 e2 = glm::dvec3(vertices[tri.v[2]].position) - p0;
+    const glm::dvec2 uv0 = uvAt(*this, tri, texCoord, 1.0f, 0.0f, 0.0f);
+    const glm::dvec2 d1 = glm::dvec2(uvAt(*this, tri, texCoord, 0.0f, 1.0f, 0.0f)) - uv0;
+    const glm::dvec2 d2 = glm::dvec2(uvAt(*this, tri, texCoord, 0.0f, 0.0f, 1.0f)) - uv0;
+    // A gradient g in the plane is α·e1 + β·e2 with g·e1 = Δ1 and g·e2 = Δ2: the 2×2 Gram
+    // system, in double so that slivers keep their digits.
+    const double a = glm::dot(e1, e1), b = glm::dot(e1, e2), c = glm::dot(e2, e2);
+    const double det = a * c - b * b;
+    if (!(det > 0.0)) return {};
+    const auto gradient = [&](double delta1, double delta2) {
+        return glm::vec3(((c * delta1 - b * delta2) * e1 + (a * delta2 - b * delta1) * e2) / det);
+    };
+    return {gradient(d1.x, d2.x), gradient(d1.y, d2.y)};
+}
+
+glm::vec3 Scene::albedoOverFootprint(uint32_t t, float b1, float b2, const glm::vec3& dPdx,
+                                     const glm::vec3& dPdy) const {
+    const Triangle& tri = triangles[t];
+    const Material& material = materials[tri.material];
+    const float b0 = 1.0f - b1 - b2;
+    glm::vec3 albedo = untexturedAlbedo(*this, tri, b0, b1, b2);
     if (material.baseColorTexture >= 0) {
-        glm::vec2 uv = material.baseColorTexCoord == 1 ? b0 * v0.uv1 + b1 * v1.uv1 + b2 * v2.uv1
-                                                       : b0 * v0.uv0 + b1 * v1.uv0 + b2 * v2.uv0;
-        albedo *= glm::vec3(textures[size_t(material.baseColorTexture)].sample(uv));
+        const UvGradients g = uvGradients(t, material.baseColorTexCoord);
+        const glm::vec2 dUvdx(glm::dot(g.u, dPdx), glm::dot(g.v, dPdx));
+        const glm::vec2 dUvdy(glm::dot(g.u, dPdy), glm::dot(g.v, dPdy));
+        albedo *= glm::vec3(textures[size_t(material.baseColorTexture)].sampleFootprint(
+            uvAt(*this, tri, material.baseColorTexCoord, b0, b1, b2), dUvdx, dUvdy));
     }
     return albedo;
 }

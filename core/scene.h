@@ -9,6 +9,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/texture.h"
+
 namespace pic {
 
 /// Axis-aligned bounding box; empty when min > max.
@@ -29,19 +31,6 @@ struct Aabb {
     glm::vec3 center() const { return 0.5f * (min + max); }
     /// Length of the diagonal in metres.
     float diagonal() const { return glm::length(extent()); }
-};
-
-/// A decoded texture in linear RGBA float (sRGB textures are linearised at load).
-struct Texture {
-    std::string name;
-    int width = 0;
-    int height = 0;
-    std::vector<glm::vec4> texels;  ///< row-major, row 0 at v = 0
-    bool repeatS = true;            ///< wrap mode along u: repeat, else clamp
-    bool repeatT = true;            ///< wrap mode along v: repeat, else clamp
-
-    /// Bilinear lookup with the texture's wrap modes.
-    glm::vec4 sample(glm::vec2 uv) const;
 };
 
 /// A Lambertian material: albedo = baseColorFactor × baseColorTexture × vertex colour.
@@ -103,6 +92,12 @@ struct Camera {
     float fovyDegrees = 60.0f;
 };
 
+/// How the UV of a point changes as it moves in its triangle's plane (Scene::uvGradients).
+struct UvGradients {
+    glm::vec3 u{0.0f};  ///< ∂u/∂position, per metre
+    glm::vec3 v{0.0f};  ///< ∂v/∂position, per metre
+};
+
 /// A loaded scene: a flat triangle list in world space plus materials, lights and cameras.
 struct Scene {
     std::string sourcePath;
@@ -122,8 +117,18 @@ struct Scene {
     float triangleArea(uint32_t t) const;
     /// Unit geometric normal of triangle t (counter-clockwise winding).
     glm::vec3 triangleNormal(uint32_t t) const;
-    /// Albedo (linear RGB) at barycentric (b1, b2) of triangle t, texture and vertex colour included.
+    /// Albedo (linear RGB) at barycentric (b1, b2) of triangle t, texture and vertex colour
+    /// included; the texture read bilinearly at the point (level 0).
     glm::vec3 albedoAt(uint32_t t, float b1, float b2) const;
+    /// The gradients of the UV set `texCoord` (0 or 1) of triangle t in its plane: the point
+    /// p0 + d of the plane has uv(p0) + (dot(gradients.u, d), dot(gradients.v, d)). Zero for
+    /// a triangle whose corners share one UV.
+    UvGradients uvGradients(uint32_t t, int texCoord) const;
+    /// albedoAt with the base-colour texture averaged over the pixel footprint whose sides are
+    /// the hit position's changes per pixel dPdx, dPdy (metres, in the triangle's plane):
+    /// Texture::sampleFootprint of the UV changes uvGradients gives for them.
+    glm::vec3 albedoOverFootprint(uint32_t t, float b1, float b2, const glm::vec3& dPdx,
+                                  const glm::vec3& dPdy) const;
     /// Emitted radiance at barycentric (b1, b2) of triangle t.
     glm::vec3 emissionAt(uint32_t t, float b1, float b2) const;
 };

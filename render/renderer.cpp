@@ -196,9 +196,8 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     }
 
     const float near = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
-    gpu::GbufferPush gbufferPush{};
-    gbufferPush.clipFromWorld = gpu::clipFromWorldOf(camera, params.width, params.height, near);
-    gbufferPush.eye = camera.eye;
+    const gpu::GbufferPush gbufferPush =
+        gpu::gbufferPushOf(camera, params.width, params.height, near);
 
     gpu::CacheShadingPush push{};
     push.eye = camera.eye;

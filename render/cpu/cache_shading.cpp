@@ -84,6 +84,10 @@ struct ShadingContext {
     const CacheValues& values;
     const LightSet& lights;
     const ShadeParams& params;
+    const CameraRays& cameraRays;
+    /// Texture footprints are a subsample's share of the pixel: 1/√n of its sides for n
+    /// subsamples, so that the filter and the subsample average do not both blur by a pixel.
+    float footprintScale;
     std::vector<float> emissiveScale;  // per material: the light set's scale
 };
 
@@ -98,7 +102,13 @@ glm::vec3 shadeRay(const ShadingContext& context, const glm::vec3& origin,
     const glm::vec3 position = origin + hit->t * direction;
     // Both faces reflect: shade the side the camera sees.
     const glm::vec3 normal = hit->backFace ? -hit->geometricNormal : hit->geometricNormal;
-    const glm::vec3 albedo = context.scene.albedoAt(hit->triangle, hit->b1, hit->b2);
+    // Base-colour textures averaged over the subsample's footprint on the hit's plane, as the
+    // G-buffer pass averages them over its pixel's (shaders/gbuffer.frag).
+    const PixelFootprint footprint =
+        context.cameraRays.footprintOnPlane(position, hit->geometricNormal);
+    const glm::vec3 albedo = context.scene.albedoOverFootprint(
+        hit->triangle, hit->b1, hit->b2, context.footprintScale * footprint.dPdx,
+        context.footprintScale * footprint.dPdy);
     glm::vec3 radiance(0.0f);
 
     if (params.component == ShadeComponent::Full && !hit->backFace) {
@@ -151,14 +161,15 @@ Result<Image> shadeFromCaches(const Scene& scene, const EmbreeScene& rays, const
                               const Camera& camera, const ShadeParams& params) {
     if (auto ok = validate(scene, bake, values, params); !ok) return std::unexpected(ok.error());
 
-    ShadingContext context{scene, rays, bake, values, lights, params, {}};
+    const CameraRays cameraRays(camera, params.width, params.height);
+    const uint32_t n = params.samplesPerPixel;
+    ShadingContext context{
+        scene, rays, bake, values, lights, params, cameraRays, 1.0f / std::sqrt(float(n)), {}};
     // The light set scales emission per material name; resolve the names once, not per pixel.
     context.emissiveScale.resize(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m)
         context.emissiveScale[m] = lights.emissiveScaleOf(scene.materials[m].name);
 
-    const CameraRays cameraRays(camera, params.width, params.height);
-    const uint32_t n = params.samplesPerPixel;
     std::vector<glm::vec2> offsets(n);
     for (uint32_t s = 0; s < n; ++s) offsets[s] = subsampleOffset(s, n);
 

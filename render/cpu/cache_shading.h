@@ -18,7 +18,9 @@ namespace pic {
 
 /// Renders `camera`'s view of `scene` lit by `lights` and shaded from cache radiance `values`
 /// of `bake`. Per pixel: a primary ray; at the hit, the geometric normal facing the camera,
-/// albedo ρ; direct = Σ ρ/π·E_light·V (Embree shadow rays), indirect = ρ/π·E_SH(n) (negative
+/// albedo ρ with its base-colour texture averaged over the ray's footprint on the hit's plane
+/// (Scene::albedoOverFootprint: mip-mapped and anisotropic, as the G-buffer pass; the
+/// footprint of each of n subsamples is the pixel's with sides scaled by 1/√n); direct = Σ ρ/π·E_light·V (Embree shadow rays), indirect = ρ/π·E_SH(n) (negative
 /// SH ringing clamped to 0 per channel) + glossyWeight·glossy lobe, emission (front faces,
 /// emissive scale applied) in Full only; misses are black. Deterministic (independent of the
 /// thread count), never NaN or negative for valid inputs. InvalidInput for zero sizes or

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/bake_data.h"
+#include "core/camera.h"
 #include "gpu/pipelines.h"
 #include "gpu/vk_error.h"
 #include "spirv/gbuffer_frag.h"
@@ -15,8 +16,10 @@ namespace pic::gpu {
 namespace {
 
 /// Storage buffers the fragment shader reads: triangles, materials, textures, texels,
-/// emissive scales (shaders/gbuffer.frag bindings 0–4).
-constexpr uint32_t kBindingCount = 5;
+/// emissive scales, mip levels (shaders/gbuffer.frag bindings 0–5).
+constexpr uint32_t kBindingCount = 6;
+
+static_assert(kGbufferMaxAnisotropy == kMaxAnisotropy, "the shader filters as core/texture.h");
 
 /// The colour targets' names, for allocation messages.
 constexpr const char* kTargetNames[kGbufferTargets] = {"G-buffer positions", "G-buffer normals",
@@ -50,6 +53,16 @@ glm::mat4 clipFromWorldOf(const Camera& camera, uint32_t width, uint32_t height,
     return m;
 }
 
+GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near) {
+    GbufferPush push{};
+    push.clipFromWorld = clipFromWorldOf(camera, width, height, near);
+    push.eye = camera.eye;
+    const CameraRays rays(camera, width, height);
+    push.directionPerPixelX = glm::vec4(rays.directionPerPixelX(), 0.0f);
+    push.directionPerPixelY = glm::vec4(rays.directionPerPixelY(), 0.0f);
+    return push;
+}
+
 Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const Scene& scene,
                                                          std::span<const glm::vec2> triangleUvs) {
     PIC_CHECK_EQ(triangleUvs.size(), 3 * scene.triangles.size());
@@ -58,8 +71,10 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
                     scene.sourcePath);
     std::unique_ptr<GbufferPass> pass(new GbufferPass(context, scene));
 
-    // Textures first: materials name them by index.
+    // Textures first: materials name them by index. Each brings its mip chain as built at
+    // load (core/texture.h buildMipChain), level 0 first, so both twins read the same levels.
     std::vector<GbufferTexture> textures;
+    std::vector<GbufferTextureLevel> levels;
     std::vector<glm::vec4> texels;
     for (size_t i = 0; i < scene.textures.size(); ++i) {
         const Texture& t = scene.textures[i];
@@ -67,12 +82,23 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
             return fail(ErrorCode::InvalidInput, "texture {} (\"{}\") is {}x{} with {} texels", i,
                         t.name, t.width, t.height, t.texels.size());
         GbufferTexture record{};
-        record.firstTexel = uint32_t(texels.size());
-        record.width = t.width;
-        record.height = t.height;
+        record.firstLevel = uint32_t(levels.size());
+        record.levelCount = t.levelCount();
         record.wrap = (t.repeatS ? kTextureRepeatS : 0u) | (t.repeatT ? kTextureRepeatT : 0u);
         textures.push_back(record);
-        texels.insert(texels.end(), t.texels.begin(), t.texels.end());
+        const auto addLevel = [&](int width, int height, const std::vector<glm::vec4>& source) {
+            levels.push_back({uint32_t(texels.size()), width, height, 0u});
+            texels.insert(texels.end(), source.begin(), source.end());
+        };
+        addLevel(t.width, t.height, t.texels);
+        for (const MipLevel& level : t.mips) {
+            if (level.width <= 0 || level.height <= 0 ||
+                level.texels.size() != size_t(level.width) * size_t(level.height))
+                return fail(ErrorCode::InvalidInput,
+                            "texture {} (\"{}\") has a mip level {}x{} with {} texels", i, t.name,
+                            level.width, level.height, level.texels.size());
+            addLevel(level.width, level.height, level.texels);
+        }
     }
     std::vector<GbufferMaterial> materials;
     const auto textureOk = [&](int index) {
@@ -124,6 +150,13 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
         record.normal = scene.triangleNormal(uint32_t(t));
         record.material = triangle.material;
         record.lightmapped = lightmapped ? 1u : 0u;
+        // The base-colour UV set's gradients turn the pixel footprint into texels.
+        const Material& material = scene.materials[triangle.material];
+        if (material.baseColorTexture >= 0) {
+            const UvGradients g = scene.uvGradients(uint32_t(t), material.baseColorTexCoord);
+            record.uGradient = g.u;
+            record.vGradient = g.v;
+        }
         triangles.push_back(record);
     }
     pass->mVertexCount = uint32_t(vertices.size());
@@ -156,6 +189,9 @@ Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const
                                       "texture records"));
     PIC_TRY_ASSIGN(pass->mTexels,
                    Buffer::createWith(context, std::span<const glm::vec4>(texels), 0, "texels"));
+    PIC_TRY_ASSIGN(pass->mLevels,
+                   Buffer::createWith(context, std::span<const GbufferTextureLevel>(levels), 0,
+                                      "texture mip levels"));
     PIC_TRY_ASSIGN(
         pass->mEmissiveScale,
         Buffer::create(context, std::max<size_t>(scene.materials.size(), 1) * sizeof(float), 0,
@@ -179,8 +215,8 @@ Result<void> GbufferPass::createPipeline() {
     const VkDescriptorSetLayout setLayout = mSetLayout.get();
     allocInfo.pSetLayouts = &setLayout;
     PIC_VK_TRY(vkAllocateDescriptorSets(device, &allocInfo, &mSet));
-    const Buffer* buffers[kBindingCount] = {&mTriangles, &mMaterials, &mTextures, &mTexels,
-                                            &mEmissiveScale};
+    const Buffer* buffers[kBindingCount] = {&mTriangles, &mMaterials,     &mTextures,
+                                            &mTexels,    &mEmissiveScale, &mLevels};
     std::array<VkDescriptorBufferInfo, kBindingCount> infos;
     std::array<VkWriteDescriptorSet, kBindingCount> writes;
     for (uint32_t b = 0; b < kBindingCount; ++b) {
@@ -328,7 +364,8 @@ void GbufferPass::record(VkCommandBuffer cmd, const GbufferPush& push) {
 
 VkDeviceSize GbufferPass::bytes() const {
     VkDeviceSize total = mVertices.size() + mTriangles.size() + mMaterials.size() +
-                         mTextures.size() + mTexels.size() + mEmissiveScale.size() + mDepth.bytes();
+                         mTextures.size() + mLevels.size() + mTexels.size() +
+                         mEmissiveScale.size() + mDepth.bytes();
     for (const RenderTarget& target : mTargets) total += target.bytes();
     return total;
 }

@@ -30,13 +30,19 @@ inline constexpr VkFormat kGbufferFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 /// stays precise far away. The camera must be valid (see Renderer::render).
 glm::mat4 clipFromWorldOf(const Camera& camera, uint32_t width, uint32_t height, float near);
 
+/// Both raster stages' push constants for the camera's width × height view: clipFromWorldOf,
+/// the eye, and how its rays turn per pixel (CameraRays), from which the fragment shader
+/// measures texture footprints exactly as the CPU twin does.
+GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near);
+
 /// Rasterises the G-buffer of one camera view per frame; the targets are resized on demand.
 class GbufferPass {
 public:
     /// Uploads the scene's triangles (3 corners each, with `triangleUvs` as their light-map
-    /// UVs, kNotLightmapped for grid-shaded triangles), materials and textures, and builds
+    /// UVs, kNotLightmapped for grid-shaded triangles), materials and textures with their mip
+    /// chains (as the scene holds them: core/texture.h buildMipChain), and builds
     /// the raster pipeline. InvalidInput for a scene whose triangles, materials or textures
-    /// do not index each other; Unsupported when its textures or triangle records exceed one
+    /// do not index each other or whose texels do not fill a texture's or a mip level's size; Unsupported when its textures or triangle records exceed one
     /// storage buffer.
     static Result<std::unique_ptr<GbufferPass>> create(Context& context, const Scene& scene,
                                                        std::span<const glm::vec2> triangleUvs);
@@ -67,7 +73,8 @@ private:
     Buffer mTriangles;      ///< GbufferTriangle
     Buffer mMaterials;      ///< GbufferMaterial
     Buffer mTextures;       ///< GbufferTexture
-    Buffer mTexels;         ///< vec4, every texture's texels
+    Buffer mLevels;         ///< GbufferTextureLevel, every texture's mip levels
+    Buffer mTexels;         ///< vec4, every level's texels
     Buffer mEmissiveScale;  ///< float per material
     std::array<RenderTarget, kGbufferTargets> mTargets;
     RenderTarget mDepth;

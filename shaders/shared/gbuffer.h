@@ -34,12 +34,14 @@ PIC_OFFSET_CHECK(GbufferVertex, lightmapUv, 48);
 struct GbufferTriangle {
     vec3 normal;       // unit geometric normal, counter-clockwise winding (Scene::triangleNormal)
     uint material;     // index into the materials
+    vec3 uGradient;    // ∂u/∂position per metre of the base-colour UV set (Scene::uvGradients)
     uint lightmapped;  // 1: shaded from the light map, 0: from the grid
+    vec3 vGradient;    // ∂v/∂position per metre of the same set
     uint pad0;
-    uint pad1;
-    uint pad2;
 };
-PIC_STRUCT_CHECK(GbufferTriangle, 32);
+PIC_STRUCT_CHECK(GbufferTriangle, 48);
+PIC_OFFSET_CHECK(GbufferTriangle, uGradient, 16);
+PIC_OFFSET_CHECK(GbufferTriangle, vGradient, 32);
 
 // core/scene.h Material, as far as shading reads it.
 struct GbufferMaterial {
@@ -55,24 +57,38 @@ PIC_STRUCT_CHECK(GbufferMaterial, 48);
 
 PIC_CONST(uint, kTextureRepeatS, 1u);
 PIC_CONST(uint, kTextureRepeatT, 2u);
+// core/texture.h kMaxAnisotropy: most trilinear taps of one footprint lookup.
+PIC_CONST(int, kGbufferMaxAnisotropy, 16);
 
-// core/scene.h Texture: its texels (linear RGBA, row 0 at v = 0) at [firstTexel, firstTexel +
-// width·height) of the texel buffer.
+// core/texture.h Texture: its mip levels (level 0 first) at [firstLevel, firstLevel +
+// levelCount) of the level records.
 struct GbufferTexture {
+    uint firstLevel;
+    int levelCount;
+    uint wrap;  // kTextureRepeatS | kTextureRepeatT where the axis repeats, else it clamps
+    uint pad0;
+};
+PIC_STRUCT_CHECK(GbufferTexture, 16);
+
+// One mip level: its texels (linear RGBA, row 0 at v = 0) at [firstTexel, firstTexel +
+// width·height) of the texel buffer.
+struct GbufferTextureLevel {
     uint firstTexel;
     int width;
     int height;
-    uint wrap;  // kTextureRepeatS | kTextureRepeatT where the axis repeats, else it clamps
+    uint pad0;
 };
-PIC_STRUCT_CHECK(GbufferTexture, 16);
+PIC_STRUCT_CHECK(GbufferTextureLevel, 16);
 
 // Push constants of both raster stages.
 struct GbufferPush {
     mat4 clipFromWorld;  // reversed-Z perspective of the camera (pixel centres = CameraRays')
     vec3 eye;            // metres: decides which face of a triangle the camera sees
     float pad0;
+    vec4 directionPerPixelX;  // xyz: CameraRays::directionPerPixelX (texture footprints), w: 0
+    vec4 directionPerPixelY;  // xyz: CameraRays::directionPerPixelY, w: 0
 };
-PIC_STRUCT_CHECK(GbufferPush, 80);
+PIC_STRUCT_CHECK(GbufferPush, 112);
 
 PIC_NAMESPACE_END
 

@@ -652,6 +652,13 @@ TEST_F(GltfLoader, TextureIsLinearisedFromSrgbAndSampledBilinearly) {
         expectVecNear(scene->albedoAt(t, b1, b2), factor * probe.texel, 1e-5f);
         expectVecNear(scene->emissionAt(t, b1, b2), probe.texel, 1e-5f);
     }
+
+    // The loader builds the mip chain from the linear values: its 1×1 top is their mean, not
+    // the mean of the sRGB codes.
+    ASSERT_EQ(texture.levelCount(), 2);
+    ASSERT_EQ(texture.mips[0].texels.size(), 1u);
+    expectVecNear(glm::vec3(texture.mips[0].texels[0]),
+                  0.25f * (linear[0] + linear[1] + linear[2] + linear[3]), 1e-6f);
 }
 
 TEST_F(GltfLoader, SixteenBitTexturesKeepTheirPrecision) {

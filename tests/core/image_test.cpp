@@ -280,11 +280,6 @@ TEST(BlotchIndex, CountsDisagreementBetweenBlocksNotScaleNorNoiseWithinThem) {
     auto blotches = blotchIndex(blotchy, reference);
     ASSERT_TRUE(blotches);
     EXPECT_NEAR(*blotches, 0.5, 1e-6);
-    // Edge blocks average what they hold.
-    const Image means = blockMean(filled(5, 3, glm::vec3(2.0f)), 4);
-    EXPECT_EQ(means.width, 2u);
-    EXPECT_EQ(means.height, 1u);
-    EXPECT_EQ(means.at(1, 0), glm::vec3(2.0f));
     EXPECT_FALSE(blotchIndex(Image(8, 4), reference));  // black: nothing to scale
 }
 
@@ -301,6 +296,37 @@ TEST(CompareImages, RejectsMismatchedBlackAndNonFiniteImages) {
     auto nanError = compareImages(nan, filled(2, 2, glm::vec3(1.0f)));
     ASSERT_FALSE(nanError);
     EXPECT_NE(nanError.error().message.find("pixel (1, 0)"), std::string::npos);
+}
+
+TEST(BlockAverage, AveragesWholeAndEdgeBlocks) {
+    // 5 × 3 with pixel (x, y) = (x, y, x + 10y): 2 × 2 blocks give 3 × 2, the edge blocks
+    // averaging the pixels they hold.
+    Image image(5, 3);
+    for (uint32_t y = 0; y < 3; ++y)
+        for (uint32_t x = 0; x < 5; ++x) image.at(x, y) = glm::vec3(x, y, x + 10.0f * y);
+    auto averaged = blockAverage(image, 2);
+    ASSERT_TRUE(averaged) << averaged.error().message;
+    ASSERT_EQ(averaged->width, 3u);
+    ASSERT_EQ(averaged->height, 2u);
+    EXPECT_EQ(averaged->at(0, 0), glm::vec3(0.5f, 0.5f, 5.5f));
+    EXPECT_EQ(averaged->at(2, 0), glm::vec3(4.0f, 0.5f, 9.0f));   // one column of two rows
+    EXPECT_EQ(averaged->at(1, 1), glm::vec3(2.5f, 2.0f, 22.5f));  // two columns of one row
+    EXPECT_EQ(averaged->at(2, 1), glm::vec3(4.0f, 2.0f, 24.0f));  // the corner pixel alone
+    // Block 1 is the image itself; the error of averages falls where the error is fine detail.
+    auto same = blockAverage(image, 1);
+    ASSERT_TRUE(same);
+    EXPECT_EQ(same->pixels, image.pixels);
+    Image checker(8, 8), grey(8, 8);
+    for (uint32_t y = 0; y < 8; ++y)
+        for (uint32_t x = 0; x < 8; ++x) {
+            checker.at(x, y) = glm::vec3(float((x + y) % 2));
+            grey.at(x, y) = glm::vec3(0.5f);
+        }
+    EXPECT_NEAR(compareImages(checker, grey)->relativeRmse, 1.0, 1e-9);
+    EXPECT_NEAR(compareImages(*blockAverage(checker, 2), *blockAverage(grey, 2))->relativeRmse, 0.0,
+                1e-9);
+    EXPECT_FALSE(blockAverage(image, 0));
+    EXPECT_FALSE(blockAverage(Image(), 4));
 }
 
 }  // namespace

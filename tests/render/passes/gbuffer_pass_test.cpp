@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <vector>
 
@@ -161,9 +162,7 @@ TEST(GbufferPass, PixelsHoldWhatTheirCameraRaysHit) {
     bool reallocated = false;
     ASSERT_TRUE((*pass)->prepare(kWidth, kHeight, lights, reallocated));
     EXPECT_TRUE(reallocated);
-    gpu::GbufferPush push{};
-    push.clipFromWorld = gpu::clipFromWorldOf(camera, kWidth, kHeight, 1e-3f);
-    push.eye = camera.eye;
+    const gpu::GbufferPush push = gpu::gbufferPushOf(camera, kWidth, kHeight, 1e-3f);
     ASSERT_TRUE(context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, push); }));
     const std::vector<glm::vec4> targets = readTargets(*context, **pass);
     ASSERT_EQ(targets.size(), size_t{gpu::kGbufferTargets} * kWidth * kHeight);
@@ -232,6 +231,96 @@ TEST(GbufferPass, PixelsHoldWhatTheirCameraRaysHit) {
     EXPECT_GT(compared[0], 300);
     EXPECT_GT(compared[1], 600);
     EXPECT_GT(compared[2], 1000);
+    EXPECT_EQ(context->validationMessages(), 0u);
+}
+
+TEST(GbufferPass, TexturedAlbedoIsTheCpuFootprintAverage) {
+    // A floor 6 m × 40 m carrying a 64 × 64 texture of random texels once per metre, seen from
+    // half a metre above it towards the horizon: footprints from one texel (magnified, near) to
+    // whole textures (grazing), many of them long enough for anisotropic taps. Each pixel's
+    // albedo against Scene::albedoOverFootprint of its centre ray's footprint on the CPU.
+    const Rectangle floor{{-3.0f, 0.0f, 2.0f}, {6.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -40.0f}, 0, false};
+    Scene scene;
+    Texture random;
+    random.name = "random";
+    random.width = random.height = 64;
+    uint32_t state = 12345u;
+    for (int i = 0; i < 64 * 64; ++i) {
+        glm::vec4 texel(1.0f);
+        for (int c = 0; c < 3; ++c) {
+            state = state * 1664525u + 1013904223u;  // a fixed LCG: the same texels everywhere
+            texel[c] = float(state >> 8) / float(1u << 24);
+        }
+        random.texels.push_back(texel);
+    }
+    buildMipChain(random);
+    scene.textures.push_back(std::move(random));
+    scene.materials = {Material{
+        .name = "floor", .baseColorFactor = {0.9f, 0.8f, 1.0f, 1.0f}, .baseColorTexture = 0}};
+    const glm::vec2 corners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (const glm::vec2& c : corners) {
+        Vertex v;
+        v.position = floor.corner + c.x * floor.edgeU + c.y * floor.edgeV;
+        v.normal = floor.normal();
+        v.uv0 = c * glm::vec2(6.0f, 40.0f);  // one texture repeat per metre
+        scene.vertices.push_back(v);
+        scene.bounds.extend(v.position);
+    }
+    scene.triangles.push_back(Triangle{{0, 1, 2}, 0, 0});
+    scene.triangles.push_back(Triangle{{0, 2, 3}, 0, 0});
+    const std::vector<glm::vec2> triangleUvs(6, glm::vec2(kNotLightmapped));
+
+    gpu::Context* context = test::sharedContext();
+    ASSERT_TRUE(context);
+    auto pass = gpu::GbufferPass::create(*context, scene, triangleUvs);
+    ASSERT_TRUE(pass) << pass.error().message;
+    Camera camera;
+    camera.eye = {0.1f, 0.5f, 2.5f};
+    camera.target = {0.0f, 0.3f, -3.0f};
+    camera.fovyDegrees = 50.0f;
+    constexpr uint32_t kWidth = 96, kHeight = 64;
+    bool reallocated = false;
+    ASSERT_TRUE((*pass)->prepare(kWidth, kHeight, LightSet{}, reallocated));
+    const gpu::GbufferPush push = gpu::gbufferPushOf(camera, kWidth, kHeight, 1e-3f);
+    ASSERT_TRUE(context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, push); }));
+    const std::vector<glm::vec4> targets = readTargets(*context, **pass);
+    ASSERT_EQ(targets.size(), size_t{gpu::kGbufferTargets} * kWidth * kHeight);
+
+    const CameraRays rays(camera, kWidth, kHeight);
+    int compared = 0, close = 0, filtered = 0;
+    float worst = 0.0f;
+    for (uint32_t y = 0; y < kHeight; ++y)
+        for (uint32_t x = 0; x < kWidth; ++x) {
+            const glm::vec3 direction = rays.direction(float(x) + 0.5f, float(y) + 0.5f);
+            const auto hit = hitPlane(floor, rays.origin(), direction);
+            if (!hit || std::min({hit->u, 1.0f - hit->u, hit->v, 1.0f - hit->v}) < 0.01f)
+                continue;  // off the floor or at its border (the coverage rule decides)
+            const glm::vec3 p = rays.origin() + hit->t * direction;
+            // Triangle 0 holds u ≥ v of the rectangle, triangle 1 the rest (see Rectangle).
+            const bool first = hit->u >= hit->v;
+            const float b1 = first ? hit->u - hit->v : hit->u;
+            const float b2 = first ? hit->v : hit->v - hit->u;
+            const PixelFootprint footprint = rays.footprintOnPlane(p, floor.normal());
+            const glm::vec3 expected =
+                scene.albedoOverFootprint(first ? 0 : 1, b1, b2, footprint.dPdx, footprint.dPdy);
+            const glm::vec4 albedo = targets[2 * size_t{kWidth} * kHeight + size_t(y) * kWidth + x];
+            float error = 0.0f;
+            for (int c = 0; c < 3; ++c) error = std::max(error, std::abs(albedo[c] - expected[c]));
+            worst = std::max(worst, error);
+            close += error <= 2e-3f;
+            // Footprints over a texel across: the lookup is more than one bilinear tap.
+            filtered += glm::length(footprint.dPdx) * 64.0f > 1.0f ||
+                        glm::length(footprint.dPdy) * 64.0f > 1.0f;
+            ++compared;
+        }
+    std::printf("textured floor: %d pixels compared, %d filtered, %d within 2e-3, worst %.4f\n",
+                compared, filtered, close, worst);
+    EXPECT_GT(compared, 2500);
+    EXPECT_GT(filtered, compared / 2);
+    // The twins agree but for float rounding; a rare pixel may differ where a tap count or
+    // a level boundary falls between the two roundings.
+    EXPECT_GE(close, compared - compared / 200);
+    EXPECT_LT(worst, 0.05f);
     EXPECT_EQ(context->validationMessages(), 0u);
 }
 

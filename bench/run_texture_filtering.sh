@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Texture filtering (docs/accuracy.md, "Texture filtering"): per-pixel and block relative RMSE
+# of the CPU shading from caches (picref shade, 1 subsample per pixel) and of the thin client
+# (picclient render on Vulkan, against a CPU-backend picserver) against the path tracer
+# (picref, which averages each pixel's footprint over its samples), on textured scenes, for the
+# direct component (exact light, so only texture filtering and shadow maps differ) and the
+# full image. Writes the images and one JSON per comparison into ${OUT:-texture_filtering}/.
+# Usage: bash bench/run_texture_filtering.sh [build-dir]
+# PICBAKE, PICREF, PICSERVER, PICCLIENT override single binaries (e.g. an older build's);
+# PICBENCH likewise (its compare subcommand measures). SPP (default 256) is the reference's.
+set -euo pipefail
+BUILD=${1:-build}
+OUT=${OUT:-texture_filtering}
+SPP=${SPP:-256}
+PICBAKE=${PICBAKE:-$BUILD/bake/picbake}
+PICREF=${PICREF:-$BUILD/bake/ref/picref}
+PICSERVER=${PICSERVER:-$BUILD/server/picserver}
+PICCLIENT=${PICCLIENT:-$BUILD/client/picclient}
+PICBENCH=${PICBENCH:-$BUILD/bench/picbench}
+HERE=$(cd "$(dirname "$0")" && pwd)
+SCENES=$HERE/../../shared/scenes
+mkdir -p "$OUT"
+
+SERVER_PID=
+stop_server() { if [ -n "$SERVER_PID" ]; then kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true; SERVER_PID=; fi; }
+trap stop_server EXIT
+
+# run_case NAME SCENE LIGHTS CAMERA SIZE: one view, both components, both shading paths.
+run_case() {
+  local name=$1 scene=$2 lights=$3 camera=$4 size=$5
+  local bake="$OUT/${name%%-*}.pic"
+  [ -f "$bake" ] || "$PICBAKE" --quiet bake "$scene" -o "$bake" > "$OUT/${name%%-*}_bake.log"
+  "$PICSERVER" --quiet --bake "$bake" --scene "$scene" --listen 127.0.0.1:0 --backend cpu \
+    > "$OUT/${name}_server.log" 2>&1 &
+  SERVER_PID=$!
+  local address=
+  for _ in $(seq 600); do
+    address=$(sed -n 's/^listening on //p' "$OUT/${name}_server.log" | head -1)
+    [ -n "$address" ] && break
+    sleep 0.1
+  done
+  [ -n "$address" ] || { echo "picserver did not start:"; cat "$OUT/${name}_server.log"; exit 1; }
+  local session token
+  session=$("$PICCLIENT" session --server "$address")
+  token=$(echo "$session" | sed -n 's/.*"editor_token": *"\([^"]*\)".*/\1/p')
+  session=$(echo "$session" | sed -n 's/.*"session": *"\([^"]*\)".*/\1/p')
+  for component in direct full; do
+    local bounces=()
+    [ "$component" = direct ] && bounces=(--bounces 0)
+    local ref="$OUT/${name}_${component}_ref.exr"
+    [ -f "$ref" ] || "$PICREF" --quiet "$scene" --lights "$lights" --camera "$camera" --size "$size" \
+      --spp "$SPP" "${bounces[@]}" --component "$component" --out "$ref"
+    "$PICREF" shade --quiet "$scene" --bake "$bake" --lights "$lights" --camera "$camera" \
+      --size "$size" --component "$component" --out "$OUT/${name}_${component}_cpu.exr" 2> /dev/null
+    "$PICCLIENT" render --server "$address" --session "$session" --token "$token" \
+      --lights "$lights" --camera "$camera" --size "$size" --component "$component" \
+      --cache-dir "$OUT/client_cache" --out "$OUT/${name}_${component}_gpu.exr" 2> /dev/null
+    for path in cpu gpu; do
+      echo "== $name $component, $path shading against picref $SPP spp"
+      "$PICBENCH" --quiet compare "$OUT/${name}_${component}_${path}.exr" "$ref" \
+        --json "$OUT/${name}_${component}_${path}.json" | sed '/^written/d'
+    done
+  done
+  stop_server
+}
+
+run_case openarena "$SCENES/openarena_oa_rpg3dm2.glb" "$HERE/lightsets/openarena_sun.json" \
+  16,25,-20,18,0,-40,0,1,0,60 320x240
+run_case living_room "$SCENES/living_room_sh3d.glb" "$HERE/lightsets/living_room_sun_lamp.json" \
+  0.5,1.7,0.5,4.5,0.5,4.0,0,1,0,70 320x240
+# The generated checker quad from its scene camera and from just above the floor (grazing).
+QUAD=$BUILD/scenes/textured_quad.gltf
+QUAD_LIGHTS="$OUT/textured_quad_lights.json"
+echo '{"lights":[{"id":"lamp","type":"point","position":[0.0,0.8,0.3],"intensity":1.0}]}' > "$QUAD_LIGHTS"
+run_case textured_quad "$QUAD" "$QUAD_LIGHTS" 0,0.9,1.3,0,0.2,-0.2,0,1,0,50 192x192
+run_case textured_quad-grazing "$QUAD" "$QUAD_LIGHTS" 0,0.06,0.9,0,0.02,-0.5,0,1,0,50 256x128
