@@ -162,6 +162,7 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     p.exposureRays = options.exposureRays;
     if (p.exposureRays > 1024)
         return fail(ErrorCode::InvalidInput, "--exposure-rays must be in [0, 1024], got {}", p.exposureRays);
+    p.linkReads = options.linkReads;
     p.relaxIterations = options.relaxIterations;
     p.seed = options.seed;
     return p;
@@ -236,6 +237,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.bands = p.bandsY;
     linkParams.samplesPerNode = p.linkSamples;
     linkParams.seed = p.seed;
+    linkParams.reads = p.linkReads;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
     bake.links = std::move(links.links);
     report.links = links.stats;

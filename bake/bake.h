@@ -26,6 +26,7 @@ struct BakeOptions {
     HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
     uint32_t linkSamples = 16;
     uint32_t exposureRays = 64;
+    LinkReads linkReads = LinkReads::Visible;
     uint32_t relaxIterations = 4;
     uint64_t seed = 1;
 };

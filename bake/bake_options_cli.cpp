@@ -17,6 +17,10 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     command.add_option("--exposure-rays", mOptions.exposureRays,
                        "rays per surfel that weight a node's flux towards its exposed surfels; 0: the "
                        "paper's uniform node radiance (default 64)");
+    command.add_option("--link-reads", mLinkReads,
+                       "whose flux a link reads: visible (the smallest part of the linked node "
+                       "holding what the cache sees) or node (the paper's; default visible)")
+        ->check(CLI::IsMember({"visible", "node"}));
     command.add_option("--relax", mOptions.relaxIterations, "surfel relaxation iterations (default 4)");
     command.add_option("--seed", mOptions.seed, "random seed (default 1)");
 }
@@ -31,6 +35,7 @@ BakeOptions BakeOptionFlags::toOptions() const {
     if (*mTexelOption) options.lightmapTexel = mLightmapTexel;
     options.linkMode = mLinkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
     options.hierarchy = mHierarchy == "kdtree" ? HierarchyMethod::KdTree : HierarchyMethod::Agglomerative;
+    options.linkReads = mLinkReads == "node" ? LinkReads::Node : LinkReads::Visible;
     return options;
 }
 

@@ -35,8 +35,14 @@ struct NodeEstimate {
     glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
+    uint32_t visibleCount = 0;              ///< samples that reached a surfel
+    uint32_t taken = 0;                     ///< samples drawn (all surfels when exact)
+    uint32_t firstVisible = UINT32_MAX;     ///< leaf-order range of the visible samples' surfels
+    uint32_t lastVisible = 0;
     float priority = 0.0f;     ///< refinement order: larger first
     bool exact = false;        ///< every surfel of the node was tested
+    uint32_t readNode = 0;     ///< the node whose flux the link reads (see CacheLinker::localise)
+    float readScale = 1.0f;    ///< Σ w·a of the node over that of readNode
 };
 
 /// Per-thread scratch, reused across caches to avoid allocation in the hot loop.
@@ -121,12 +127,16 @@ public:
             NodeEstimate again = estimate(scratch.estimates[e].node, cache, fresh,
                                           scratch.samples, rays);
             if (again.visible <= 0.0f) continue;
+            // Both sample sets bound the part the cache sees.
+            again.firstVisible = std::min(again.firstVisible, scratch.estimates[e].firstVisible);
+            again.lastVisible = std::max(again.lastVisible, scratch.estimates[e].lastVisible);
             scratch.estimates.push_back(again);
             chosen.push_back(static_cast<uint32_t>(scratch.estimates.size() - 1));
         }
+        for (uint32_t e : chosen) localise(scratch.estimates[e]);
         // Links sorted by node index: neighbouring caches then read nodes in a similar order.
         std::sort(chosen.begin(), chosen.end(), [&](uint32_t a, uint32_t b) {
-            return scratch.estimates[a].node < scratch.estimates[b].node;
+            return scratch.estimates[a].readNode < scratch.estimates[b].readNode;
         });
         return rays;
     }
@@ -136,6 +146,40 @@ public:
     }
 
 private:
+    double weightedArea(uint32_t node) const {
+        const Node& n = mNodes[node];
+        return mPrefix[n.firstSurfel + n.surfelCount] - mPrefix[n.firstSurfel];
+    }
+
+    /// With LinkReads::Visible the link reads the flux of the smallest descendant of its node
+    /// that holds every visible sample (of both estimates) and at least the weighted area the
+    /// fresh samples found visible, (visible samples ÷ samples)·Σ w·a: a cache that sees one
+    /// side of a cluster (one face of a thin wall, the floor beside a sofa) reads that side's
+    /// light instead of the cluster's mean. The factor keeps the node's visible Σ w·Ω over
+    /// the descendant's Σ w·a, so the flux the node model spreads there is read the same way.
+    void localise(NodeEstimate& e) const {
+        e.readNode = e.node;
+        e.readScale = 1.0f;
+        if (mParams.reads == LinkReads::Node) return;
+        const double whole = weightedArea(e.node);
+        const double needed = e.exact ? 0.0 : whole * double(e.visibleCount) / double(e.taken);
+        uint32_t n = e.node;
+        for (;;) {
+            const Node& node = mNodes[n];
+            if (node.left == kNoNode) break;
+            uint32_t next = kNoNode;
+            for (uint32_t child : {node.left, node.right}) {
+                const Node& c = mNodes[child];
+                if (c.firstSurfel <= e.firstVisible && e.lastVisible < c.firstSurfel + c.surfelCount)
+                    next = child;
+            }
+            if (next == kNoNode || weightedArea(next) < needed) break;
+            n = next;
+        }
+        e.readNode = n;
+        e.readScale = float(whole / weightedArea(n));
+    }
+
     /// Estimates a node from up to K of its surfels: all of them when it has at most K (exact),
     /// else K drawn in proportion to w·a (stratified over the node's contiguous range of the
     /// prefix sums), one occlusion ray each. Drawn by weight, sample j estimates
@@ -150,6 +194,7 @@ private:
         e.sampleBegin = static_cast<uint32_t>(samples.size());
         const uint32_t k = mParams.samplesPerNode;
         const uint32_t taken = std::min(node.surfelCount, k);
+        e.taken = taken;
         e.exact = node.surfelCount <= k;
         const double begin = mPrefix[node.firstSurfel];
         const double weightedArea = mPrefix[node.firstSurfel + node.surfelCount] - begin;
@@ -177,6 +222,9 @@ private:
             ++rays;
             if (!view.visible) continue;
             e.visible += omega;
+            ++e.visibleCount;
+            e.firstVisible = std::min(e.firstVisible, s);
+            e.lastVisible = std::max(e.lastVisible, s);
             e.perArea += share;
             e.directionSum += share * view.direction;
             samples.push_back({view.direction, share});
@@ -301,8 +349,8 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                     // The cone spans the node's unoccluded solid angle; the factor scales it to
                     // Σ w·Ω·V / Σ w·a.
                     RtpLink& link = links.rtp[slot];
-                    link.node = e.node;
-                    link.factor = e.perArea / e.unoccluded * toRadiance;
+                    link.node = e.readNode;
+                    link.factor = e.perArea * e.readScale / e.unoccluded * toRadiance;
                     link.directionOct = encodeOctahedral(glm::normalize(e.directionSum));
                     link.oneMinusCosAlpha = std::min(2.0f, e.unoccluded / (2.0f * kPi));
                 } else {
@@ -314,10 +362,10 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                         shEvaluate(bands, s.direction, basis);
                         for (int i = 0; i < coefficients; ++i) sh[i] += s.share * basis[i];
                     }
-                    links.shNodes[slot] = e.node;
+                    links.shNodes[slot] = e.readNode;
                     uint16_t* out = &links.shCoefficients[slot * coefficients];
                     for (int i = 0; i < coefficients; ++i) {
-                        float value = sh[i] * toRadiance;
+                        float value = sh[i] * e.readScale * toRadiance;
                         if (std::abs(value) > 65504.0f) clamped.fetch_add(1, std::memory_order_relaxed);
                         out[i] = floatToHalfClamped(value);
                     }

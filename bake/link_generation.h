@@ -17,6 +17,7 @@ struct LinkParams {
     LinkMode mode = LinkMode::Rtp;
     uint32_t bands = 3;            ///< SH bands per link in SH mode
     uint32_t samplesPerNode = 16;  ///< visibility rays that estimate one node
+    LinkReads reads = LinkReads::Visible;
     uint64_t seed = 1;
 };
 
@@ -37,9 +38,11 @@ struct LinkResult {
 };
 
 /// Builds the links of every cache against the hierarchy (surfels in leaf order). A link reads
-/// its node's flux as spread over the surfels by `weights` (bake/surfel_exposure.h: one per
-/// surfel; empty for uniform): the radiance it carries from visible surfel j is
-/// Φ_node·w_j / (π·Σ_node w·a), so its factor is Σ_visible w_j·Ω_j / (π·Σ_node w·a).
+/// the flux Φ_r of a node r as spread over its surfels by `weights` (bake/surfel_exposure.h:
+/// one per surfel; empty for uniform): the radiance it carries from visible surfel j is
+/// Φ_r·w_j / (π·Σ_r w·a), so its factor is Σ_visible w_j·Ω_j / (π·Σ_r w·a). r is the node of
+/// the cache's cut (LinkReads::Node, paper 000) or its smallest descendant that holds the part
+/// the cache sees (LinkReads::Visible); the links of a cache then need not form a cut.
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params, const std::vector<float>& weights = {});

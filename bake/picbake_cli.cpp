@@ -112,6 +112,9 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     fmt::print("  flux weights    {}\n", p.exposureRays > 0
                                             ? fmt::format("exposure, {} rays per surfel", p.exposureRays)
                                             : std::string("uniform (--exposure-rays 0)"));
+    fmt::print("  links read      {}\n", p.linkReads == LinkReads::Node
+                                            ? "the linked node's flux (--link-reads node)"
+                                            : "the part of the node the cache sees");
     fmt::print("  bands           y {}, c {}{}\n", p.bandsY, p.bandsC,
                bake->defaults.count("bands") ? "  (default)" : "");
     fmt::print("  seed            {}\n", p.seed);
@@ -155,6 +158,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     out["params"] = {{"grid_cell", p.gridCell}, {"lightmap_texel", p.lightmapTexel},
                      {"hierarchy", toString(p.hierarchy)}, {"link_samples", p.linkSamples},
                      {"exposure_rays", p.exposureRays},
+                     {"link_reads", p.linkReads == LinkReads::Node ? "node" : "visible"},
                      {"relax_iterations", p.relaxIterations}, {"seed", p.seed}};
     out["defaults"] = Json::object();
     for (const auto& [key, how] : info->defaults) out["defaults"][key] = how;

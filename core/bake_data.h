@@ -32,6 +32,12 @@ enum class HierarchyMethod : uint32_t {
     KdTree = 1,         ///< median-split kd-tree (fast)
 };
 
+/// Whose flux a link reads (bake/link_generation.h).
+enum class LinkReads : uint32_t {
+    Node = 0,     ///< the linked node's (paper 000)
+    Visible = 1,  ///< the smallest descendant holding the part the cache sees
+};
+
 /// The parameters a bake was made with, after defaults were resolved.
 struct BakeParams {
     uint32_t surfels = 0;            ///< nS
@@ -45,6 +51,7 @@ struct BakeParams {
     uint32_t linkSamples = 16;       ///< visibility rays per node estimate
     uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
                                      ///< (bake/surfel_exposure.h); 0: uniform node radiance
+    LinkReads linkReads = LinkReads::Visible;
     uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
     uint64_t seed = 1;
 };

@@ -137,6 +137,10 @@ const char* hierarchyName(HierarchyMethod method) {
     return method == HierarchyMethod::KdTree ? "kdtree" : "agglomerative";
 }
 
+const char* linkReadsName(LinkReads reads) {
+    return reads == LinkReads::Node ? "node" : "visible";
+}
+
 // ---------------------------------------------------------------------------------------
 // Validation shared by the writer (InvalidInput) and the reader (Corrupt).
 
@@ -303,6 +307,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["hierarchy"] = hierarchyName(p.hierarchy);
     json["link_samples"] = p.linkSamples;
     json["exposure_rays"] = p.exposureRays;
+    json["link_reads"] = linkReadsName(p.linkReads);
     json["relax_iterations"] = p.relaxIterations;
     json["seed"] = p.seed;
     json["defaults"] = defaults;
@@ -423,6 +428,8 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     p.hierarchy = static_cast<HierarchyMethod>(hierarchy);
     PIC_TRY_ASSIGN(p.linkSamples, reader.u32("link_samples"));
     PIC_TRY_ASSIGN(p.exposureRays, reader.u32("exposure_rays"));
+    PIC_TRY_ASSIGN(const uint32_t linkReads, reader.oneOf("link_reads", {"node", "visible"}));
+    p.linkReads = static_cast<LinkReads>(linkReads);
     PIC_TRY_ASSIGN(p.relaxIterations, reader.u32("relax_iterations"));
     PIC_TRY_ASSIGN(p.seed, reader.unsignedField("seed", std::numeric_limits<uint64_t>::max()));
     PIC_TRY_ASSIGN(parsed.defaults, reader.stringMap("defaults"));

@@ -55,7 +55,7 @@
 namespace pic {
 
 /// Format version written into, and required of, every bake file.
-inline constexpr uint32_t kBakeFormatVersion = 2;
+inline constexpr uint32_t kBakeFormatVersion = 3;
 /// Bytes of the header including its trailing checksum; the section table follows.
 inline constexpr uint64_t kBakeHeaderBytes = 48;
 /// Bytes of one section table entry.

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "bake/link_generation.h"
+#include "bake/surfel_hierarchy.h"
 #include "bake/surfel_exposure.h"
 #include "core/color.h"
 #include "rays/embree_scene.h"
@@ -155,6 +156,66 @@ TEST(SurfelExposure, LinkFactorsFollowTheWeightsOfTheVisibleSurfels) {
     auto bad = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, mixed);
     ASSERT_FALSE(bad);
     EXPECT_NE(bad.error().message.find("surfel 7"), std::string::npos) << bad.error().message;
+}
+
+TEST(LinkReads, ACacheReadsTheSideOfAThinSlabItSees) {
+    // A 2 m slab 1 cm thick, 8 × 8 surfels on its top face and on its bottom face, one
+    // cluster over both, and a grid cache 1 m above it with one link: paper 000's link reads
+    // the cluster's flux, so light under the slab leaks to the cache; a link that reads the
+    // visible part reads the top face alone, with the factor doubled (half the area).
+    Scene scene;
+    scene.sourcePath = "slab.gltf";
+    addSquare(scene, 0.005f, 1.0f, true);
+    addSquare(scene, -0.005f, 1.0f, false);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    std::vector<Surfel> surfels;
+    for (int side = 0; side < 2; ++side)
+        for (int i = 0; i < 8; ++i)
+            for (int j = 0; j < 8; ++j) {
+                const float y = side == 0 ? 0.005f : -0.005f;
+                Surfel s = surfelAt({-0.875f + 0.25f * i, y, -0.875f + 0.25f * j},
+                                    {0.0f, side == 0 ? 1.0f : -1.0f, 0.0f});
+                s.area = 0.0625f;
+                s.radius = std::sqrt(s.area / std::numbers::pi_v<float>);
+                surfels.push_back(s);
+            }
+    auto hierarchy = buildHierarchy(surfels, HierarchyParams{.sceneExtent = 2.83f});
+    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+    const std::vector<Surfel>& leaves = hierarchy->surfels;
+    const std::vector<Node>& nodes = hierarchy->nodes;
+    Cache cache{};
+    cache.position = glm::vec3(0.1f, 1.0f, -0.2f);
+    cache.kind = gpu::kCacheKindGrid;
+
+    LinkParams params;
+    params.linksPerCache = 1;
+    params.reads = LinkReads::Node;
+    auto paper = generateLinks(**rays, leaves, nodes, {cache}, params);
+    params.reads = LinkReads::Visible;
+    auto visible = generateLinks(**rays, leaves, nodes, {cache}, params);
+    ASSERT_TRUE(paper && visible);
+    const RtpLink& whole = paper->links.rtp[0];
+    const RtpLink& part = visible->links.rtp[0];
+    ASSERT_EQ(whole.node, nodes.size() - 1);  // the root: both faces
+    const Node& read = nodes[part.node];
+    ASSERT_GT(read.surfelCount, 0u);
+    bool onlyTop = true;
+    for (uint32_t s = read.firstSurfel; s < read.firstSurfel + read.surfelCount; ++s)
+        onlyTop = onlyTop && leaves[s].normal.y > 0.0f;
+    EXPECT_TRUE(onlyTop);
+    EXPECT_EQ(read.surfelCount, 64u);  // the whole top face: the cache sees all of it
+    EXPECT_NEAR(part.factor / whole.factor, 2.0f, 1e-5f);
+
+    // Flux on the bottom face only (lit from below): the node-read link carries half of it to
+    // the cache, the visible-part link none.
+    std::vector<glm::vec3> flux(nodes.size(), glm::vec3(0.0f));
+    for (size_t s = 0; s < leaves.size(); ++s)
+        if (leaves[s].normal.y < 0.0f) flux[s] = glm::vec3(1.0f);
+    for (size_t n = leaves.size(); n < nodes.size(); ++n)
+        flux[n] = flux[nodes[n].left] + flux[nodes[n].right];
+    EXPECT_GT(flux[whole.node].x * whole.factor, 0.0f);
+    EXPECT_EQ(flux[part.node].x * part.factor, 0.0f);
 }
 
 }  // namespace

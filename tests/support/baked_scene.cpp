@@ -21,13 +21,13 @@ namespace {
 using BakeKey = std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
                            std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
                            std::optional<float>, LinkMode, HierarchyMethod, uint32_t, uint32_t,
-                           uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
+                           LinkReads, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
 
 BakeKey keyOf(const std::string& name, const BakeOptions& o,
               std::optional<std::pair<float, float>> perDiagonal) {
     return {name,       o.surfels,   o.links,          o.bandsY,          o.bandsC,
             o.gridCell, o.lightmapTexel, o.linkMode, o.hierarchy, o.linkSamples,
-            o.exposureRays, o.relaxIterations, o.seed, perDiagonal};
+            o.exposureRays, o.linkReads, o.relaxIterations, o.seed, perDiagonal};
 }
 
 /// bakedScene for both sizings: `perDiagonal` (grid cell, light-map texel) replaces the
