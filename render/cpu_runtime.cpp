@@ -22,13 +22,12 @@ double millisecondsSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-/// Luminance of the summed flux (W); summed in double so that 10⁵ small terms keep their
-/// digits, and in index order so that the result does not depend on threads.
-double totalLuminance(std::span<const glm::vec3> flux) {
-    double sum[3] = {0.0, 0.0, 0.0};
-    for (const glm::vec3& f : flux)
-        for (int c = 0; c < 3; ++c) sum[c] += f[c];
-    return luminance(glm::vec3(float(sum[0]), float(sum[1]), float(sum[2])));
+/// The summed flux (W, RGB); summed in double so that 10⁵ small terms keep their digits, and
+/// in index order so that the result does not depend on threads.
+glm::dvec3 totalFlux(std::span<const glm::vec3> flux) {
+    glm::dvec3 sum(0.0);
+    for (const glm::vec3& f : flux) sum += glm::dvec3(f);
+    return sum;
 }
 
 /// The CPU backend: every pass of paper 000 Figure 2 but shadow maps (visibility comes from
@@ -41,6 +40,7 @@ public:
           mRays(rays),
           mBake(bake),
           mBounces(bounces),
+          mRatioBound(bounceRatioBound(bake)),
           mDirectFlux(bake.surfels.size()),
           mNodeFlux(bake.nodes.size()),
           mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)) {
@@ -57,6 +57,7 @@ private:
     const EmbreeScene& mRays;
     const BakeData& mBake;
     BounceParams mBounces;
+    glm::vec3 mRatioBound;              ///< bounceRatioBound of the bake
     RtpLinkTable mRtp;                  ///< RTP bakes only
     std::vector<glm::vec3> mDirectFlux; ///< nS: flux from lights and emission, per update
     std::vector<glm::vec3> mNodeFlux;   ///< 2nS − 1: leaves hold the current bounce's surfel flux
@@ -77,9 +78,8 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     double& pullMs = s.passMs["pull"];
     double& cacheMs = s.passMs["cache_lighting"];
 
-    const bool progressive = mBounces.bounces < 0;
-    const int passes = progressive ? mBounces.maxBounces : mBounces.bounces;
-    if (passes == 0) {
+    BounceSchedule schedule(mBounces, mRatioBound);
+    if (schedule.maxPasses() == 0) {
         // No cache pass: the caches hold no light and no surfel needs lighting.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         s.totalMs = millisecondsSince(start);
@@ -90,7 +90,8 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     Clock::time_point t = Clock::now();
     directSurfelFlux(mScene, mRays, mBake, lights, mDirectFlux);
     std::copy(mDirectFlux.begin(), mDirectFlux.end(), leaves.begin());
-    double total = totalLuminance(leaves);
+    glm::dvec3 total = totalFlux(leaves);
+    schedule.record(total);
     surfelMs += millisecondsSince(t);
 
     for (int bounce = 1;; ++bounce) {
@@ -102,18 +103,16 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
         lightCaches(mBake, mNodeFlux, mRtp, mValues);
         cacheMs += millisecondsSince(t);
         s.bounces = bounce;
-        s.surfelFlux = total;
-        if (bounce == passes) break;
+        s.surfelFlux = luminance(glm::vec3(total));
+        const BounceStep step = schedule.afterBounce(bounce);
+        if (!step.another) break;
 
         // The next bounce: direct flux plus what the surfels receive from these caches.
         t = Clock::now();
-        bounceSurfelFlux(mScene, mBake, mDirectFlux, mValues, leaves);
-        const double next = totalLuminance(leaves);
+        bounceSurfelFlux(mScene, mBake, mDirectFlux, mValues, leaves, step.tail);
+        total = totalFlux(leaves);
         surfelMs += millisecondsSince(t);
-        // Progressive: a bounce that adds less than `convergence` of the flux is not worth
-        // its cache pass (`<=` also stops a scene without light at once).
-        if (progressive && next - total <= double(mBounces.convergence) * next) break;
-        total = next;
+        if (!schedule.record(total)) break;
     }
     s.totalMs = millisecondsSince(start);
     return &mValues;

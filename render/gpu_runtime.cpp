@@ -39,7 +39,7 @@ Result<std::unique_ptr<GpuRuntime>> GpuRuntime::create(const Scene& scene, const
 }
 
 GpuRuntime::GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces)
-    : mScene(scene), mBake(bake), mBounces(bounces) {}
+    : mScene(scene), mBake(bake), mBounces(bounces), mRatioBound(bounceRatioBound(bake)) {}
 
 GpuRuntime::~GpuRuntime() = default;
 
@@ -161,10 +161,9 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     PIC_TRY(prepareLights(lights));
     mTexturesCurrent = false;
 
-    const bool progressive = mBounces.bounces < 0;
-    const int passes = progressive ? mBounces.maxBounces : mBounces.bounces;
+    BounceSchedule schedule(mBounces, mRatioBound);
     const uint32_t lightCount = uint32_t(lights.lights.size());
-    if (passes == 0) {
+    if (schedule.maxPasses() == 0) {
         // No cache pass: the caches, and so the textures, hold no light.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         PIC_TRY(uploadCaches(mValues));
@@ -172,26 +171,29 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         return &mValues;
     }
 
-    // Each submission ends with a bounce's caches and, when another bounce may follow, the
-    // surfel flux that bounce would pull; the host reads the flux sums to decide. Each one
-    // also reads its caches back, since only the host's look at the sums tells which bounce
-    // is the last.
-    const auto cacheBounce = [&](VkCommandBuffer cmd, bool another, uint32_t sumSlot) {
+    // Each submission ends with a bounce's caches and, when another bounce follows, the
+    // surfel flux that bounce pulls; the host reads the flux sums to decide whether its cache
+    // pass runs (BounceSchedule). Each one also reads its caches back, since only the host's
+    // look at the sums tells which bounce is the last.
+    const auto cacheBounce = [&](VkCommandBuffer cmd, const BounceStep& next, uint32_t sumSlot) {
         mTimer.begin(cmd, "pull");
         mPull->record(cmd);
         mTimer.begin(cmd, "cache_lighting");
         mCacheLighting->record(cmd);
-        if (another) {
+        if (next.another) {
             // The caches are written before the surfels read them.
             gpu::computeBarrier(cmd);
             mTimer.begin(cmd, "surfel_lighting");
-            mSurfels->record(cmd, true, lightCount, sumSlot);
+            mSurfels->record(cmd, true, lightCount, sumSlot, next.tail);
         }
         // Everything written before the next submission's first pass reads it.
         gpu::computeBarrier(cmd);
         recordCacheReadback(cmd);
     };
 
+    // Bounce 1's plan needs no flux sums, so the direct pass and bounce 2's surfels share a
+    // submission.
+    BounceStep step = schedule.afterBounce(1);
     PIC_TRY(submitTimed(
         [&](VkCommandBuffer cmd) {
             recordShadowMaps(cmd);
@@ -199,29 +201,25 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
             mSurfels->record(cmd, false, lightCount, 0);
             // The leaves are written before the pull reads them.
             gpu::computeBarrier(cmd);
-            cacheBounce(cmd, passes > 1, 1);
+            cacheBounce(cmd, step, 1);
         },
         stats));
     addVisibilityStats(stats);
     PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
-    double total = luminance(glm::vec3(sum));
+    schedule.record(sum);
     stats.bounces = 1;
-    stats.surfelFlux = total;
+    stats.surfelFlux = luminance(glm::vec3(sum));
 
     // sumSlot of the surfel flux the latest submission computed for the next bounce.
     uint32_t slot = 1;
-    for (int bounce = 2; bounce <= passes; ++bounce) {
+    for (int bounce = 2; step.another; ++bounce) {
         PIC_TRY_ASSIGN(sum, mSurfels->totalFlux(slot));
-        const double next = luminance(glm::vec3(sum));
-        // Progressive: a bounce that adds less than `convergence` of the flux is not worth
-        // its cache pass (`<=` also stops a scene without light at once).
-        if (progressive && next - total <= double(mBounces.convergence) * next) break;
-        total = next;
+        if (!schedule.record(sum)) break;
+        step = schedule.afterBounce(bounce);
         slot ^= 1u;
-        PIC_TRY(submitTimed([&](VkCommandBuffer cmd) { cacheBounce(cmd, bounce < passes, slot); },
-                            stats));
+        PIC_TRY(submitTimed([&](VkCommandBuffer cmd) { cacheBounce(cmd, step, slot); }, stats));
         stats.bounces = bounce;
-        stats.surfelFlux = total;
+        stats.surfelFlux = luminance(glm::vec3(sum));
     }
 
     readCaches(mValues);

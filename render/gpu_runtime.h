@@ -142,6 +142,7 @@ private:
     const Scene& mScene;
     const BakeData& mBake;
     BounceParams mBounces;
+    glm::vec3 mRatioBound;  ///< bounceRatioBound of the bake
     std::unique_ptr<gpu::Context> mContext;
     gpu::DirectVisibility mVisibility = gpu::DirectVisibility::ShadowMaps;
     std::unique_ptr<gpu::ShadowMapPass> mShadows;            ///< DirectVisibility::ShadowMaps

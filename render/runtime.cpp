@@ -1,7 +1,9 @@
 #include "render/runtime.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/color.h"
 #include "core/sh.h"
 
 namespace pic {
@@ -65,6 +67,59 @@ Result<void> checkBounceParams(const BounceParams& p) {
     if (p.maxBounces < 0)
         return fail(ErrorCode::InvalidInput, "maxBounces must be ≥ 0, got {}", p.maxBounces);
     return {};
+}
+
+namespace {
+/// Luminance of a flux sum: differences are taken in double first, so float is enough here.
+double luminanceOf(const glm::dvec3& flux) { return luminance(glm::vec3(flux)); }
+}  // namespace
+
+BounceSchedule::BounceSchedule(const BounceParams& params, glm::vec3 ratioBound)
+    : mParams(params),
+      mRatioBound(ratioBound),
+      mPasses(params.bounces < 0 ? params.maxBounces : params.bounces) {}
+
+bool BounceSchedule::record(const glm::dvec3& total) {
+    mTotals.push_back(total);
+    if (mTotals.size() == 1 || mParams.bounces >= 0 || mLastPlanned) return true;
+    // `<=` also stops a scene without light at once.
+    const double added = luminanceOf(total - mTotals[mTotals.size() - 2]);
+    return added > double(mParams.convergence) * luminanceOf(total);
+}
+
+BounceStep BounceSchedule::afterBounce(int bounce) {
+    BounceStep step;
+    if (bounce >= mPasses || mLastPlanned) return step;
+    step.another = true;
+    step.last = bounce + 1 == mPasses;
+    if (mParams.bounces < 0 && bounce >= 2) {
+        PIC_CHECK(mTotals.size() >= size_t(bounce));
+        const glm::dvec3 before = bounce >= 3 ? mTotals[bounce - 3] : glm::dvec3(0.0);
+        const glm::dvec3 previous = mTotals[bounce - 2] - before;  // ΔS_{b−1} (S_0 = 0)
+        const glm::dvec3 latest = mTotals[bounce - 1] - mTotals[bounce - 2];  // ΔS_b
+        glm::dvec3 q(0.0);
+        for (int c = 0; c < 3; ++c)
+            if (previous[c] > 0.0 && latest[c] > 0.0)
+                q[c] = std::min(latest[c] / previous[c], mRatioBound[c]);
+        const double qLuminance = std::min(
+            luminanceOf(previous) > 0.0 ? std::max(luminanceOf(latest), 0.0) / luminanceOf(previous) : 0.0,
+            std::max({mRatioBound.x, mRatioBound.y, mRatioBound.z}));
+        // The first ratio, bounced over direct light, says little about later ones (a sunlit
+        // patch spreads into the room first: the living room stopped after 3 bounces at 0.84
+        // of the light on it): only ratios of bounces plan the end.
+        step.last = step.last ||
+                    (bounce >= 3 && qLuminance * qLuminance * luminanceOf(latest) <=
+                                        double(mParams.convergence) * luminanceOf(mTotals[bounce - 1]));
+        if (step.last) step.tail = glm::vec3(q / (1.0 - q));
+    }
+    mLastPlanned = step.last;
+    return step;
+}
+
+glm::vec3 bounceRatioBound(const BakeData& bake) {
+    glm::vec3 bound(0.0f);
+    for (const Surfel& s : bake.surfels) bound = glm::max(bound, s.albedo);
+    return glm::min(bound, glm::vec3(0.95f));
 }
 
 Result<void> checkRuntimeLights(const LightSet& lights, const Scene& scene) {

@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/bake_data.h"
 #include "core/cache_textures.h"
@@ -21,6 +22,51 @@ struct BounceParams {
     float convergence = 0.005f;       ///< progressive: stop when a bounce adds less than this fraction of flux
     int maxBounces = 8;               ///< progressive: at most this many
 };
+
+/// What follows a bounce's cache pass (BounceSchedule::afterBounce).
+struct BounceStep {
+    bool another = false;     ///< the surfels take the next bounce's flux
+    bool last = false;        ///< and that bounce's cache pass is the last
+    glm::vec3 tail{0.0f};     ///< per channel: its surfel pass adds tail·max(ΔS, 0)
+};
+
+/// The bounce loop both backends run. Bounce b's surfel flux is S_b = S_direct + ρ·A·E(C_{b−1}),
+/// its caches C_b. Progressive updates converge the series: its increments ΔS_b = S_b − S_{b−1}
+/// shrink by the ratio q of the transport's leading eigenvalue (per channel, at most the largest
+/// albedo), so all the light after the last bounce computed is ΔS·q/(1 − q). The last surfel
+/// pass adds it (the geometric tail, as the ambient term of progressive radiosity does) instead
+/// of stopping short of the converged light: white rooms keep 5–10 % of their indirect light
+/// in the bounces after the eighth. Fixed bounce counts add no tail: they are what they say.
+class BounceSchedule {
+public:
+    /// `ratioBound`: the largest surfel albedo per channel (bounceRatioBound).
+    BounceSchedule(const BounceParams& params, glm::vec3 ratioBound);
+    /// Cache passes at most.
+    int maxPasses() const { return mPasses; }
+    /// Records the summed surfel flux (W, RGB) of the next bounce, the direct flux first.
+    /// Returns whether that bounce's cache pass runs: always for the first bounce, one planned
+    /// as the last and fixed counts; progressive, only while it adds more than `convergence`
+    /// of the flux.
+    bool record(const glm::dvec3& total);
+    /// After bounce b's cache pass (b ≥ 2 needs the totals of bounces 1…b recorded; b = 1 none):
+    /// whether bounce b + 1 follows, whether it is the last and its tail. Progressive, bounce
+    /// b + 1 is the last at the cap, or from b = 3 on when the bounce after it would add less
+    /// than `convergence` of the flux at the ratio of the last two increments (q² ΔS_b), so
+    /// the loop runs as many passes as stopping on that bounce would. (The first ratio, bounced
+    /// over direct light, does not predict the later ones.)
+    BounceStep afterBounce(int bounce);
+
+private:
+    BounceParams mParams;
+    glm::dvec3 mRatioBound;
+    int mPasses = 0;
+    bool mLastPlanned = false;
+    std::vector<glm::dvec3> mTotals;  ///< per bounce recorded
+};
+
+/// The largest surfel albedo per channel, at most 0.95: no bounce returns more of the light
+/// than that (energy conservation); the cap keeps the tail of a room of perfect white finite.
+glm::vec3 bounceRatioBound(const BakeData& bake);
 
 /// Timings and counts of one update.
 struct UpdateStats {

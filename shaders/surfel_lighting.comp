@@ -3,7 +3,9 @@
 // channel. Direct mode: Φ = ρ·A·Σ E_light·V + π·L_e·A·emissiveScale, V from the shadow maps
 // or, in the rays mode, one bit per surfel and light traced on the host (RayVisibilityPass);
 // bounce mode: Φ = Φ_direct + ρ·A·max(0, E) with E the irradiance the previous bounce's caches
-// deliver at the surfel (its precomputed interpolation stencil). Each workgroup also writes
+// deliver at the surfel (its precomputed interpolation stencil), plus on the last bounce
+// tail·max(Φ − Φ_previous, 0), the light of the bounces not computed (render/runtime.h
+// BounceSchedule). Each workgroup also writes
 // its summed flux for the progressive stop, in one of two slots so that consecutive passes
 // of one submission keep both sums. CPU twin: render/cpu/surfel_lighting.cpp.
 //
@@ -34,7 +36,7 @@ layout(std430, binding = 2) readonly buffer ShadowLayers { GpuShadowLayer shadow
 layout(binding = 3) uniform samplerBuffer emissiveScale;  // per material
 layout(binding = 4) uniform sampler2DArray shadowMaps;
 layout(std430, binding = 5) writeonly buffer DirectFlux { vec4 directFlux[]; };  // nS
-layout(std430, binding = 6) writeonly buffer NodeFlux { vec4 nodeFlux[]; };      // leaves [0, nS)
+layout(std430, binding = 6) buffer NodeFlux { vec4 nodeFlux[]; };  // leaves [0, nS): the previous bounce's in bounce mode
 layout(binding = 7) uniform usamplerBuffer stencilTexels;  // SurfelStencil: 4 texels
 layout(binding = 8) uniform samplerBuffer cacheY;          // half texels, nC·lY²
 layout(binding = 9) uniform samplerBuffer cacheCo;         // nC·lC²
@@ -112,6 +114,8 @@ void main() {
             // SH ringing can make irradiance negative on the dark side; cut at zero per channel.
             const vec3 irradiance = max(yCoCgToRgb(e), vec3(0.0));
             flux = texelFetch(directFluxTexels, int(i)).xyz + surfel.albedo * (surfel.area * irradiance);
+            // The light of the bounces not computed (BounceSchedule); tail is 0 but on the last.
+            flux += pc.tail.xyz * max(flux - nodeFlux[i].xyz, vec3(0.0));
         }
         nodeFlux[i] = vec4(flux, 0.0);
         // Cache lighting reads the leaf's radiance Φ / (π·A) (paper 000 §4.7).

@@ -78,7 +78,7 @@ void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light
 
 void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
                       std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
-                      std::span<glm::vec3> surfelFlux) {
+                      std::span<glm::vec3> surfelFlux, glm::vec3 tail) {
     PIC_CHECK_EQ(directFlux.size(), bake.surfels.size());
     PIC_CHECK_EQ(surfelFlux.size(), bake.surfels.size());
     PIC_CHECK(directFlux.data() != surfelFlux.data());
@@ -97,7 +97,8 @@ void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
         // side of a bright cache. Irradiance is never negative, and negative flux would carry
         // negative light into the next bounce, so it is cut at zero.
         const glm::vec3 e = glm::max(irradiance(radiance, surfel.normal), glm::vec3(0.0f));
-        surfelFlux[i] = directFlux[i] + surfel.albedo * (surfel.area * e);
+        const glm::vec3 flux = directFlux[i] + surfel.albedo * (surfel.area * e);
+        surfelFlux[i] = flux + tail * glm::max(flux - surfelFlux[i], glm::vec3(0.0f));
     }, kSurfelGrain);
 }
 

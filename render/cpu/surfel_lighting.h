@@ -39,11 +39,13 @@ void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
 /// irradiance that the interpolated caches of `previousBounce` deliver at the surfel
 /// (lookupSurfaceRadiance at its barycentrics, clamped-cosine about its normal), per channel
-/// cut at zero where SH ringing makes it negative.
+/// cut at zero where SH ringing makes it negative. `surfelFlux` holds the previous bounce's
+/// flux S on entry; with a `tail` (BounceSchedule: the light of the bounces not computed) each
+/// surfel's new flux S' becomes S' + tail·max(S' − S, 0), per channel.
 /// `directFlux` and `surfelFlux` hold nS entries; they may not alias.
 void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
                       std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
-                      std::span<glm::vec3> surfelFlux);
+                      std::span<glm::vec3> surfelFlux, glm::vec3 tail = glm::vec3(0.0f));
 
 /// Both parts at once: direct flux, plus the bounce from `previousBounce` when it is not null
 /// (null for the first pass). `surfelFlux` must hold nS entries.

@@ -167,7 +167,7 @@ Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
 }
 
 void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
-                                uint32_t sumSlot) {
+                                uint32_t sumSlot, glm::vec3 tail) {
     PIC_CHECK(sumSlot < 2);
     PIC_CHECK(mDirectSet != VK_NULL_HANDLE && mBounceSet != VK_NULL_HANDLE);
     SurfelLightingPush push{};
@@ -175,6 +175,7 @@ void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t light
     push.lightCount = lightCount;
     push.epsilon = mEpsilon;
     push.sumSlot = sumSlot;
+    push.tail = glm::vec4(tail, 0.0f);
     const Kernel& kernel = bounce ? mBounce : mDirect;
     kernel.dispatch(cmd, bounce ? mBounceSet : mDirectSet, &push,
                     groupsFor(mSurfelCount, kSurfelLightingGroup));

@@ -64,9 +64,11 @@ public:
     Result<void> bind(const SurfelLightingResources& resources);
     /// Writes the per-material emission scales of `lights`.
     Result<void> setEmissiveScales(const LightSet& lights);
-    /// Records the direct part (directFlux and the leaves) or a bounce (the leaves); the
-    /// pass's flux sum goes to `sumSlot` (0 or 1).
-    void record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount, uint32_t sumSlot);
+    /// Records the direct part (directFlux and the leaves) or a bounce (the leaves; with a
+    /// `tail`, each leaf's new flux S' becomes S' + tail·max(S' − S, 0), as the CPU twin's
+    /// bounceSurfelFlux); the pass's flux sum goes to `sumSlot` (0 or 1).
+    void record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount, uint32_t sumSlot,
+                glm::vec3 tail = glm::vec3(0.0f));
     /// Σ of the leaves' flux of the last pass recorded with `sumSlot`, after it completed, in
     /// double (W, RGB).
     Result<glm::dvec3> totalFlux(uint32_t sumSlot);

@@ -36,8 +36,9 @@ struct SurfelLightingPush {
     uint lightCount;
     float epsilon;     // metres: the CPU twin's ray offset along the normal
     uint sumSlot;      // 0 or 1: which half of groupFlux takes this pass's workgroup sums
+    vec4 tail;         // bounce: xyz per channel, leaves = S' + tail·max(S' − S, 0) (BounceSchedule)
 };
-PIC_STRUCT_CHECK(SurfelLightingPush, 16);
+PIC_STRUCT_CHECK(SurfelLightingPush, 32);
 
 PIC_NAMESPACE_END
 
