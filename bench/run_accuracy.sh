@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Accuracy of the cache term against the path-traced reference on the test scenes and the
-# living room, with the default exposure flux weights and with paper 000's uniform node
-# radiance (--exposure-rays 0), the nL sweep on cornell and the one-bounce decomposition of the
-# linked caches' error: the commands of docs/accuracy.md. Writes JSON and side-by-side PNGs
-# into ${OUT:-accuracy}/<default|uniform>/.
+# living room, with the default bake (exposure flux weights, links that read the part they
+# see) and with paper 000's links (--exposure-rays 0 --link-reads node), the nL sweep on
+# cornell and the one-bounce decomposition of the linked caches' error: the commands of
+# docs/accuracy.md. Writes JSON and side-by-side PNGs into ${OUT:-accuracy}/<default|paper>/.
 # Usage: bash bench/run_accuracy.sh [build-dir]
 set -euo pipefail
 BUILD=${1:-build}
@@ -11,15 +11,17 @@ OUT=${OUT:-accuracy}
 SCENES="$BUILD/scenes"
 LIVING="$(dirname "$0")/../../shared/scenes/living_room_sh3d.glb"
 SUN_LAMP="$(dirname "$0")/lightsets/living_room_sun_lamp.json"
-for variant in default uniform; do
+for variant in default paper; do
   X=()
-  [ "$variant" = uniform ] && X=(--exposure-rays 0)
+  [ "$variant" = paper ] && X=(--exposure-rays 0 --link-reads node)
   A="$BUILD/bench/picbench --quiet accuracy --out-dir $OUT/$variant"
   $A --scene "$SCENES/cornell.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"
   $A --scene "$SCENES/cornell_area.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"
   $A --scene "$SCENES/two_floors.gltf" --camera 1.8,1.6,1.8,-1.5,0.8,-1.5,0,1,0,70 \
     --size 120x72 --spp 256 --probe-samples 256 "${X[@]}"
   $A --scene "$SCENES/opposite_colors.gltf" --size 120x72 --spp 256 --probe-samples 256 "${X[@]}"
+  $A --scene "$SCENES/furnished_room.gltf" --size 120x90 --spp 256 --probe-samples 256 "${X[@]}"
+  $A --scene "$SCENES/furnished_study.gltf" --size 120x90 --spp 256 --probe-samples 256 "${X[@]}"
   $A --scene "$LIVING" --lights "$SUN_LAMP" --camera 0.5,1.7,0.5,4.5,0.5,4.0,0,1,0,70 \
     --size 120x90 --spp 256 --probe-samples 256 "${X[@]}"
 done
