@@ -228,6 +228,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
                        surfelFreeDistance(*rays, scene.bounds, exposureReach(scene), bake.surfels,
                                           ExposureParams{p.exposureRays, p.seed}));
         weights = fluxWeights(bake.surfels, freeDistance);
+        exposureTimer.stop();
     }
 
     StageTimer linkTimer(report, "links");
