@@ -67,6 +67,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
         if (remap[c] == kNoCache) continue;
         const size_t to = remap[c];
         bake.caches[to] = bake.caches[c];
+        std::copy_n(links.tint.begin() + c * nL, nL, links.tint.begin() + to * nL);
         if (links.mode == LinkMode::Rtp) {
             std::copy_n(links.rtp.begin() + c * nL, nL, links.rtp.begin() + to * nL);
         } else {
@@ -76,6 +77,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
         }
     }
     bake.caches.resize(kept);
+    links.tint.resize(size_t{kept} * nL);
     if (links.mode == LinkMode::Rtp) {
         links.rtp.resize(size_t{kept} * nL);
     } else {

@@ -33,6 +33,7 @@ struct NodeEstimate {
     float unoccluded = 0.0f;   ///< estimated solid angle ignoring occlusion, sr
     float perArea = 0.0f;      ///< estimated Σ w·Ω·V / Σ w·a over the node, sr/m²
     glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
+    glm::vec3 colourSum{0.0f};     ///< Σ w·Ω·V·κ over the samples, in the units of perArea
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
     uint32_t visibleCount = 0;              ///< samples that reached a surfel
@@ -58,9 +59,12 @@ public:
                 const std::vector<Node>& nodes, const LinkParams& params,
                 const std::vector<float>& weights)
         : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params), mWeights(weights),
-          mPrefix(surfels.size() + 1, 0.0) {
-        for (size_t s = 0; s < surfels.size(); ++s)
-            mPrefix[s + 1] = mPrefix[s] + double(weights[s]) * surfels[s].area;
+          mPrefix(surfels.size() + 1, 0.0), mColourPrefix(surfels.size() + 1, glm::dvec3(0.0)) {
+        for (size_t s = 0; s < surfels.size(); ++s) {
+            const double wa = double(weights[s]) * surfels[s].area;
+            mPrefix[s + 1] = mPrefix[s] + wa;
+            mColourPrefix[s + 1] = mColourPrefix[s] + glm::dvec3(fluxColour(surfels[s])) * wa;
+        }
     }
 
     /// Fills the nL links of cache `c` starting at `out`; returns rays cast.
@@ -145,6 +149,25 @@ public:
         return scratch.estimates[e];
     }
 
+    /// The tint of a localised estimate's link: per channel, the colour of the part the cache
+    /// sees, Σ w·Ω·V·κ / Σ w·Ω·V, over that of the read node, Σ w·κ·a / Σ w·a. The read node's
+    /// flux then reaches the cache as the flux of what it sees would (surfel_exposure.h
+    /// fluxColour): a cache beside a red rug on a white floor reads the rug's red. Neutral
+    /// under LinkReads::Node, and in a channel the read node has no colour in (its flux there
+    /// has no known spread).
+    glm::vec3 tintOf(const NodeEstimate& e) const {
+        glm::vec3 tint(1.0f);
+        if (mParams.reads == LinkReads::Node || !(e.perArea > 0.0f)) return tint;
+        const Node& read = mNodes[e.readNode];
+        const size_t first = read.firstSurfel, last = read.firstSurfel + read.surfelCount;
+        const double area = mPrefix[last] - mPrefix[first];
+        const glm::dvec3 readColour = (mColourPrefix[last] - mColourPrefix[first]) / area;
+        const glm::vec3 seenColour = e.colourSum / e.perArea;
+        for (int c = 0; c < 3; ++c)
+            if (readColour[c] > 1e-6) tint[c] = float(seenColour[c] / readColour[c]);
+        return tint;
+    }
+
 private:
     double weightedArea(uint32_t node) const {
         const Node& n = mNodes[node];
@@ -227,6 +250,7 @@ private:
             e.lastVisible = std::max(e.lastVisible, s);
             e.perArea += share;
             e.directionSum += share * view.direction;
+            e.colourSum += share * fluxColour(surfel);
             samples.push_back({view.direction, share});
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
@@ -253,6 +277,7 @@ private:
     const LinkParams& mParams;
     const std::vector<float>& mWeights;
     std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
+    std::vector<glm::dvec3> mColourPrefix;  ///< Σ w·κ·a over the surfels before each
 };
 
 }  // namespace
@@ -313,6 +338,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     links.mode = params.mode;
     links.linksPerCache = nL;
     links.bands = params.mode == LinkMode::Sh ? params.bands : 0;
+    links.tint.assign(nC * nL, 0u);  // padding: no light
     if (params.mode == LinkMode::Rtp) {
         links.rtp.assign(nC * nL, RtpLink{0, 0.0f, 0, 0.0f});
     } else {
@@ -344,7 +370,10 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                 solidAngleSum[c] += e.visible;
                 // Flux → radiance of the visible surfels: B_j/π = Φ·w_j / (π·Σ w·a), paper 000
                 // §4.1 with the node's flux spread by the weights instead of evenly.
-                constexpr float toRadiance = 1.0f / kPi;
+                // The tint's largest channel scales the factor, the code keeps the rest.
+                const EncodedLinkTint tint = encodeLinkTint(linker.tintOf(e));
+                links.tint[slot] = tint.code;
+                const float toRadiance = tint.scale / kPi;
                 if (params.mode == LinkMode::Rtp) {
                     // The cone spans the node's unoccluded solid angle; the factor scales it to
                     // Σ w·Ω·V / Σ w·a.

@@ -117,6 +117,12 @@ std::vector<float> fluxWeights(const std::vector<Surfel>& surfels,
     return weights;
 }
 
+glm::vec3 fluxColour(const Surfel& surfel) {
+    if (!isEmitter(surfel)) return surfel.albedo;
+    const float y = luminance(surfel.emission);
+    return y > 0.0f ? surfel.emission / y : glm::vec3(1.0f);
+}
+
 std::vector<double> weightedNodeArea(const std::vector<Surfel>& surfels,
                                      const std::vector<Node>& nodes,
                                      const std::vector<float>& weights) {

@@ -49,13 +49,19 @@ inline bool isEmitter(const Surfel& s) { return s.emission.r > 0.0f || s.emissio
 /// Least flux weight, against an area-weighted mean of 1.
 inline constexpr float kMinFluxWeight = 1e-3f;
 
-/// The flux weight w of every surfel (see above; reflectors take E_cos[min(t, R)] alone: an
-/// albedo factor would move a node's flux between its materials in every channel alike,
-/// which tints what a cache sees of a node that mixes them); Σ w·a over a node is the area its flux is
-/// read over. Every weight is finite and ≥ kMinFluxWeight; a kind whose weights are all 0
+/// The flux weight w of every surfel (see above; reflectors take E_cos[min(t, R)] alone: their
+/// albedo spreads the flux per channel, fluxColour below); Σ w·a over a node is the area its
+/// flux is read over. Every weight is finite and ≥ kMinFluxWeight; a kind whose weights are all 0
 /// gets 1.
 std::vector<float> fluxWeights(const std::vector<Surfel>& surfels,
                                const std::vector<float>& freeDistance);
+
+/// The colour κ in which a surfel's share of its node's flux is expected to come, per channel:
+/// a reflector's flux is ρ·E·a with E ∝ w, so κ = ρ, its albedo; an emitter's is π·L_e·a with
+/// w ∝ π·luminance(L_e), so κ = L_e / luminance(L_e). A node's flux spreads over its surfels as
+/// w·κ·a per channel, and a link's tint is the colour of what its cache sees over the colour
+/// of the node it reads (bake/link_generation.h).
+glm::vec3 fluxColour(const Surfel& surfel);
 
 /// Σ w·a per node (leaves first, children before parents), m².
 std::vector<double> weightedNodeArea(const std::vector<Surfel>& surfels,

@@ -31,9 +31,9 @@ namespace {
 using Json = nlohmann::ordered_json;
 constexpr double kPi = std::numbers::pi;
 
-/// The five band-0 luma estimates of one cache (see the header), in W/(m²·sr) × y00.
+/// The five band-0 RGB estimates of one cache (see the header), in W/(m²·sr) × y00.
 struct Estimates {
-    double traced = 0.0, gather = 0.0, cut = 0.0, mean = 0.0, linked = 0.0;
+    glm::dvec3 traced{0.0}, gather{0.0}, cut{0.0}, mean{0.0}, linked{0.0};
     Estimates& operator+=(const Estimates& o) {
         traced += o.traced, gather += o.gather, cut += o.cut, mean += o.mean, linked += o.linked;
         return *this;
@@ -48,14 +48,33 @@ uint32_t linkedNode(const LinkSet& links, size_t slot) {
     return links.shCoefficients[slot * coefficients] != 0 ? links.shNodes[slot] : kNoNode;
 }
 
+/// YCoCg luma of linear RGB (Y = R/4 + G/2 + B/4), in double.
+double luma(const glm::dvec3& rgb) { return 0.25 * rgb.r + 0.5 * rgb.g + 0.25 * rgb.b; }
+
+/// Luma ratio a/b, 0 where b holds no light.
+double lumaRatio(const glm::dvec3& a, const glm::dvec3& b) {
+    return luma(b) > 0.0 ? luma(a) / luma(b) : 0.0;
+}
+
+/// Per-channel ratios a/b, 0 for a channel where b holds no light.
+Json channelRatios(const glm::dvec3& a, const glm::dvec3& b) {
+    Json out = Json::array();
+    for (int i = 0; i < 3; ++i) out.push_back(b[i] > 0.0 ? a[i] / b[i] : 0.0);
+    return out;
+}
+
 Json ratiosJson(const Estimates& e, uint32_t caches) {
-    auto ratio = [](double a, double b) { return b > 0.0 ? a / b : 0.0; };
     return {{"caches", caches},
-            {"linked_over_traced", ratio(e.linked, e.traced)},
-            {"representation", ratio(e.gather, e.traced)},
-            {"cut_coverage", ratio(e.cut, e.gather)},
-            {"node_mean_radiance", ratio(e.mean, e.cut)},
-            {"visibility_estimate", ratio(e.linked, e.mean)}};
+            {"linked_over_traced", lumaRatio(e.linked, e.traced)},
+            {"representation", lumaRatio(e.gather, e.traced)},
+            {"cut_coverage", lumaRatio(e.cut, e.gather)},
+            {"node_mean_radiance", lumaRatio(e.mean, e.cut)},
+            {"visibility_estimate", lumaRatio(e.linked, e.mean)},
+            {"channels", {{"linked_over_traced", channelRatios(e.linked, e.traced)},
+                          {"representation", channelRatios(e.gather, e.traced)},
+                          {"cut_coverage", channelRatios(e.cut, e.gather)},
+                          {"node_mean_radiance", channelRatios(e.mean, e.cut)},
+                          {"visibility_estimate", channelRatios(e.linked, e.mean)}}}};
 }
 
 }  // namespace
@@ -90,11 +109,26 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         weights = fluxWeights(bake->surfels, *free);
     }
     const std::vector<double> weightedArea = weightedNodeArea(bake->surfels, bake->nodes, weights);
-    std::vector<double> radiance(nS), fluxY(bake->nodes.size());
-    for (size_t n = 0; n < fluxY.size(); ++n) fluxY[n] = rgbToYCoCg(flux[n]).x;
-    for (size_t s = 0; s < nS; ++s) radiance[s] = fluxY[s] / (kPi * bake->surfels[s].area);
+    std::vector<glm::dvec3> radiance(nS);
+    for (size_t s = 0; s < nS; ++s) radiance[s] = glm::dvec3(flux[s]) / (kPi * bake->surfels[s].area);
+    // With visible-part reads the flux spreads per channel as w·κ·a (surfel_exposure.h
+    // fluxColour; the links' tints), except in a channel the node has no colour in.
+    const bool coloured = bake->params.linkReads == LinkReads::Visible;
+    std::vector<glm::dvec3> colouredArea(bake->nodes.size());
+    for (size_t n = 0; n < colouredArea.size(); ++n) {
+        const Node& node = bake->nodes[n];
+        colouredArea[n] = node.left == kNoNode
+                              ? glm::dvec3(fluxColour(bake->surfels[n])) * (double(weights[n]) * bake->surfels[n].area)
+                              : colouredArea[node.left] + colouredArea[node.right];
+    }
     auto modelled = [&](uint32_t node, uint32_t s) {
-        return fluxY[node] * weights[s] / (kPi * weightedArea[node]);
+        glm::dvec3 read = glm::dvec3(flux[node]) * (weights[s] / (kPi * weightedArea[node]));
+        if (!coloured) return read;
+        const glm::dvec3 colour(fluxColour(bake->surfels[s]));
+        for (int c = 0; c < 3; ++c)
+            if (colouredArea[node][c] > 1e-6 * weightedArea[node])
+                read[c] *= colour[c] * weightedArea[node] / colouredArea[node][c];
+        return read;
     };
 
     const size_t nC = bake->caches.size();
@@ -133,10 +167,11 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         const Cache& cache = bake->caches[c];
         const bool hemisphere = cache.kind == gpu::kCacheKindLightmap;
         Estimates& e = estimates[k];
-        e.linked = values.y[c * strideY];
+        const size_t strideC = size_t{values.bandsC} * values.bandsC;
+        e.linked = glm::dvec3(yCoCgToRgb({values.y[c * strideY], values.co[c * strideC], values.cg[c * strideC]}));
         for (size_t s = 0; s < nS; ++s) {
             const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
-            if (view.visible) e.gather += radiance[s] * view.solidAngle * y00;
+            if (view.visible) e.gather += radiance[s] * (double(view.solidAngle) * y00);
         }
         for (uint32_t j = 0; j < nL; ++j) {
             const uint32_t n = linkedNode(bake->links, c * nL + j);
@@ -145,19 +180,19 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
             for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
                 const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
                 if (!view.visible) continue;
-                e.cut += radiance[s] * view.solidAngle * y00;
-                e.mean += modelled(n, s) * view.solidAngle * y00;
+                e.cut += radiance[s] * (double(view.solidAngle) * y00);
+                e.mean += modelled(n, s) * (double(view.solidAngle) * y00);
             }
         }
         // Uniform directions over the cache's sphere (hemisphere for light-map caches).
         Rng rng(params.seed, c);
-        double sum = 0.0;
+        glm::dvec3 sum(0.0);
         for (uint32_t i = 0; i < params.directions; ++i) {
             glm::vec3 w = sampleUniformSphere(rng.uniform(), rng.uniform());
             if (hemisphere && glm::dot(w, cache.normal) < 0.0f) w = -w;
-            sum += rgbToYCoCg(firstBounce(cache.position, w)).x;
+            sum += glm::dvec3(firstBounce(cache.position, w));
         }
-        e.traced = sum / params.directions * (hemisphere ? 2.0 : 4.0) * kPi * y00;
+        e.traced = sum * ((hemisphere ? 2.0 : 4.0) * kPi * y00 / params.directions);
         progress.advance();
     }, 1);
     progress.finish();
@@ -189,12 +224,24 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 nC, nL, bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");
     std::printf("  %-9s %7s %14s %15s %10s %11s %11s\n", "caches", "count", "linked/traced",
                 "representation", "coverage", "node mean", "visibility");
+    const char* factors[] = {"linked_over_traced", "representation", "cut_coverage",
+                             "node_mean_radiance", "visibility_estimate"};
     for (const char* kind : {"all", "grid", "lightmap"}) {
         const Json& r = json[kind];
         std::printf("  %-9s %7u %14.4f %15.4f %10.4f %11.4f %11.4f\n", kind, r["caches"].get<uint32_t>(),
-                    r["linked_over_traced"].get<double>(), r["representation"].get<double>(),
-                    r["cut_coverage"].get<double>(), r["node_mean_radiance"].get<double>(),
-                    r["visibility_estimate"].get<double>());
+                    r[factors[0]].get<double>(), r[factors[1]].get<double>(), r[factors[2]].get<double>(),
+                    r[factors[3]].get<double>(), r[factors[4]].get<double>());
+        // The same factors per channel, R G B, under their luma.
+        std::printf("  %-9s %7s", "", "R G B");
+        const int widths[] = {14, 15, 10, 11, 11};
+        for (int f = 0; f < 5; ++f) {
+            const Json& c = r["channels"][factors[f]];
+            char text[32];
+            std::snprintf(text, sizeof text, "%.2f %.2f %.2f", c[0].get<double>(), c[1].get<double>(),
+                          c[2].get<double>());
+            std::printf(" %*s", widths[f], text);
+        }
+        std::printf("\n");
     }
     if (!params.jsonPath.empty()) {
         std::ofstream out(params.jsonPath);

@@ -1,14 +1,16 @@
 #pragma once
 /// `picbench links`: where the linked caches' error comes from. Bakes a scene, lights the
 /// surfels directly (one bounce, so that errors do not compound) and, for a sample of caches,
-/// compares the band-0 luma of five estimates of the same incident radiance:
+/// compares the band-0 luma (and each RGB channel) of five estimates of the same incident
+/// radiance:
 ///   traced    ray-traced radiance of what the first runtime bounce holds (the truth):
 ///             emitters seen directly and punctual light reflected once, with shadow rays,
 ///   gather    every surfel of the bake with exact visibility and its own radiance,
 ///   cut       the surfels of the cache's linked nodes, exact visibility, own radiance,
 ///   mean      the same surfels with the radiance a link reads for them: the node's flux
 ///             spread by the bake's flux weights, Φ·w/(π·Σ w·a) (Φ/(πA) with uniform
-///             weights), exact visibility,
+///             weights), per channel in the surfels' colours κ, Φ·w·κ/(π·Σ w·κ·a), with
+///             visible-part reads (the links' tints), exact visibility,
 ///   linked    the runtime's cache (estimated visibility).
 /// Their ratios factor linked/traced into the surfel representation (gather/traced), the
 /// coverage of the cut (cut/gather), the node radiance model (mean/cut) and the visibility

@@ -35,7 +35,8 @@ enum class HierarchyMethod : uint32_t {
 /// Whose flux a link reads (bake/link_generation.h).
 enum class LinkReads : uint32_t {
     Node = 0,     ///< the linked node's (paper 000)
-    Visible = 1,  ///< the smallest descendant holding the part the cache sees
+    Visible = 1,  ///< the smallest descendant holding the part the cache sees, in the
+                  ///< colour of that part (the link's tint)
 };
 
 /// The parameters a bake was made with, after defaults were resolved.
@@ -87,6 +88,7 @@ struct LinkSet {
     std::vector<RtpLink> rtp;              ///< RTP mode: nC·nL links (padding: node 0, factor 0)
     std::vector<uint32_t> shNodes;         ///< SH mode: nC·nL node indices (padding: node 0, zero coefficients)
     std::vector<uint16_t> shCoefficients;  ///< SH mode: nC·nL·bands² half floats, 1/(m²·sr)
+    std::vector<uint32_t> tint;            ///< both modes: nC·nL tints (core/color.h encodeLinkTint)
 };
 
 /// A complete bake.

@@ -87,10 +87,10 @@ static_assert(sizeof(LinksRecord) == 16);
 static_assert(sizeof(glm::vec2) == 8 && std::is_trivially_copyable_v<glm::vec2>);
 
 /// Section names in the order the writer emits them; a file must hold each exactly once.
-constexpr std::array<std::string_view, 14> kSectionNames = {
+constexpr std::array<std::string_view, 15> kSectionNames = {
     "params", "surfels",    "nodes",          "levels",          "caches",
     "grid",   "grid_index", "lightmap",       "lightmap_index",  "lightmap_uvs",
-    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs",
+    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs", "links_tint",
 };
 constexpr size_t kSectionCount = kSectionNames.size();
 static_assert(std::ranges::all_of(kSectionNames,
@@ -111,6 +111,7 @@ struct BakeView {
     std::span<const RtpLink> rtp;
     std::span<const uint32_t> shNodes;
     std::span<const uint16_t> shCoefficients;
+    std::span<const uint32_t> tint;
 };
 
 std::string errnoText(int err) {
@@ -234,7 +235,8 @@ Result<void> checkCachesAndLayouts(const BakeView& v, ErrorCode code, const std:
     return {};
 }
 
-Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& what) {
+/// The link records of the link mode, and no others.
+Result<void> checkLinkRecords(const BakeView& v, ErrorCode code, const std::string& what) {
     const LinksRecord& links = v.links;
     const uint64_t nNodes = v.nodes.size();
     const uint64_t nC = v.caches.size();
@@ -271,6 +273,19 @@ Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& wh
         return {};
     }
     return fail(code, "{}: link mode {} is neither sh (0) nor rtp (1)", what, links.mode);
+}
+
+Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& what) {
+    PIC_TRY(checkLinkRecords(v, code, what));
+    const uint64_t nLinks = uint64_t{v.caches.size()} * v.links.linksPerCache;
+    if (v.tint.size() != nLinks)
+        return fail(code, "{}: links of {} caches × {} links need {} tints, found {}", what,
+                    v.caches.size(), v.links.linksPerCache, nLinks, v.tint.size());
+    for (size_t i = 0; i < v.tint.size(); ++i)
+        if (v.tint[i] >> 30 != 0)
+            return fail(code, "{}: tint {} of link {} sets bits above the 30 of its channels", what,
+                        v.tint[i], i);
+    return {};
 }
 
 /// Checks that counts agree across arrays and that every index lies in range, so that the
@@ -638,6 +653,7 @@ Result<BakeView> viewSections(const SectionMap& s, const std::string& path) {
     PIC_TRY_ASSIGN(v.rtp, arrayIn<RtpLink>(s, "links_rtp", path));
     PIC_TRY_ASSIGN(v.shNodes, arrayIn<uint32_t>(s, "links_sh_nodes", path));
     PIC_TRY_ASSIGN(v.shCoefficients, arrayIn<uint16_t>(s, "links_sh_coeffs", path));
+    PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", path));
     return v;
 }
 
@@ -687,6 +703,7 @@ BakeView viewOf(const BakeData& bake) {
     v.rtp = links.rtp;
     v.shNodes = links.shNodes;
     v.shCoefficients = links.shCoefficients;
+    v.tint = links.tint;
     return v;
 }
 
@@ -713,6 +730,7 @@ std::array<std::span<const std::byte>, kSectionCount> sectionBytesOf(const BakeV
         std::as_bytes(v.rtp),
         std::as_bytes(v.shNodes),
         std::as_bytes(v.shCoefficients),
+        std::as_bytes(v.tint),
     };
 }
 
@@ -843,6 +861,7 @@ Result<BakeData> readBakeFile(const std::string& path) {
     bake.links.rtp = toVector(v.rtp);
     bake.links.shNodes = toVector(v.shNodes);
     bake.links.shCoefficients = toVector(v.shCoefficients);
+    bake.links.tint = toVector(v.tint);
     return bake;
 }
 

@@ -2,7 +2,7 @@
 /// The bake file (ARCHITECTURE.md §6): writes a BakeData atomically, reads it back through
 /// one read-only mmap, and refuses files whose format, version, checksums or counts are wrong.
 ///
-/// Layout, version 1. Little-endian, fixed-width types, no implicit padding; every byte the
+/// Layout (version kBakeFormatVersion). Little-endian, fixed-width types, no implicit padding; every byte the
 /// writer emits is determined by the BakeData, so identical bakes give identical files.
 ///
 ///   offset  size  field
@@ -38,6 +38,7 @@
 ///   links_rtp        RTP mode: nC·nL × gpu::RtpLink (16 bytes); SH mode: empty
 ///   links_sh_nodes   SH mode: nC·nL × u32 node index (padding: node 0 with zero coefficients)
 ///   links_sh_coeffs  SH mode: nC·nL·bands² × u16 half float; RTP mode: empty
+///   links_tint       nC·nL × u32 link tint (core/color.h encodeLinkTint), both modes
 ///
 /// Both directions check that the counts agree and that every node and cache index is in range
 /// (kNoNode / kNoCache aside; RTP padding links have factor 0), so the runtime can index the
@@ -55,7 +56,7 @@
 namespace pic {
 
 /// Format version written into, and required of, every bake file.
-inline constexpr uint32_t kBakeFormatVersion = 3;
+inline constexpr uint32_t kBakeFormatVersion = 4;
 /// Bytes of the header including its trailing checksum; the section table follows.
 inline constexpr uint64_t kBakeHeaderBytes = 48;
 /// Bytes of one section table entry.

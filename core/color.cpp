@@ -105,6 +105,17 @@ uint32_t encodeOctahedral(const glm::vec3& unitDir) {
     return toSnorm16(u) | (toSnorm16(v) << 16);
 }
 
+EncodedLinkTint encodeLinkTint(const glm::vec3& tint) {
+    glm::vec3 t;
+    for (int c = 0; c < 3; ++c) t[c] = std::isfinite(tint[c]) ? std::max(tint[c], 0.0f) : 0.0f;
+    const float largest = std::max({t.r, t.g, t.b});
+    if (!(largest > 0.0f)) return {0u, 0.0f};
+    uint32_t code = 0;
+    for (int c = 0; c < 3; ++c)
+        code |= uint32_t(std::lround(std::min(t[c] / largest, 1.0f) * 1023.0f)) << (10 * c);
+    return {code, largest};
+}
+
 glm::vec3 decodeOctahedral(uint32_t code) {
     const auto fromSnorm16 = [](uint32_t bits) {
         return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f);

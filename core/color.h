@@ -6,6 +6,8 @@
 #include <bit>
 #include <cstdint>
 
+#include <glm/common.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace pic {
@@ -48,6 +50,37 @@ uint32_t encodeOctahedral(const glm::vec3& unitDir);
 
 /// Unit direction of an octahedral code from encodeOctahedral.
 glm::vec3 decodeOctahedral(uint32_t code);
+
+/// The chroma per luma (Co/Y, Cg/Y) of a YCoCg colour, clamped to what non-negative RGB
+/// allows (|Co| ≤ 2Y, |Cg| ≤ Y); (0, 0) where Y ≤ 0. The SH caches predict the chroma of
+/// their bands above lC from their luma with the ratio of band 0 (core/cache_values.h).
+inline glm::vec2 chromaPerLuma(const glm::vec3& yCoCg) {
+    if (!(yCoCg.x > 0.0f)) return glm::vec2(0.0f);
+    return glm::clamp(glm::vec2(yCoCg.y, yCoCg.z) / yCoCg.x, glm::vec2(-2.0f, -1.0f), glm::vec2(2.0f, 1.0f));
+}
+
+/// A link's tint (bake/link_generation.h): per-channel multipliers of its factor, stored as
+/// three unorm10 fractions of the largest, R in bits 0-9, G 10-19, B 20-29, bits 30-31 zero.
+/// kNeutralLinkTint is (1, 1, 1). Every channel keeps an error ≤ 1/2046 of the largest.
+inline constexpr uint32_t kNeutralLinkTint = 0x3FFFFFFFu;
+
+/// A tint's code and the scale the link's factor takes so that scale·decodeLinkTint(code)
+/// is the tint.
+struct EncodedLinkTint {
+    uint32_t code = kNeutralLinkTint;
+    float scale = 1.0f;
+};
+
+/// Encodes a tint; negative and non-finite channels count as 0, and an all-zero tint encodes
+/// code 0 with scale 0.
+EncodedLinkTint encodeLinkTint(const glm::vec3& tint);
+
+/// The multipliers of a tint code, each in [0, 1] (shaders/cache_lighting.comp decodes the
+/// same way).
+inline glm::vec3 decodeLinkTint(uint32_t code) {
+    return glm::vec3(float(code & 0x3FFu), float((code >> 10) & 0x3FFu), float((code >> 20) & 0x3FFu)) *
+           (1.0f / 1023.0f);
+}
 
 /// Shared-exponent RGBE8 (Ward's RGBE, as in the Radiance format): 8-bit mantissas R, G, B in
 /// bits 0-7, 8-15, 16-23 and an 8-bit exponent byte x in bits 24-31, each channel being

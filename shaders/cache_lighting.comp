@@ -22,8 +22,9 @@ layout(constant_id = 4) const uint kMapping = 0u;
 layout(constant_id = 5) const uint kTexelWords = 1u;  // words per texel of `links`
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
-const uint kShPairs = (kCountY + 1u) / 2u;  // shared/cache_lighting.h shLinkWords − 1
-const uint kLinkWords = kLinkForm == kLinkFormRtp ? 3u : 1u + kShPairs;
+const uint kShPairs = (kCountY + 1u) / 2u;
+const uint kShWords = 2u + kShPairs + kShPairs % 2u;  // shared/cache_lighting.h shLinkWords
+const uint kLinkWords = kLinkForm == kLinkFormRtp ? 4u : kShWords;
 const uint kLinkTexels = kLinkWords / kTexelWords;  // the host picks a divisor
 
 // Uniform texel buffers of uint words (shared/cache_lighting.h says why).
@@ -46,21 +47,32 @@ float16_t toHalf(float value) {
     return float16_t(clamp(value, -kHalfMax, kHalfMax));
 }
 
+/// core/color.h decodeLinkTint: three unorm10 channels.
+vec3 decodeLinkTint(uint code) {
+    return vec3(uvec3(code, code >> 10u, code >> 20u) & 0x3FFu) * (1.0 / 1023.0);
+}
+
+/// The YCoCg radiance a link carries: its node's radiance times the link's tint.
+vec3 linkRadiance(uint node, uint tint) {
+    return rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(node)).x) * decodeLinkTint(tint));
+}
+
 /// Adds link `slot` (within the chunk) to y, co, cg.
 void addLink(uint slot) {
-    uint words[1 + 64 / 2];  // kLinkWords at most, for lY ≤ 8 as basis[64] below
+    uint words[2 + 64 / 2];  // kLinkWords at most, for lY ≤ 8 as basis[64] below
     [[unroll]] for (uint t = 0u; t < kLinkTexels; ++t) {
         const uvec4 texel = texelFetch(links, int(slot * kLinkTexels + t));
         [[unroll]] for (uint c = 0u; c < kTexelWords; ++c) words[t * kTexelWords + c] = texel[c];
     }
     if (kLinkForm == kLinkFormRtp) {
         // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
-        const GpuRtpLink link = GpuRtpLink(words[0], words[1], words[2]);
-        const float visible = float(link.visibleAndCone & 0xFFFFu) * (1.0 / 65535.0);
+        const GpuRtpLink link = GpuRtpLink(words[0], words[1], words[2], words[3]);
+        const vec2 visibleAndCone = unpackHalf2x16(link.visibleAndCone);
+        const float visible = visibleAndCone.x;
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(link.node)).x));
+        const vec3 radiance = linkRadiance(link.node, link.tint);
         float cone[kBandsY];
-        coneZonal(unpackHalf2x16(link.visibleAndCone >> 16u).x, cone);
+        coneZonal(visibleAndCone.y, cone);
         float basis[64];
         shEvaluate(decodeOctahedral(link.directionOct), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
@@ -72,12 +84,12 @@ void addLink(uint slot) {
             }
         }
     } else {
-        // SH-projected links: the node, then lY² half coefficients two per word, scaled by
-        // π·A at upload to take the node's radiance; chroma takes the first lC².
+        // SH-projected links: the node, its tint, then lY² half coefficients two per word,
+        // scaled by π·A at upload to take the node's radiance; chroma takes the first lC².
         if (words[0] == kNoNode) return;
-        const vec3 radiance = rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(words[0])).x));
+        const vec3 radiance = linkRadiance(words[0], words[1]);
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
-            const vec2 pair = unpackHalf2x16(words[1u + p]);
+            const vec2 pair = unpackHalf2x16(words[2u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {
                 const uint i = 2u * p + h;
                 if (i >= kCountY) break;

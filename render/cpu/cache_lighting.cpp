@@ -71,9 +71,22 @@ struct CacheSh {
     }
 };
 
-/// Eq. 3 with SH-projected links: L = Σ Φ_node · c_link.
+/// A node's flux in RGB and in YCoCg.
+struct NodeFluxes {
+    std::span<const glm::vec3> rgb;
+    std::span<const glm::vec3> yCoCg;
+};
+
+/// The YCoCg flux a link carries: its node's flux times the link's tint. Most links are
+/// neutral (their node has one colour), and those take the node's YCoCg as it is.
+inline glm::vec3 linkFlux(const NodeFluxes& flux, uint32_t node, uint32_t tint) {
+    if (tint == kNeutralLinkTint) return flux.yCoCg[node];
+    return rgbToYCoCg(flux.rgb[node] * decodeLinkTint(tint));
+}
+
+/// Eq. 3 with SH-projected links: L = Σ Φ_node · tint · c_link.
 template <int BandsY>
-void lightCachesSh(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg, CacheValues& out) {
+void lightCachesSh(const BakeData& bake, const NodeFluxes& nodeFlux, CacheValues& out) {
     constexpr int countY = shCount(BandsY);
     const int countC = shCount(int(out.bandsC));
     const LinkSet& links = bake.links;
@@ -85,7 +98,7 @@ void lightCachesSh(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg, C
             // Padding links hold zero coefficients; the file format also allows kNoNode there.
             const uint32_t node = links.shNodes[slot];
             if (node == kNoNode) continue;
-            const glm::vec3 flux = fluxYCoCg[node];
+            const glm::vec3 flux = linkFlux(nodeFlux, node, links.tint[slot]);
             const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
             // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
             for (int i = 0; i < countY; ++i) {
@@ -101,9 +114,10 @@ void lightCachesSh(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg, C
     }, kCacheGrain);
 }
 
-/// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · factor · K_l(α) · y_lm(direction).
+/// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · tint · factor · K_l(α) ·
+/// y_lm(direction).
 template <int BandsY>
-void lightCachesRtp(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg,
+void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux,
                     const RtpLinkTable& table, CacheValues& out) {
     const int bandsC = int(out.bandsC);
     const LinkSet& links = bake.links;
@@ -115,7 +129,7 @@ void lightCachesRtp(const BakeData& bake, std::span<const glm::vec3> fluxYCoCg,
             const float* w = table.weights.data() + slot * BandsY;
             // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
             if (w[0] == 0.0f) continue;
-            const glm::vec3 flux = fluxYCoCg[links.rtp[slot].node];
+            const glm::vec3 flux = linkFlux(nodeFlux, links.rtp[slot].node, links.tint[slot]);
             shEvaluate(BandsY, table.directions[slot], basis.data());
             for (int l = 0; l < BandsY; ++l) {
                 const float fluxY = flux.x * w[l];
@@ -161,25 +175,26 @@ void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
     if (out.bandsY != bandsY || out.bandsC != bandsC || out.cacheCount() != nC)
         out = CacheValues::zeros(nC, bandsY, bandsC);
 
-    // Links are monochromatic, so one YCoCg conversion per node serves all its links.
+    const size_t nLinks = nC * bake.links.linksPerCache;
+    PIC_CHECK_EQ(bake.links.tint.size(), nLinks);
+    // One YCoCg conversion per node serves all its neutral links.
     std::vector<glm::vec3> fluxYCoCg(nodeFlux.size());
     parallelFor(0, nodeFlux.size(), [&](size_t n) { fluxYCoCg[n] = rgbToYCoCg(nodeFlux[n]); },
                 4096);
-
-    const size_t nLinks = nC * bake.links.linksPerCache;
+    const NodeFluxes fluxes{nodeFlux, fluxYCoCg};
     if (bake.links.mode == LinkMode::Sh) {
         PIC_CHECK_EQ(bake.links.bands, bandsY);
         PIC_CHECK_EQ(bake.links.shNodes.size(), nLinks);
         PIC_CHECK_EQ(bake.links.shCoefficients.size(), nLinks * bandsY * bandsY);
         withBands(bandsY, [&](auto bands) {
-            lightCachesSh<decltype(bands)::value>(bake, fluxYCoCg, out);
+            lightCachesSh<decltype(bands)::value>(bake, fluxes, out);
         });
     } else {
         PIC_CHECK_EQ(bake.links.rtp.size(), nLinks);
         PIC_CHECK_EQ(rtp.bands, bandsY);
         PIC_CHECK_EQ(rtp.directions.size(), nLinks);
         withBands(bandsY, [&](auto bands) {
-            lightCachesRtp<decltype(bands)::value>(bake, fluxYCoCg, rtp, out);
+            lightCachesRtp<decltype(bands)::value>(bake, fluxes, rtp, out);
         });
     }
 }

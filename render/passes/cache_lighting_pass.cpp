@@ -45,15 +45,14 @@ uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t max
 
 }  // namespace
 
-GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea) {
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, float nodeArea) {
     // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
-    const double visible =
-        std::clamp(double(link.factor) * std::numbers::pi * double(nodeArea), 0.0, 1.0);
-    auto unorm = uint32_t(std::lround(visible * 65535.0));
-    // A real link too faint for unorm16 would read as padding; it keeps the smallest step.
-    if (unorm == 0 && link.factor > 0.0f) unorm = 1;
+    const auto visible = float(double(link.factor) * std::numbers::pi * double(nodeArea));
+    uint32_t half = floatToHalfClamped(std::max(visible, 0.0f));
+    // A real link too faint for binary16 would read as padding; it keeps the smallest step.
+    if (half == 0 && link.factor > 0.0f) half = 1;
     const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
-    return {link.node, link.directionOct, unorm | (cone << 16)};
+    return {link.node, link.directionOct, half | (cone << 16), tint};
 }
 
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
@@ -121,8 +120,9 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
             [&](size_t i) {
                 const RtpLink& link = links.rtp[i];
                 // Padding (factor 0) may name any node; V = 0 marks it.
-                rtp[i] = link.factor > 0.0f ? packRtpLink(link, bake.nodes[link.node].area)
-                                            : GpuRtpLink{0, 0, 0};
+                rtp[i] = link.factor > 0.0f
+                             ? packRtpLink(link, links.tint[i], bake.nodes[link.node].area)
+                             : GpuRtpLink{0, 0, 0, 0};
             },
             4096);
         PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const GpuRtpLink>(rtp),
@@ -138,9 +138,10 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 const float area = node == kNoNode ? 0.0f : bake.nodes[node].area;
                 uint32_t* record = sh.data() + slot * words;
                 record[0] = node;
+                record[1] = links.tint[slot];
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 for (uint32_t i = 0; i < countY; ++i)
-                    record[1 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
+                    record[2 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
                                          << (16 * (i % 2));
             },
             4096);

@@ -16,17 +16,17 @@
 
 namespace pic::gpu {
 
-/// The GPU's 12-byte form of a runtime-projected link whose node has area `nodeArea`:
-/// V = factor·π·A as unorm16 (at least one step for a link with factor > 0) and 1 − cos α as
-/// binary16 (shaders/shared/cache_lighting.h).
-GpuRtpLink packRtpLink(const RtpLink& link, float nodeArea);
+/// The GPU's 16-byte form of a runtime-projected link with tint code `tint` whose node has area
+/// `nodeArea`: V = factor·π·A as binary16 (clamped to 65504, at least the smallest subnormal for
+/// a link with factor > 0) and 1 − cos α as binary16 (shaders/shared/cache_lighting.h).
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, float nodeArea);
 /// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
 /// c·π·A, clamped to ±65504.
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 
 class CacheLightingPass {
 public:
-    /// Uploads the links (RTP: 12 bytes each, packRtpLink; SH: node index + lY² half
+    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint and lY² half
     /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read

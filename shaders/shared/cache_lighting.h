@@ -26,24 +26,27 @@ PIC_CONST(uint, kCachePerSubgroup, 1u);
 // Largest |radiance| a half-float cache coefficient holds; larger values are clamped.
 PIC_CONST(float, kHalfMax, 65504.0f);
 
-// A runtime-projected link as the GPU reads it: 12 bytes, paper 000 Table 4 (the bake's
-// RtpLink is 16). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written by surfel
-// lighting and the pull), so the link keeps the visible fraction V = factor·π·A ∈ [0, 1]
-// instead of the factor: Φ·factor = (Φ / (π·A))·V.
+// A runtime-projected link as the GPU reads it: 16 bytes, one texel of 4 words (the bake's
+// RtpLink and its tint are 20). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written by
+// surfel lighting and the pull), so the link keeps V = factor·π·A instead of the factor:
+// Φ·factor = (Φ / (π·A))·V. V is the visible fraction of the node in the uniform model and
+// may exceed 1 where the flux weights favour the part the cache sees (binary16 holds it).
 struct GpuRtpLink {
     uint node;            // index into the node array
     uint directionOct;    // unit direction cache → node, octahedral 2 × snorm16
-    uint visibleAndCone;  // unorm16 V (0 marks padding) | binary16 (1 − cos α) << 16
+    uint visibleAndCone;  // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
+    uint tint;            // core/color.h encodeLinkTint
 };
-PIC_STRUCT_CHECK(GpuRtpLink, 12);
+PIC_STRUCT_CHECK(GpuRtpLink, 16);
 
-// An SH-projected link as the GPU reads it: the node index, then its lY² binary16
+// An SH-projected link as the GPU reads it: the node index, its tint, then its lY² binary16
 // coefficients (rescaled by π·A to take the node's radiance) two per 32-bit word, the last
-// word's high half zero when lY² is odd. Whole words keep each lane's loads few: 1 + ⌈lY²/2⌉
-// (3, 6, 9 words for lY = 2, 3, 4).
+// word's high half zero when lY² is odd, and a zero word where that makes the count odd, so
+// that 2- or 4-word texels divide it: 4, 8, 10 words for lY = 2, 3, 4.
 #ifdef __cplusplus
 inline constexpr uint shLinkWords(uint countY) {
-    return 1u + (countY + 1u) / 2u;
+    const uint words = 2u + (countY + 1u) / 2u;
+    return words + words % 2u;
 }
 #endif
 

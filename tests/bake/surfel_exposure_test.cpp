@@ -218,5 +218,64 @@ TEST(LinkReads, ACacheReadsTheSideOfAThinSlabItSees) {
     EXPECT_EQ(flux[part.node].x * part.factor, 0.0f);
 }
 
+TEST(LinkReads, ALinkTakesTheColourOfThePartItSees) {
+    // Two places 2.4 m apart on a 1 cm slab, each with a red surfel on top and a white one
+    // underneath. The hierarchy pairs each red surfel with the white one under it (their
+    // normals differ by 0.2 in the metric, the places by 2.4² / 2.83² = 0.72), so a cache
+    // above sees one surfel of each pair and its link reads the root, whose flux is half white
+    // when uniform light falls on all four. The visible-part link's tint gives the cache the
+    // red it sees: per channel, red ÷ the root's mean albedo; paper 000's link stays neutral.
+    const glm::vec3 red(0.8f, 0.1f, 0.1f), white(0.8f);
+    Scene scene;
+    scene.sourcePath = "slab.gltf";
+    addSquare(scene, 0.005f, 1.5f, true);
+    addSquare(scene, -0.005f, 1.5f, false);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    std::vector<Surfel> surfels;
+    for (const float x : {-1.2f, 1.2f})
+        for (const bool top : {true, false}) {
+            Surfel s = surfelAt({x, top ? 0.005f : -0.005f, 0.0f}, {0.0f, top ? 1.0f : -1.0f, 0.0f});
+            s.albedo = top ? red : white;
+            surfels.push_back(s);
+        }
+    auto hierarchy = buildHierarchy(surfels, HierarchyParams{.sceneExtent = 2.83f});
+    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+    const std::vector<Surfel>& leaves = hierarchy->surfels;
+    const std::vector<Node>& nodes = hierarchy->nodes;
+    const uint32_t root = uint32_t(nodes.size() - 1);
+    for (const uint32_t child : {nodes[root].left, nodes[root].right}) {
+        ASSERT_EQ(nodes[child].surfelCount, 2u);  // a pair: one red, one white
+        const uint32_t first = nodes[child].firstSurfel;
+        ASSERT_EQ(leaves[first].position.x, leaves[first + 1].position.x);
+    }
+    Cache cache{};
+    cache.position = glm::vec3(0.1f, 1.0f, 0.3f);
+    cache.kind = gpu::kCacheKindGrid;
+
+    LinkParams params;
+    params.linksPerCache = 1;
+    params.reads = LinkReads::Node;
+    auto paper = generateLinks(**rays, leaves, nodes, {cache}, params);
+    params.reads = LinkReads::Visible;
+    auto visible = generateLinks(**rays, leaves, nodes, {cache}, params);
+    ASSERT_TRUE(paper && visible);
+    ASSERT_EQ(paper->links.rtp[0].node, root);
+    ASSERT_EQ(visible->links.rtp[0].node, root);  // the red surfels are in both children
+    EXPECT_EQ(paper->links.tint[0], kNeutralLinkTint);
+    const glm::vec3 rootAlbedo = (red + white) * 0.5f;
+    const glm::vec3 expected = red / rootAlbedo;  // (1, 0.22, 0.22)
+    const glm::vec3 tint = decodeLinkTint(visible->links.tint[0]) *
+                           (visible->links.rtp[0].factor / paper->links.rtp[0].factor);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(tint[c], expected[c], 1e-3f) << "channel " << c;
+
+    // Under uniform irradiance E the root's flux is E·a·Σρ: the tinted link carries the red
+    // surfels' radiance in every channel, the neutral one the root's mean colour.
+    const glm::vec3 rootFlux = leaves[0].area * (2.0f * red + 2.0f * white);
+    const glm::vec3 seen = rootFlux * tint;
+    EXPECT_NEAR(seen.g / seen.r, red.g / red.r, 1e-3f);
+    EXPECT_NEAR(rootFlux.g / rootFlux.r, rootAlbedo.g / rootAlbedo.r, 1e-6f);
+}
+
 }  // namespace
 }  // namespace pic

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "core/color.h"
 #include "core/hash.h"
 
 namespace pic {
@@ -23,7 +24,7 @@ namespace fs = std::filesystem;
 constexpr std::string_view kAllSections[] = {
     "params", "surfels",    "nodes",          "levels",          "caches",
     "grid",   "grid_index", "lightmap",       "lightmap_index",  "lightmap_uvs",
-    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs",
+    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs", "links_tint",
 };
 
 /// A hand-made bake: 4 surfels under a balanced hierarchy of 7 nodes, 2 grid caches and 1
@@ -114,6 +115,7 @@ BakeData makeBake(LinkMode mode) {
         for (uint32_t i = 0; i < nLinks * 9; ++i)
             bake.links.shCoefficients.push_back(static_cast<uint16_t>(0x3C00 + 37 * i));
     }
+    for (uint32_t i = 0; i < nLinks; ++i) bake.links.tint.push_back(kNeutralLinkTint - 1025 * i);
     return bake;
 }
 
@@ -161,6 +163,7 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     expectSameRecords(a.links.rtp, b.links.rtp, "links.rtp");
     EXPECT_EQ(a.links.shNodes, b.links.shNodes);
     EXPECT_EQ(a.links.shCoefficients, b.links.shCoefficients);
+    EXPECT_EQ(a.links.tint, b.links.tint);
 }
 
 std::vector<char> readBytes(const std::string& path) {
@@ -553,6 +556,10 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     badUvs.lightmap.triangleUvs.pop_back();
     BakeData badRtpNode = makeBake(LinkMode::Rtp);
     badRtpNode.links.rtp[1].node = 9;
+    BakeData shortTints = makeBake(LinkMode::Sh);
+    shortTints.links.tint.pop_back();
+    BakeData badTint = makeBake(LinkMode::Rtp);
+    badTint.links.tint[4] = 0x40000000u;
     const std::pair<const BakeData*, const char*> cases[] = {
         {&missingNode, "2·nS − 1 = 7"},
         {&badGridIndex, "grid_index entry 3 refers to cache 3"},
@@ -564,6 +571,8 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
         {&badCacheKind, "cache 1 has kind 2"},
         {&badUvs, "5 light-map UVs"},
         {&badRtpNode, "RTP link 1 refers to node 9"},
+        {&shortTints, "need 6 tints, found 5"},
+        {&badTint, "tint 1073741824 of link 4"},
     };
     for (const auto& [bake, expected] : cases) {
         const Result<void> ok = writeBakeFile(path("bad.pic"), *bake);

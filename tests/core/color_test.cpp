@@ -219,6 +219,43 @@ TEST(Octahedral, LayoutAndDegenerateInputs) {
         EXPECT_NEAR(glm::length(decodeOctahedral(code)), 1.0f, 1e-6f);
 }
 
+TEST(LinkTint, ScaleTimesCodeIsTheTintWithinHalfAStep) {
+    Lcg rng;
+    for (int i = 0; i < 10000; ++i) {
+        // Tints over four decades, channels independent (a black or saturated surface gives 0).
+        const float magnitude = std::exp2(-6.0f + 13.0f * rng.next());
+        glm::vec3 tint = magnitude * glm::vec3(rng.next(), rng.next(), rng.next());
+        if (i % 7 == 0) tint[i % 3] = 0.0f;
+        const EncodedLinkTint e = encodeLinkTint(tint);
+        const glm::vec3 back = e.scale * decodeLinkTint(e.code);
+        const float largest = std::max({tint.r, tint.g, tint.b});
+        EXPECT_EQ(e.scale, largest);
+        EXPECT_EQ(e.code >> 30, 0u);
+        for (int c = 0; c < 3; ++c)
+            ASSERT_LE(std::abs(back[c] - tint[c]), largest * (1.0001f / 2046.0f)) << i << " " << c;
+    }
+}
+
+TEST(LinkTint, LayoutNeutralAndDegenerateInputs) {
+    // R in bits 0-9, G 10-19, B 20-29.
+    EXPECT_EQ(encodeLinkTint({1.0f, 0.0f, 0.0f}).code, 0x3FFu);
+    EXPECT_EQ(encodeLinkTint({0.0f, 2.0f, 0.0f}).code, 0x3FFu << 10);
+    EXPECT_EQ(encodeLinkTint({0.0f, 0.0f, 0.5f}).code, 0x3FFu << 20);
+    const EncodedLinkTint grey = encodeLinkTint(glm::vec3(3.5f));
+    EXPECT_EQ(grey.code, kNeutralLinkTint);
+    EXPECT_EQ(grey.scale, 3.5f);
+    EXPECT_EQ(decodeLinkTint(kNeutralLinkTint), glm::vec3(1.0f));
+    // Nothing to carry: code 0, scale 0; negative and non-finite channels count as 0.
+    for (const glm::vec3 t : {glm::vec3(0.0f), glm::vec3(-1.0f), glm::vec3(NAN, 0.0f, -INFINITY)}) {
+        const EncodedLinkTint e = encodeLinkTint(t);
+        EXPECT_EQ(e.code, 0u);
+        EXPECT_EQ(e.scale, 0.0f);
+    }
+    const EncodedLinkTint partly = encodeLinkTint({NAN, 2.0f, -1.0f});
+    EXPECT_EQ(partly.code, 0x3FFu << 10);
+    EXPECT_EQ(partly.scale, 2.0f);
+}
+
 TEST(Rgbe8, ErrorIsBoundedOverAFloatsRange) {
     Lcg rng;
     double maxRelative = 0.0;

@@ -34,6 +34,7 @@ BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t 
     bake.caches.resize(1);
     bake.links.mode = mode;
     bake.links.linksPerCache = nL;
+    bake.links.tint.assign(nL, kNeutralLinkTint);
     if (mode == LinkMode::Sh) {
         bake.links.bands = bandsY;
         bake.links.shNodes.assign(nL, 0u);
@@ -120,6 +121,35 @@ TEST(CacheLighting, RtpLinkProjectsTheNodeConeWithYCoCgBandSplit) {
             const double transport = factor * coneZonal(l, u) * basis[i];
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(back[c], rgb[c] * transport, 1e-5) << "coefficient " << i;
+        }
+    }
+}
+
+TEST(CacheLighting, ALinksTintMultipliesItsNodesFluxPerChannel) {
+    // The same link with and without a tint (bake/link_generation.h): every RGB coefficient of
+    // the tinted cache is the neutral one's times the tint, in both link forms.
+    const glm::vec3 tint(0.25f, 1.0f, 0.5f);
+    const uint32_t code = encodeLinkTint(tint).code;
+    const glm::vec3 decoded = decodeLinkTint(code);
+    for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
+        BakeData bake = oneCacheBake(mode, 2, 2, 1, 1);
+        if (mode == LinkMode::Rtp) {
+            bake.links.rtp[0] = RtpLink{0, 0.5f, encodeOctahedral(glm::vec3(0, 1, 0)), 0.2f};
+        } else {
+            const float c[4] = {0.5f, 0.25f, -0.125f, 0.75f};
+            for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
+        }
+        const std::vector<glm::vec3> nodeFlux = {glm::vec3(3.0f, 2.0f, 1.0f)};
+        CacheValues neutral, tinted;
+        lightCaches(bake, nodeFlux, neutral);
+        bake.links.tint[0] = code;
+        lightCaches(bake, nodeFlux, tinted);
+        for (int i = 0; i < 4; ++i) {
+            const glm::vec3 a = yCoCgToRgb({neutral.y[i], neutral.co[i], neutral.cg[i]});
+            const glm::vec3 b = yCoCgToRgb({tinted.y[i], tinted.co[i], tinted.cg[i]});
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(b[c], a[c] * decoded[c], 1e-5f * std::abs(a[c]) + 1e-7f)
+                    << (mode == LinkMode::Rtp ? "rtp" : "sh") << " coefficient " << i << " channel " << c;
         }
     }
 }

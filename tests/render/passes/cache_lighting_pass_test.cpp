@@ -21,35 +21,38 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-TEST(GpuCacheLighting, RtpLinksPackIntoTwelveBytes) {
-    // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as unorm16.
+TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
+    // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as binary16.
     const float area = 0.37f;
+    const uint32_t tint = encodeLinkTint({0.25f, 1.0f, 0.5f}).code;
     const auto pack = [&](float visible, float oneMinusCos) {
         const gpu::RtpLink link{42, visible / (kPi * area), encodeOctahedral({0, 0, 1}),
                                 oneMinusCos};
-        return gpu::packRtpLink(link, area);
+        return gpu::packRtpLink(link, tint, area);
     };
     const auto visibleOf = [](const gpu::GpuRtpLink& l) {
-        return float(l.visibleAndCone & 0xFFFFu) / 65535.0f;
+        return halfToFloat(uint16_t(l.visibleAndCone & 0xFFFFu));
     };
     const auto coneOf = [](const gpu::GpuRtpLink& l) {
         return halfToFloat(uint16_t(l.visibleAndCone >> 16));
     };
-    for (const float visible : {1.0f, 0.75f, 0.3f, 1e-3f}) {
+    // V above 1: flux weights that favour the part a cache sees (surfel_exposure.h).
+    for (const float visible : {5.5f, 1.0f, 0.75f, 0.3f, 1e-3f}) {
         for (const float oneMinusCos : {2.0f, 0.5f, 1e-2f, 3e-5f, 1e-7f}) {
             const gpu::GpuRtpLink l = pack(visible, oneMinusCos);
             EXPECT_EQ(l.node, 42u);
             EXPECT_EQ(l.directionOct, encodeOctahedral({0, 0, 1}));
-            EXPECT_NEAR(visibleOf(l), visible, 0.5f / 65535.0f + 1e-6f * visible);
+            EXPECT_EQ(l.tint, tint);
             // binary16: relative 2^-11 for normal values, 2^-25 absolute below 2^-14.
+            EXPECT_NEAR(visibleOf(l), visible, visible / 2048.0f);
             EXPECT_NEAR(coneOf(l), oneMinusCos, std::max(oneMinusCos / 2048.0f, 3e-8f));
         }
     }
-    // A link too faint for unorm16 keeps one step instead of reading as padding; padding
-    // (factor 0) stays 0; rounding never takes V past 1.
-    EXPECT_EQ(pack(1e-7f, 0.1f).visibleAndCone & 0xFFFFu, 1u);
+    // A link too faint for binary16 keeps its smallest step instead of reading as padding;
+    // padding (factor 0) stays 0; V saturates at 65504.
+    EXPECT_EQ(pack(1e-9f, 0.1f).visibleAndCone & 0xFFFFu, 1u);
     EXPECT_EQ(pack(0.0f, 0.1f).visibleAndCone & 0xFFFFu, 0u);
-    EXPECT_EQ(pack(1.0001f, 0.1f).visibleAndCone & 0xFFFFu, 65535u);
+    EXPECT_EQ(visibleOf(pack(1e6f, 0.1f)), 65504.0f);
 
     // SH links: c·π·A in binary16, saturating.
     const float c = 123.5f / (kPi * area);
@@ -73,9 +76,9 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
     auto gpu =
         test::gpuFor(b, {}, {.cachePerSubgroup = perSubgroup, .maxLinkTexelWords = texelWords});
     ASSERT_TRUE(gpu);
-    // A link is 3 words (RTP) or 1 + ⌈lY²/2⌉; every device reads single words, and lavapipe
-    // texels of 2, 3 and 4 words, of which the pass takes 4 or 2 before 3.
-    const uint32_t linkWords = mode == LinkMode::Rtp ? 3 : gpu::shLinkWords(bandsY * bandsY);
+    // A link is 4 words (RTP) or 2 + ⌈lY²/2⌉ rounded up to even; every device reads single
+    // words, and lavapipe texels of 2, 3 and 4 words, of which the pass takes 4 or 2 before 3.
+    const uint32_t linkWords = mode == LinkMode::Rtp ? 4 : gpu::shLinkWords(bandsY * bandsY);
     EXPECT_EQ(linkWords % gpu->linkTexelWords(), 0u);
     EXPECT_LE(gpu->linkTexelWords(), texelWords);
     if (texelWords == 1) {
