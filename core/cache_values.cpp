@@ -150,7 +150,14 @@ RadianceSh blendCaches(const CacheValues& values, const CacheStencil& stencil) {
             cg[i] += w * srcCg[i];
         }
     }
-    // Chroma bands above lC stay zero: those coefficients are grey (R = G = B = Y).
+    // Chroma bands above lC are not stored; they take band 0's chroma per luma, so that the
+    // luma's higher bands change the light's strength by direction but not its colour (kept
+    // grey, they would add white light where luma rises and take it where it falls).
+    const glm::vec2 ratio = chromaPerLuma({y[0], co[0], cg[0]});
+    for (size_t i = countC; i < countY; ++i) {
+        co[i] = ratio.x * y[i];
+        cg[i] = ratio.y * y[i];
+    }
     for (size_t i = 0; i < countY; ++i) {
         const glm::vec3 rgb = yCoCgToRgb(glm::vec3(y[i], co[i], cg[i]));
         out.rgb[0][i] = rgb.r;

@@ -198,9 +198,11 @@ void main() {
             }
         }
 
-        // Irradiance Σ K_l L_lm y_lm(n) per YCoCg channel. A truncated expansion rings: on the
-        // dark side of a bright cache it can dip below zero, which irradiance never does, so
-        // each RGB channel is cut at 0.
+        // Irradiance Σ K_l L_lm y_lm(n) per YCoCg channel, the chroma of the bands above lC
+        // predicted from their luma (core/cache_values.h blendCaches). A truncated expansion
+        // rings: on the dark side of a bright cache it can dip below zero, which irradiance
+        // never does, so each RGB channel is cut at 0.
+        const vec2 chroma = chromaPerLuma(vec3(y[0], co[0], cg[0]));
         float basis[64];
         shEvaluate(normal, basis);
         vec3 e = vec3(0.0);
@@ -210,6 +212,8 @@ void main() {
             if (c < kCountC) {
                 e.y += co[c] * w;
                 e.z += cg[c] * w;
+            } else {
+                e.yz += chroma * (y[c] * w);
             }
         }
         result += albedo * (1.0 / kPi) * max(yCoCgToRgb(e), vec3(0.0));
@@ -226,6 +230,8 @@ void main() {
                 if (c < kCountC) {
                     g.y += co[c] * w;
                     g.z += cg[c] * w;
+                } else {
+                    g.yz += chroma * (y[c] * w);
                 }
             }
             result += pc.glossyWeight * max(yCoCgToRgb(g), vec3(0.0));

@@ -100,15 +100,20 @@ void main() {
                     cg[c] += w * texelFetch(cacheCg, int(cache * kCountC + c)).x;
                 }
             }
+            // YCoCg irradiance Σ K_l L_lm y_lm(n), the chroma of the bands above lC predicted
+            // from their luma (core/cache_values.h blendCaches).
+            const vec2 chroma = chromaPerLuma(vec3(y[0], co[0], cg[0]));
             float basis[64];
             shEvaluate(surfel.normal, basis);
-            vec3 e = vec3(0.0);  // YCoCg irradiance: Σ K_l L_lm y_lm(n)
+            vec3 e = vec3(0.0);
             [[unroll]] for (uint c = 0u; c < kCountY; ++c) {
                 const float w = PIC_SH_TABLE(sh.clampedCosine, kShBandOf[c]) * basis[c];
                 e.x += y[c] * w;
                 if (c < kCountC) {
                     e.y += co[c] * w;
                     e.z += cg[c] * w;
+                } else {
+                    e.yz += chroma * (y[c] * w);
                 }
             }
             // SH ringing can make irradiance negative on the dark side; cut at zero per channel.

@@ -46,6 +46,13 @@ vec3 yCoCgToRgb(vec3 ycocg) {
     return vec3(t + ycocg.y, ycocg.x + ycocg.z, t - ycocg.y);
 }
 
+/// core/color.h chromaPerLuma: (Co/Y, Cg/Y) within |Co| ≤ 2Y, |Cg| ≤ Y; 0 where Y ≤ 0. The
+/// chroma of SH bands above lC is their luma times band 0's ratio (core/cache_values.h).
+vec2 chromaPerLuma(vec3 ycocg) {
+    if (!(ycocg.x > 0.0)) return vec2(0.0);
+    return clamp(ycocg.yz / ycocg.x, vec2(-2.0, -1.0), vec2(2.0, 1.0));
+}
+
 /// core/color.h decodeOctahedral: 2 × snorm16 → unit vector (times 1/32767 rather than over
 /// 32767, as in coneZonal).
 vec3 decodeOctahedral(uint code) {

@@ -81,16 +81,18 @@ CacheValues makeValues() {
     return values;
 }
 
-/// Expected RGB of coefficient i from YCoCg (chroma zero above lC²).
-glm::vec3 toRgb(const glm::vec3& yCoCg, int i) {
-    return i < shCount(kBandsC) ? yCoCgToRgb(yCoCg) : glm::vec3(yCoCg.x);
+/// Expected RGB of coefficient i from YCoCg, above lC² with the chroma per luma of band 0.
+glm::vec3 toRgb(const glm::vec3& yCoCg, const glm::vec3& band0, int i) {
+    if (i < shCount(kBandsC)) return yCoCgToRgb(yCoCg);
+    const glm::vec2 ratio = chromaPerLuma(band0);
+    return yCoCgToRgb({yCoCg.x, ratio.x * yCoCg.x, ratio.y * yCoCg.x});
 }
 
 void expectRadiance(const RadianceSh& radiance, const std::function<glm::vec3(int)>& expectedYCoCg,
                     float tolerance = 1e-5f) {
     ASSERT_EQ(radiance.bands, kBandsY);
     for (int i = 0; i < shCount(kBandsY); ++i) {
-        const glm::vec3 expected = toRgb(expectedYCoCg(i), i);
+        const glm::vec3 expected = toRgb(expectedYCoCg(i), expectedYCoCg(0), i);
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(radiance.rgb[c][i], expected[c], tolerance)
                 << "coefficient " << i << " channel " << c;
@@ -264,6 +266,38 @@ TEST(CacheRadiance, YCoCgRoundTrips) {
     ASSERT_EQ(radiance.bands, 4u);
     for (int i = 0; i < 16; ++i)
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(radiance.rgb[c][i], rgb(i)[c], 1e-6f);
+}
+
+TEST(CacheRadiance, BandsAboveLcTakeTheChromaOfBandZero) {
+    // Radiance whose every coefficient has band 0's colour, stored with lC = 1: the luma keeps
+    // the direction, the prediction the colour, so all 9 RGB coefficients come back.
+    const glm::vec3 colour(0.8f, 0.4f, 0.2f);
+    const auto rgb = [&](int i) { return colour * (i == 0 ? 2.0f : 0.3f - 0.1f * float(i)); };
+    SingleCache cache(3, rgb);
+    CacheValues truncated = CacheValues::zeros(1, 3, 1);
+    truncated.y = cache.values.y;
+    truncated.co = {cache.values.co[0]};
+    truncated.cg = {cache.values.cg[0]};
+    cache.values = truncated;
+    const RadianceSh radiance = cache.radiance();
+    for (int i = 0; i < 9; ++i)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(radiance.rgb[c][i], rgb(i)[c], 1e-6f) << "coefficient " << i << " channel " << c;
+
+    // Chroma per luma is clamped to what non-negative RGB allows (|Co| ≤ 2Y, |Cg| ≤ Y), and a
+    // band 0 without light leaves the higher bands grey.
+    EXPECT_EQ(chromaPerLuma({1.0f, 5.0f, -3.0f}), glm::vec2(2.0f, -1.0f));
+    EXPECT_EQ(chromaPerLuma({0.0f, 1.0f, 1.0f}), glm::vec2(0.0f));
+    EXPECT_EQ(chromaPerLuma({-1.0f, 1.0f, 1.0f}), glm::vec2(0.0f));
+    for (const glm::vec3 pure : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1),
+                                 glm::vec3(1, 0, 1), glm::vec3(1, 1, 0)}) {
+        const glm::vec3 v = rgbToYCoCg(pure);
+        EXPECT_EQ(chromaPerLuma(v), glm::vec2(v.y, v.z) / v.x);  // inside the bounds
+    }
+    cache.values.y[0] = 0.0f;
+    const RadianceSh dark = cache.radiance();
+    for (int i = 1; i < 9; ++i)
+        EXPECT_TRUE(dark.rgb[0][i] == dark.rgb[1][i] && dark.rgb[1][i] == dark.rgb[2][i]) << i;
 }
 
 TEST(CacheRadiance, ConstantRadianceGivesPiTimesRadiance) {
