@@ -43,7 +43,8 @@ public:
           mRatioBound(bounceRatioBound(bake)),
           mDirectFlux(bake.surfels.size()),
           mNodeFlux(bake.nodes.size()),
-          mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)) {
+          mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)),
+          mStencils(surfelStencils(scene, rays, bake)) {
         // RTP links' directions and cone factors do not depend on the lights: unpacked once.
         if (bake.links.mode == LinkMode::Rtp) mRtp = unpackRtpLinks(bake.links, bake.params.bandsY);
     }
@@ -62,6 +63,7 @@ private:
     std::vector<glm::vec3> mDirectFlux; ///< nS: flux from lights and emission, per update
     std::vector<glm::vec3> mNodeFlux;   ///< 2nS − 1: leaves hold the current bounce's surfel flux
     CacheValues mValues;
+    std::vector<CacheStencil> mStencils;  ///< nS: the caches each surfel's bounce reads
     CacheTextures mTextures;         ///< filled on demand from mValues
     bool mTexturesCurrent = false;
 };
@@ -109,7 +111,7 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
 
         // The next bounce: direct flux plus what the surfels receive from these caches.
         t = Clock::now();
-        bounceSurfelFlux(mScene, mBake, mDirectFlux, mValues, leaves, step.tail);
+        bounceSurfelFlux(mBake, mStencils, mDirectFlux, mValues, leaves, step.tail);
         total = totalFlux(leaves);
         surfelMs += millisecondsSince(t);
         if (!schedule.record(total)) break;

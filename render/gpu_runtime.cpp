@@ -9,6 +9,7 @@
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
+#include "render/cpu/surfel_lighting.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/sh_tables.h"
 
@@ -87,7 +88,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                               .equalFootprint = options.shadowEqualFootprint}));
     }
     PIC_TRY_ASSIGN(mSurfels,
-                   SurfelLightingPass::create(ctx, mScene, mBake, rays.epsilon(), mVisibility));
+                   SurfelLightingPass::create(ctx, mScene, mBake, surfelStencils(mScene, rays, mBake),
+                                              rays.epsilon(), mVisibility));
     PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
     const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup,

@@ -76,23 +76,52 @@ void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light
         kSurfelGrain / 32);
 }
 
-void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
+std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& rays,
+                                         const BakeData& bake) {
+    std::vector<CacheStencil> stencils(bake.surfels.size());
+    const float offset = 4.0f * rays.epsilon();
+    parallelFor(0, bake.surfels.size(), [&](size_t i) {
+        const Surfel& surfel = bake.surfels[i];
+        PIC_DCHECK(surfel.triangle < scene.triangles.size());
+        const Triangle& triangle = scene.triangles[surfel.triangle];
+        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
+                                        scene.vertices[triangle.v[1]].position,
+                                        scene.vertices[triangle.v[2]].position);
+        const CacheStencil all = surfaceStencil(bake, surfel.triangle, b.y, b.z, surfel.position);
+        const glm::vec3 origin = surfel.position + offset * surfel.normal;
+        CacheStencil seen;
+        float total = 0.0f;
+        for (int k = 0; k < all.count; ++k) {
+            const Cache& cache = bake.caches[all.cache[k]];
+            const glm::vec3 v = cache.position + offset * cache.normal - origin;
+            const float d = glm::length(v);
+            if (d > 2.0f * offset && rays.occluded(origin, v / d, 0.0f, d - offset)) continue;
+            seen.cache[seen.count] = all.cache[k];
+            seen.weight[seen.count] = all.weight[k];
+            total += all.weight[k];
+            ++seen.count;
+        }
+        if (seen.count == all.count || seen.count == 0 || !(total > 0.0f)) {
+            stencils[i] = all;
+            return;
+        }
+        for (int k = 0; k < seen.count; ++k) seen.weight[k] /= total;
+        stencils[i] = seen;
+    }, kSurfelGrain / 4);
+    return stencils;
+}
+
+void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stencils,
                       std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
                       std::span<glm::vec3> surfelFlux, glm::vec3 tail) {
+    PIC_CHECK_EQ(stencils.size(), bake.surfels.size());
     PIC_CHECK_EQ(directFlux.size(), bake.surfels.size());
     PIC_CHECK_EQ(surfelFlux.size(), bake.surfels.size());
     PIC_CHECK(directFlux.data() != surfelFlux.data());
 
     parallelFor(0, bake.surfels.size(), [&](size_t i) {
         const Surfel& surfel = bake.surfels[i];
-        PIC_DCHECK(surfel.triangle < scene.triangles.size());
-        // The renderer's lookup wants the point's barycentrics on its triangle.
-        const Triangle& triangle = scene.triangles[surfel.triangle];
-        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
-                                        scene.vertices[triangle.v[1]].position,
-                                        scene.vertices[triangle.v[2]].position);
-        const RadianceSh radiance = lookupSurfaceRadiance(bake, previousBounce, surfel.triangle,
-                                                          b.y, b.z, surfel.position);
+        const RadianceSh radiance = blendCaches(previousBounce, stencils[i]);
         // Truncated SH ring: the clamped-cosine convolution can dip below zero on the dark
         // side of a bright cache. Irradiance is never negative, and negative flux would carry
         // negative light into the next bounce, so it is cut at zero.
@@ -108,7 +137,7 @@ void lightSurfels(const Scene& scene, const EmbreeScene& rays, const BakeData& b
     if (!previousBounce) return directSurfelFlux(scene, rays, bake, lights, surfelFlux);
     std::vector<glm::vec3> direct(bake.surfels.size());
     directSurfelFlux(scene, rays, bake, lights, direct);
-    bounceSurfelFlux(scene, bake, direct, *previousBounce, surfelFlux);
+    bounceSurfelFlux(bake, surfelStencils(scene, rays, bake), direct, *previousBounce, surfelFlux);
 }
 
 }  // namespace pic

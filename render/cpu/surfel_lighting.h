@@ -36,14 +36,24 @@ inline size_t visibilityWords(size_t surfels) {
 void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
                       std::span<uint32_t> bits);
 
+/// The caches each surfel's bounce reads: surfaceStencil at the surfel's barycentrics, less
+/// the caches it cannot see. A cache is dropped when the segment from the surfel (offset along
+/// its normal) to the cache (offset along a light-map cache's normal) is occluded, and the
+/// others are renormalised; a surfel that sees none of them keeps them all. Bilinear light-map
+/// texels and trilinear grid vertices otherwise reach through a thin wall: a floor that runs
+/// under a partition interpolates the texels on its far side, and surfels there re-emit the
+/// other room's light at every bounce. One ray per stencil entry, computed once per bake.
+std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& rays,
+                                         const BakeData& bake);
+
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
-/// irradiance that the interpolated caches of `previousBounce` deliver at the surfel
-/// (lookupSurfaceRadiance at its barycentrics, clamped-cosine about its normal), per channel
-/// cut at zero where SH ringing makes it negative. `surfelFlux` holds the previous bounce's
-/// flux S on entry; with a `tail` (BounceSchedule: the light of the bounces not computed) each
-/// surfel's new flux S' becomes S' + tail·max(S' − S, 0), per channel.
-/// `directFlux` and `surfelFlux` hold nS entries; they may not alias.
-void bounceSurfelFlux(const Scene& scene, const BakeData& bake,
+/// irradiance that the caches of `previousBounce` deliver at the surfel through its stencil
+/// (surfelStencils; clamped-cosine about its normal), per channel cut at zero where SH
+/// ringing makes it negative. `surfelFlux` holds the previous bounce's flux S on entry; with a
+/// `tail` (BounceSchedule: the light of the bounces not computed) each surfel's new flux S'
+/// becomes S' + tail·max(S' − S, 0), per channel.
+/// `stencils`, `directFlux` and `surfelFlux` hold nS entries; the last two may not alias.
+void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stencils,
                       std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
                       std::span<glm::vec3> surfelFlux, glm::vec3 tail = glm::vec3(0.0f));
 

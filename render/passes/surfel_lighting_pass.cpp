@@ -33,8 +33,11 @@ Result<std::optional<DirectVisibility>> parseDirectVisibility(std::string_view t
 }
 
 Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
-    Context& context, const Scene& scene, const BakeData& bake, float epsilon,
-    DirectVisibility visibility) {
+    Context& context, const Scene& scene, const BakeData& bake,
+    std::span<const CacheStencil> stencils, float epsilon, DirectVisibility visibility) {
+    if (stencils.size() != bake.surfels.size())
+        return fail(ErrorCode::InvalidInput, "{} surfel stencils for {} surfels", stencils.size(),
+                    bake.surfels.size());
     std::unique_ptr<SurfelLightingPass> pass(new SurfelLightingPass(context, scene));
     pass->mSurfelCount = uint32_t(bake.surfels.size());
     pass->mEpsilon = epsilon;
@@ -55,17 +58,12 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
     PIC_TRY_ASSIGN(pass->mBounce, Kernel::create(context, kSpirvSurfelLightingComp, layout,
                                                  "surfel_lighting (bounce)"));
 
-    // The bounce reads the caches at fixed points: each surfel's stencil is computed once.
+    // The bounce reads the caches at fixed points: each surfel's stencil is uploaded once.
     const size_t nS = bake.surfels.size();
-    std::vector<SurfelStencil> stencils(nS);
+    std::vector<SurfelStencil> records(nS);
     parallelFor(0, nS, [&](size_t i) {
-        const pic::Surfel& surfel = bake.surfels[i];
-        const Triangle& triangle = scene.triangles[surfel.triangle];
-        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
-                                        scene.vertices[triangle.v[1]].position,
-                                        scene.vertices[triangle.v[2]].position);
-        const CacheStencil s = surfaceStencil(bake, surfel.triangle, b.y, b.z, surfel.position);
-        SurfelStencil& out = stencils[i];
+        const CacheStencil& s = stencils[i];
+        SurfelStencil& out = records[i];
         out = SurfelStencil{};
         for (int k = 0; k < s.count; ++k) {
             if (k < 4) {
@@ -82,7 +80,7 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
                    Buffer::createWith(context, bake.surfels.data(), nS * sizeof(pic::Surfel),
                                       kTexels, "surfels"));
     PIC_TRY_ASSIGN(pass->mStencils,
-                   Buffer::createWith(context, std::span<const SurfelStencil>(stencils), kTexels,
+                   Buffer::createWith(context, std::span<const SurfelStencil>(records), kTexels,
                                       "surfel stencils"));
     PIC_TRY_ASSIGN(
         pass->mEmissiveScale,

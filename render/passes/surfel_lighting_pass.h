@@ -7,12 +7,14 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "core/bake_data.h"
+#include "core/cache_values.h"
 #include "core/light_set.h"
 #include "core/scene.h"
 #include "gpu/device.h"
@@ -53,11 +55,11 @@ struct SurfelLightingResources {
 
 class SurfelLightingPass {
 public:
-    /// Uploads the surfels and their cache stencils (core/cache_values.h surfaceStencil at
-    /// each surfel's barycentrics: the same lookup as the CPU twin's bounce).
-    static Result<std::unique_ptr<SurfelLightingPass>> create(Context& context, const Scene& scene,
-                                                              const BakeData& bake, float epsilon,
-                                                              DirectVisibility visibility);
+    /// Uploads the surfels and their cache stencils (render/cpu/surfel_lighting.h
+    /// surfelStencils: the CPU twin's bounce reads the same), nS of them.
+    static Result<std::unique_ptr<SurfelLightingPass>> create(
+        Context& context, const Scene& scene, const BakeData& bake,
+        std::span<const CacheStencil> stencils, float epsilon, DirectVisibility visibility);
 
     /// (Re)binds the pass to the runtime's buffers and the current shadow-map image or
     /// visibility buffer.

@@ -200,8 +200,9 @@ TEST(BounceSchedule, AGeometricSeriesEndsOnItsExactTail) {
                                                 params.convergence * luminance(glm::vec3(total)))
             << bounce;
         EXPECT_EQ(step.tail == glm::vec3(0.0f), !step.last) << bounce;
-        if (step.last)
+        if (step.last) {
             for (int c = 0; c < 3; ++c) EXPECT_NEAR(step.tail[c], q[c] / (1.0 - q[c]), 1e-5) << c;
+        }
         increment *= q;
     }
     EXPECT_GT(last, 3);

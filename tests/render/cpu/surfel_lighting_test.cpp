@@ -1,6 +1,7 @@
 // The surfel-lighting CPU twin (render/cpu/surfel_lighting.h) on tiny hand-built inputs with
 // known answers: one surfel under a point, directional or occluded light, emission, the
-// visibility bits of a spot, and one bounce from a cache of constant radiance.
+// visibility bits of a spot, one bounce from a cache of constant radiance, and the stencil
+// that leaves out caches behind a wall.
 
 #include <gtest/gtest.h>
 
@@ -228,12 +229,65 @@ TEST(SurfelLighting, BounceAddsAlbedoAreaTimesCacheIrradiance) {
     lights.lights = {pointLight({0.0f, 1.0f, 0.0f}, 1.0f, glm::vec3(1.0f))};
     std::vector<glm::vec3> direct(1), bounced(1), combined(1);
     directSurfelFlux(scene, **rays, bake, lights, direct);
-    bounceSurfelFlux(scene, bake, direct, values, bounced);
+    bounceSurfelFlux(bake, surfelStencils(scene, **rays, bake), direct, values, bounced);
     lightSurfels(scene, **rays, bake, lights, &values, combined);
     const glm::dvec3 expected =
         glm::dvec3(direct[0]) + glm::dvec3(0.5, 0.25, 0.8) * 0.01 * kPi * radiance;
     expectVecNear(bounced[0], expected, 1e-5);
     EXPECT_EQ(bounced[0], combined[0]);
+}
+
+TEST(SurfelLighting, ASurfelsStencilLeavesOutTheCachesBehindAWall) {
+    // A one-cell grid over the floor: vertices at x = −1 hold cache 0, at x = +1 cache 1, so a
+    // surfel at x = 0.2 reads them 0.4 : 0.6. A wall at x = 0.5 standing on the floor hides
+    // cache 1: the stencil keeps cache 0 alone. Walls on both sides hide both: the surfel
+    // keeps its stencil rather than go dark.
+    const auto bakeOverGrid = [] {
+        BakeData bake = oneSurfelBake({0.2f, 0.0f, 0.0f});
+        bake.caches.resize(2);
+        bake.caches[0].position = {-1.0f, 0.5f, 0.0f};
+        bake.caches[1].position = {1.0f, 0.5f, 0.0f};
+        bake.grid.origin = {-1.0f, -0.5f, -1.0f};
+        bake.grid.cellSize = 2.0f;
+        bake.grid.dims = {2, 2, 2};
+        for (uint32_t i = 0; i < 8; ++i) bake.grid.cacheIndex.push_back(i & 1u);
+        for (Cache& c : bake.caches) c.kind = gpu::kCacheKindGrid;
+        return bake;
+    };
+    const auto wallAt = [](Scene& scene, float x) {
+        addQuad(scene, {x, 0, -1}, {x, 2, -1}, {x, 2, 1}, {x, 0, 1}, 0);
+    };
+    const auto weightOf = [](const CacheStencil& s, uint32_t cache) {
+        float w = 0.0f;
+        for (int k = 0; k < s.count; ++k)
+            if (s.cache[k] == cache) w += s.weight[k];
+        return w;
+    };
+    const BakeData bake = bakeOverGrid();
+
+    Scene open = floorScene();
+    auto openRays = EmbreeScene::create(open);
+    ASSERT_TRUE(openRays);
+    const CacheStencil both = surfelStencils(open, **openRays, bake)[0];
+    EXPECT_NEAR(weightOf(both, 0), 0.4f, 1e-5f);
+    EXPECT_NEAR(weightOf(both, 1), 0.6f, 1e-5f);
+
+    Scene walled = floorScene();
+    wallAt(walled, 0.5f);
+    auto walledRays = EmbreeScene::create(walled);
+    ASSERT_TRUE(walledRays);
+    const CacheStencil near = surfelStencils(walled, **walledRays, bake)[0];
+    EXPECT_NEAR(weightOf(near, 0), 1.0f, 1e-6f);
+    EXPECT_EQ(weightOf(near, 1), 0.0f);
+
+    Scene boxed = floorScene();
+    wallAt(boxed, 0.5f);
+    wallAt(boxed, -0.5f);
+    auto boxedRays = EmbreeScene::create(boxed);
+    ASSERT_TRUE(boxedRays);
+    const CacheStencil hidden = surfelStencils(boxed, **boxedRays, bake)[0];
+    EXPECT_NEAR(weightOf(hidden, 0), 0.4f, 1e-5f);
+    EXPECT_NEAR(weightOf(hidden, 1), 0.6f, 1e-5f);
 }
 
 }  // namespace

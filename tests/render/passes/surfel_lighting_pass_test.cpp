@@ -159,7 +159,7 @@ TEST(GpuSurfelLighting, BounceMatchesTheCpuTwin) {
     lightCaches(b.bake, nodes, caches);
     const std::vector<glm::vec3> direct(nodes.begin(), nodes.begin() + b.bake.surfels.size());
     std::vector<glm::vec3> cpu(direct.size());
-    bounceSurfelFlux(b.scene, b.bake, direct, caches, cpu);
+    bounceSurfelFlux(b.bake, surfelStencils(b.scene, *b.rays, b.bake), direct, caches, cpu);
     auto leaves = gpu->runBounce(direct, caches);
     ASSERT_TRUE(leaves) << leaves.error().message;
     // The GPU reads the caches as half floats: agreement to ~0.1 %, well inside 1 %.
