@@ -1,7 +1,7 @@
 #pragma once
 /// Link generation (paper 000 §4.5-4.6): for every cache, a cut of nL hierarchy nodes
 /// refined top-down by visible solid angle (Embree occlusion rays), stored SH-projected
-/// (eq. 2) or runtime-projected (direction, cone, scalar factor).
+/// (eq. 2) or runtime-projected (direction, cone, scalar factor), each with a colour tint.
 
 #include <cstdint>
 #include <vector>
@@ -42,7 +42,10 @@ struct LinkResult {
 /// one per surfel; empty for uniform): the radiance it carries from visible surfel j is
 /// Φ_r·w_j / (π·Σ_r w·a), so its factor is Σ_visible w_j·Ω_j / (π·Σ_r w·a). r is the node of
 /// the cache's cut (LinkReads::Node, paper 000) or its smallest descendant that holds the part
-/// the cache sees (LinkReads::Visible); the links of a cache then need not form a cut.
+/// the cache sees (LinkReads::Visible); the links of a cache then need not form a cut. With
+/// LinkReads::Visible each link also has a tint (LinkSet::tint): per channel, the colour κ
+/// (surfel_exposure.h fluxColour) of the surfels it sees over the read node's, Σ w·κ·a / Σ w·a,
+/// so that the node's flux reaches the cache in the colour of what it sees.
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params, const std::vector<float>& weights = {});
