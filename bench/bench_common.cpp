@@ -17,13 +17,14 @@ double median(std::vector<double> values) {
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-BakeOptions settingOptions(const std::string& setting, const std::string& linkMode) {
+BakeOptions settingOptions(const std::string& setting, const std::string& linkMode,
+                           uint32_t chromaBands) {
     BakeOptions options;
     const bool high = setting == "high";
     options.surfels = high ? 131072u : 32768u;
     options.links = high ? 254u : 128u;
     options.bandsY = high ? 4u : 3u;
-    options.bandsC = 2u;
+    options.bandsC = chromaBands;
     options.linkMode = linkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
     return options;
 }

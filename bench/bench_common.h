@@ -23,8 +23,10 @@ namespace pic {
 double median(std::vector<double> values);
 
 /// Paper 000 Table 2's settings as bake options: "moderate" (nS 32k, nL 128, lY 3) or
-/// "high" (nS 128k, nL 254, lY 4), lC 2, with "rtp" or "sh" links.
-BakeOptions settingOptions(const std::string& setting, const std::string& linkMode);
+/// "high" (nS 128k, nL 254, lY 4), with "rtp" or "sh" links and `chromaBands` lC (2 in the
+/// paper's settings; the bake refuses lC > lY).
+BakeOptions settingOptions(const std::string& setting, const std::string& linkMode,
+                           uint32_t chromaBands = 2);
 
 /// The light set of update `k` under a kind of change: "move-all" (every light moves by a
 /// small step: point and spot lights along x, directional lights tilt), "move-one" (the

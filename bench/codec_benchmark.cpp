@@ -25,7 +25,7 @@ int runCodecBenchmark(const CodecBenchmarkParams& params) {
     const Scene& scene = inputs->scene;
     BakeReport bakeReport;
     std::fprintf(stderr, "picbench: baking %s %s …\n", params.setting.c_str(), params.linkMode.c_str());
-    auto bake = runBake(scene, settingOptions(params.setting, params.linkMode), bakeReport);
+    auto bake = runBake(scene, settingOptions(params.setting, params.linkMode, params.chromaBands), bakeReport);
     if (!bake) return reportError(bake.error());
     std::unique_ptr<Runtime> runtime;
     if (params.backend == "gpu") {

@@ -17,6 +17,7 @@ struct CodecBenchmarkParams {
     std::string lightsPath;            ///< empty: the scene's lights
     std::string setting = "moderate";
     std::string linkMode = "rtp";
+    uint32_t chromaBands = 2;          ///< lC
     std::string backend = "cpu";       ///< "cpu" or "gpu": the textures are the same to 1 %
     std::string change = "move-one";   ///< bench_common.h changedLights
     int updates = 10;

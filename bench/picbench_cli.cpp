@@ -23,6 +23,12 @@ void addSceneOption(CLI::App& command, std::string& path) {
     command.add_option("--scene", path, "scene file (.gltf or .glb)")->required();
 }
 
+/// --chroma-bands L: lC of the settings' bakes (settingOptions).
+void addChromaBandsOption(CLI::App& command, uint32_t& bands) {
+    command.add_option("--chroma-bands", bands, "SH bands for chroma lC <= lY (default 2)")
+        ->check(CLI::Range(1u, 8u));
+}
+
 /// --setting moderate|high: a row of paper 000's Table 2 (settingOptions).
 void addSettingOption(CLI::App& command, std::string& setting) {
     command.add_option("--setting", setting, "paper 000 Table 2 setting (default: moderate)")
@@ -92,6 +98,7 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::IsMember({"moderate", "high"}));
     runtime->add_option("--link-modes", runtimeParams.linkModes, "link forms (default: rtp sh)")
         ->check(CLI::IsMember({"rtp", "sh"}));
+    addChromaBandsOption(*runtime, runtimeParams.chromaBands);
     runtime->add_option("--bounces", runtimeParams.bounces,
                         "bounces per update, −1 = progressive (default: 1 -1)");
     runtime->add_option("--repeat", runtimeParams.repeat, "timed updates per backend (default 5)")
@@ -142,6 +149,7 @@ int picbenchMain(int argc, char** argv) {
     addSceneOption(*codec, codecParams.scenePath);
     addLightsOption(*codec, codecParams.lightsPath);
     addSettingOption(*codec, codecParams.setting);
+    addChromaBandsOption(*codec, codecParams.chromaBands);
     codec->add_option("--link-mode", codecParams.linkMode, "link form (default: rtp)")
         ->check(CLI::IsMember({"rtp", "sh"}));
     codec->add_option("--backend", codecParams.backend, "runtime backend (default: cpu)")

@@ -239,7 +239,7 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
         for (const std::string& linkMode : params.linkModes) {
             BakeReport bakeReport;
             std::fprintf(stderr, "picbench: baking %s %s …\n", setting.c_str(), linkMode.c_str());
-            auto bake = runBake(scene, settingOptions(setting, linkMode), bakeReport);
+            auto bake = runBake(scene, settingOptions(setting, linkMode, params.chromaBands), bakeReport);
             if (!bake) return reportError(bake.error());
             for (int bounces : params.bounces) {
                 const BounceParams bounceParams{bounces};

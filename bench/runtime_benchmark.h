@@ -26,6 +26,7 @@ struct RuntimeBenchmarkParams {
     std::string lightsPath;                        ///< empty: the scene's lights
     std::vector<std::string> settings{"moderate", "high"};
     std::vector<std::string> linkModes{"rtp", "sh"};
+    uint32_t chromaBands = 2;                      ///< lC
     std::vector<int> bounces{1, -1};               ///< per update; −1 = progressive
     std::vector<std::string> changes{"move-all", "move-one", "recolour"};
     int repeat = 5;

@@ -129,6 +129,29 @@ TEST_F(PicbenchRuntime, CodecFramesDecodeExactlyAndDeltasAreSmaller) {
     EXPECT_TRUE(fs::exists(mDir / "codec.png"));
 }
 
+TEST_F(PicbenchRuntime, CodecTakesTheChromaBandsAndRefusesMoreThanLuma) {
+    // --chroma-bands 3 at the moderate setting (lY 3): every coefficient has its chroma, 27 per
+    // cache; 4 exceeds lY and is refused with the value named.
+    const fs::path json = mDir / "codec3.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("codec --scene ") + PIC_TEST_SCENE_DIR +
+                      "/cornell.gltf --updates 1 --zstd-levels 3 --chroma-bands 3 --json " +
+                      json.string(),
+                  err),
+              0)
+        << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    EXPECT_EQ(report.at("bands").at("c").get<int>(), 3);
+    EXPECT_EQ(report.at("coefficients_per_frame").get<uint64_t>(),
+              27u * report.at("caches").get<uint64_t>());
+    EXPECT_EQ(run(std::string("codec --scene ") + PIC_TEST_SCENE_DIR +
+                      "/cornell.gltf --updates 1 --chroma-bands 4 --json " + json.string(),
+                  err),
+              2);
+    EXPECT_NE(err.find("got 4"), std::string::npos) << err;
+}
+
 TEST_F(PicbenchRuntime, RefusesAnUnknownChange) {
     std::string err;
     EXPECT_EQ(run(std::string("runtime --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --changes teleport", err), 2);
