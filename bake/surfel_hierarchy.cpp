@@ -326,17 +326,30 @@ uint32_t appendKdNodes(const std::vector<uint32_t>& perm, uint32_t begin, uint32
     return tree.leafCount + static_cast<uint32_t>(tree.children.size() - 1);
 }
 
-// Recursive median split along the largest extent of the surfel positions. Every range
-// splits at its middle, so the tree's shape depends on nS alone and the positions decide
-// only which surfel lands in which leaf.
+// Recursive median split along the largest extent of the surfel positions, within each
+// surfel class (surfelClass: each emissive material, then the reflectors), the classes' trees
+// joined pairwise at the top, so an emitter's flux stays on nodes of its own as in the
+// agglomerative tree. Every range splits at its middle, so the tree's shape depends on the
+// classes' sizes alone and the positions decide only which surfel lands in which leaf.
 BuildTree buildKdTree(const std::vector<Surfel>& surfels) {
     const auto nS = static_cast<uint32_t>(surfels.size());
     std::vector<uint32_t> perm(nS);
     std::iota(perm.begin(), perm.end(), 0u);
+    std::stable_sort(perm.begin(), perm.end(), [&](uint32_t a, uint32_t b) {
+        return surfelClass(surfels[a]) < surfelClass(surfels[b]);
+    });
+    std::vector<std::pair<uint32_t, uint32_t>> classes;
+    for (uint32_t begin = 0; begin < nS;) {
+        uint32_t end = begin + 1;
+        while (end < nS && surfelClass(surfels[perm[end]]) == surfelClass(surfels[perm[begin]])) ++end;
+        classes.emplace_back(begin, end);
+        begin = end;
+    }
 
     // Split all ranges of one depth in parallel; they are disjoint.
     std::vector<std::pair<uint32_t, uint32_t>> ranges;
-    if (nS > 1) ranges.emplace_back(0u, nS);
+    for (auto [begin, end] : classes)
+        if (end - begin > 1) ranges.emplace_back(begin, end);
     std::vector<std::pair<uint32_t, uint32_t>> next;
     while (!ranges.empty()) {
         parallelFor(
@@ -353,7 +366,18 @@ BuildTree buildKdTree(const std::vector<Surfel>& surfels) {
 
     BuildTree tree{nS, {}};
     tree.children.reserve(nS - 1);
-    appendKdNodes(perm, 0, nS, tree);
+    std::vector<uint32_t> roots;
+    for (auto [begin, end] : classes) roots.push_back(appendKdNodes(perm, begin, end, tree));
+    // The classes' roots, joined in pairs until one is left.
+    while (roots.size() > 1) {
+        std::vector<uint32_t> joined;
+        for (size_t i = 0; i + 1 < roots.size(); i += 2) {
+            tree.children.push_back({roots[i], roots[i + 1]});
+            joined.push_back(tree.leafCount + static_cast<uint32_t>(tree.children.size() - 1));
+        }
+        if (roots.size() % 2) joined.push_back(roots.back());
+        roots = std::move(joined);
+    }
     return tree;
 }
 

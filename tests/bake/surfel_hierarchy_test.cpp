@@ -482,21 +482,26 @@ TEST(SurfelHierarchy, EmittersOfEachMaterialStayInNodesOfTheirOwn) {
                 s.emission = glm::vec3(5.0f);
                 surfels.push_back(s);
             }
-    HierarchyParams params;
-    params.sceneExtent = std::sqrt(2.0f);
-    auto hierarchy = buildHierarchy(surfels, params);
-    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
-    const std::vector<Node>& nodes = hierarchy->nodes;
-    int mixed = 0;
-    for (const Node& node : nodes) {
-        std::set<uint32_t> classes;
-        for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
-            const Surfel& surfel = hierarchy->surfels[s];
-            classes.insert(surfel.emission.r > 0.0f ? surfel.material : 0xFFFFu);
+    // Both methods: the agglomerative metric's class penalty, the kd-tree's trees per class.
+    for (const HierarchyMethod method : {HierarchyMethod::Agglomerative, HierarchyMethod::KdTree}) {
+        SCOPED_TRACE(method == HierarchyMethod::KdTree ? "kd-tree" : "agglomerative");
+        HierarchyParams params;
+        params.method = method;
+        params.sceneExtent = std::sqrt(2.0f);
+        auto hierarchy = buildHierarchy(surfels, params);
+        ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+        const std::vector<Node>& nodes = hierarchy->nodes;
+        int mixed = 0;
+        for (const Node& node : nodes) {
+            std::set<uint32_t> classes;
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
+                const Surfel& surfel = hierarchy->surfels[s];
+                classes.insert(surfel.emission.r > 0.0f ? surfel.material : 0xFFFFu);
+            }
+            mixed += classes.size() > 1;
         }
-        mixed += classes.size() > 1;
+        EXPECT_EQ(mixed, 2);
     }
-    EXPECT_EQ(mixed, 2);
 }
 
 }  // namespace
