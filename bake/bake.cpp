@@ -68,6 +68,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
         const size_t to = remap[c];
         bake.caches[to] = bake.caches[c];
         std::copy_n(links.tint.begin() + c * nL, nL, links.tint.begin() + to * nL);
+        std::copy_n(links.offset.begin() + c * nL * 3, nL * 3, links.offset.begin() + to * nL * 3);
         if (links.mode == LinkMode::Rtp) {
             std::copy_n(links.rtp.begin() + c * nL, nL, links.rtp.begin() + to * nL);
         } else {
@@ -78,6 +79,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
     }
     bake.caches.resize(kept);
     links.tint.resize(size_t{kept} * nL);
+    links.offset.resize(size_t{kept} * nL * 3);
     if (links.mode == LinkMode::Rtp) {
         links.rtp.resize(size_t{kept} * nL);
     } else {
@@ -243,6 +245,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.reads = p.linkReads;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
     bake.links = std::move(links.links);
+    bake.surfelWeights = weights.empty() ? std::vector<float>(bake.surfels.size(), 1.0f) : weights;
     report.links = links.stats;
     report.blindCachesDropped = dropBlindCaches(bake, links.visibleSolidAngle);
     linkTimer.stop();

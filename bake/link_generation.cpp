@@ -34,6 +34,7 @@ struct NodeEstimate {
     float perArea = 0.0f;      ///< estimated Σ w·Ω·V / Σ w·a over the node, sr/m²
     glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
     glm::vec3 colourSum{0.0f};     ///< Σ w·Ω·V·κ over the samples, in the units of perArea
+    glm::vec3 positionSum{0.0f};   ///< Σ w·Ω·V·x over the samples, in the units of perArea
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
     uint32_t visibleCount = 0;              ///< samples that reached a surfel
@@ -59,11 +60,13 @@ public:
                 const std::vector<Node>& nodes, const LinkParams& params,
                 const std::vector<float>& weights)
         : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params), mWeights(weights),
-          mPrefix(surfels.size() + 1, 0.0), mColourPrefix(surfels.size() + 1, glm::dvec3(0.0)) {
+          mPrefix(surfels.size() + 1, 0.0), mColourPrefix(surfels.size() + 1, glm::dvec3(0.0)),
+          mPositionPrefix(surfels.size() + 1, glm::dvec3(0.0)) {
         for (size_t s = 0; s < surfels.size(); ++s) {
             const double wa = double(weights[s]) * surfels[s].area;
             mPrefix[s + 1] = mPrefix[s] + wa;
             mColourPrefix[s + 1] = mColourPrefix[s] + glm::dvec3(fluxColour(surfels[s])) * wa;
+            mPositionPrefix[s + 1] = mPositionPrefix[s] + glm::dvec3(surfels[s].position) * wa;
         }
     }
 
@@ -168,6 +171,21 @@ public:
         return tint;
     }
 
+    /// The offset of a localised estimate's link: the centroid of the part the cache sees,
+    /// Σ w·Ω·V·x / Σ w·Ω·V, from the read node's flux centroid, Σ w·a·x / Σ w·a (metres). The
+    /// runtime scales the read node's flux by its linear spread along this offset
+    /// (render/cpu/pull.h). Zero for a surfel, and under LinkReads::Node, whose links read
+    /// the node's mean.
+    glm::vec3 offsetOf(const NodeEstimate& e) const {
+        const Node& read = mNodes[e.readNode];
+        if (mParams.reads == LinkReads::Node || !(e.perArea > 0.0f) || read.surfelCount == 1)
+            return glm::vec3(0.0f);
+        const size_t first = read.firstSurfel, last = read.firstSurfel + read.surfelCount;
+        const glm::dvec3 centroid =
+            (mPositionPrefix[last] - mPositionPrefix[first]) / (mPrefix[last] - mPrefix[first]);
+        return glm::vec3(glm::dvec3(e.positionSum) / double(e.perArea) - centroid);
+    }
+
 private:
     double weightedArea(uint32_t node) const {
         const Node& n = mNodes[node];
@@ -251,6 +269,7 @@ private:
             e.perArea += share;
             e.directionSum += share * view.direction;
             e.colourSum += share * fluxColour(surfel);
+            e.positionSum += share * surfel.position;
             samples.push_back({view.direction, share});
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
@@ -278,6 +297,7 @@ private:
     const std::vector<float>& mWeights;
     std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
     std::vector<glm::dvec3> mColourPrefix;  ///< Σ w·κ·a over the surfels before each
+    std::vector<glm::dvec3> mPositionPrefix;  ///< Σ w·a·x over the surfels before each
 };
 
 }  // namespace
@@ -339,6 +359,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     links.linksPerCache = nL;
     links.bands = params.mode == LinkMode::Sh ? params.bands : 0;
     links.tint.assign(nC * nL, 0u);  // padding: no light
+    links.offset.assign(nC * nL * 3, 0u);
     if (params.mode == LinkMode::Rtp) {
         links.rtp.assign(nC * nL, RtpLink{0, 0.0f, 0, 0.0f});
     } else {
@@ -373,6 +394,8 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                 // The tint's largest channel scales the factor, the code keeps the rest.
                 const EncodedLinkTint tint = encodeLinkTint(linker.tintOf(e));
                 links.tint[slot] = tint.code;
+                const glm::vec3 offset = linker.offsetOf(e);
+                for (int i = 0; i < 3; ++i) links.offset[slot * 3 + i] = floatToHalfClamped(offset[i]);
                 const float toRadiance = tint.scale / kPi;
                 if (params.mode == LinkMode::Rtp) {
                     // The cone spans the node's unoccluded solid angle; the factor scales it to

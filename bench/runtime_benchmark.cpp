@@ -136,9 +136,9 @@ Result<std::vector<double>> timeCacheLighting(GpuRuntime& gpu, const Scene& scen
     directSurfelFlux(scene, rays, bake, lights,
                      std::span<glm::vec3>(nodeFlux.data(), bake.surfels.size()));
     pullFlux(bake, nodeFlux);
-    const std::vector<uint32_t> radiance = packNodeRadiance(bake, nodeFlux);
+    const std::vector<glm::uvec4> light = packNodeLight(bake, nodeFlux);
     return timeRepeated(repeat, [&]() -> Result<void> {
-        PIC_TRY(gpu.runCacheLighting(std::span<const uint32_t>(radiance)));
+        PIC_TRY(gpu.runCacheLighting(std::span<const glm::uvec4>(light)));
         return {};
     });
 }

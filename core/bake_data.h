@@ -89,6 +89,8 @@ struct LinkSet {
     std::vector<uint32_t> shNodes;         ///< SH mode: nC·nL node indices (padding: node 0, zero coefficients)
     std::vector<uint16_t> shCoefficients;  ///< SH mode: nC·nL·bands² half floats, 1/(m²·sr)
     std::vector<uint32_t> tint;            ///< both modes: nC·nL tints (core/color.h encodeLinkTint)
+    std::vector<uint16_t> offset;          ///< both modes: nC·nL·3 binary16, metres: the centroid of
+                                           ///< the part the link sees from its node's flux centroid
 };
 
 /// A complete bake.
@@ -96,6 +98,8 @@ struct BakeData {
     BakeParams params;
     uint64_t sceneHash = 0;
     std::vector<Surfel> surfels;           ///< nS, in hierarchy leaf order
+    std::vector<float> surfelWeights;      ///< nS flux weights the links were made with
+                                           ///< (bake/surfel_exposure.h; all 1: uniform)
     std::vector<Node> nodes;               ///< 2·nS − 1
     std::vector<uint32_t> levelOffsets;    ///< inner nodes of level k are [levelOffsets[k-1], levelOffsets[k])
     std::vector<Cache> caches;             ///< nC unique caches

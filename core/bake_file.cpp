@@ -87,10 +87,11 @@ static_assert(sizeof(LinksRecord) == 16);
 static_assert(sizeof(glm::vec2) == 8 && std::is_trivially_copyable_v<glm::vec2>);
 
 /// Section names in the order the writer emits them; a file must hold each exactly once.
-constexpr std::array<std::string_view, 15> kSectionNames = {
-    "params", "surfels",    "nodes",          "levels",          "caches",
-    "grid",   "grid_index", "lightmap",       "lightmap_index",  "lightmap_uvs",
-    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs", "links_tint",
+constexpr std::array<std::string_view, 17> kSectionNames = {
+    "params",         "surfels",         "surfel_weights", "nodes",        "levels",
+    "caches",         "grid",            "grid_index",     "lightmap",     "lightmap_index",
+    "lightmap_uvs",   "links",           "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
+    "links_tint",     "links_offset",
 };
 constexpr size_t kSectionCount = kSectionNames.size();
 static_assert(std::ranges::all_of(kSectionNames,
@@ -99,6 +100,7 @@ static_assert(std::ranges::all_of(kSectionNames,
 /// The arrays of a bake, borrowed from a BakeData or from a mapped file.
 struct BakeView {
     std::span<const Surfel> surfels;
+    std::span<const float> surfelWeights;
     std::span<const Node> nodes;
     std::span<const uint32_t> levelOffsets;
     std::span<const Cache> caches;
@@ -112,6 +114,7 @@ struct BakeView {
     std::span<const uint32_t> shNodes;
     std::span<const uint16_t> shCoefficients;
     std::span<const uint32_t> tint;
+    std::span<const uint16_t> offset;
 };
 
 std::string errnoText(int err) {
@@ -177,6 +180,13 @@ Result<void> checkNodes(const BakeView& v, ErrorCode code, const std::string& wh
     if (nNodes != expectedNodes)
         return fail(code, "{}: {} nodes for nS = {} surfels, expected 2·nS − 1 = {}", what, nNodes,
                     nS, expectedNodes);
+    if (v.surfelWeights.size() != nS)
+        return fail(code, "{}: {} surfel flux weights for nS = {} surfels", what,
+                    v.surfelWeights.size(), nS);
+    for (size_t i = 0; i < v.surfelWeights.size(); ++i)
+        if (!(std::isfinite(v.surfelWeights[i]) && v.surfelWeights[i] > 0.0f))
+            return fail(code, "{}: flux weight of surfel {} is {}, expected finite and positive",
+                        what, i, v.surfelWeights[i]);
     for (size_t i = 0; i < v.nodes.size(); ++i) {
         const Node& node = v.nodes[i];
         const std::pair<const char*, uint32_t> relatives[] = {
@@ -285,6 +295,13 @@ Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& wh
         if (v.tint[i] >> 30 != 0)
             return fail(code, "{}: tint {} of link {} sets bits above the 30 of its channels", what,
                         v.tint[i], i);
+    if (v.offset.size() != nLinks * 3)
+        return fail(code, "{}: links of {} caches × {} links need {} offset components, found {}",
+                    what, v.caches.size(), v.links.linksPerCache, nLinks * 3, v.offset.size());
+    for (size_t i = 0; i < v.offset.size(); ++i)
+        if ((v.offset[i] & 0x7C00u) == 0x7C00u)
+            return fail(code, "{}: offset of link {} is not finite (half bits {:#06x})", what,
+                        i / 3, v.offset[i]);
     return {};
 }
 
@@ -641,6 +658,7 @@ Result<T> recordIn(const SectionMap& sections, std::string_view name, const std:
 Result<BakeView> viewSections(const SectionMap& s, const std::string& path) {
     BakeView v;
     PIC_TRY_ASSIGN(v.surfels, arrayIn<Surfel>(s, "surfels", path));
+    PIC_TRY_ASSIGN(v.surfelWeights, arrayIn<float>(s, "surfel_weights", path));
     PIC_TRY_ASSIGN(v.nodes, arrayIn<Node>(s, "nodes", path));
     PIC_TRY_ASSIGN(v.levelOffsets, arrayIn<uint32_t>(s, "levels", path));
     PIC_TRY_ASSIGN(v.caches, arrayIn<Cache>(s, "caches", path));
@@ -654,6 +672,7 @@ Result<BakeView> viewSections(const SectionMap& s, const std::string& path) {
     PIC_TRY_ASSIGN(v.shNodes, arrayIn<uint32_t>(s, "links_sh_nodes", path));
     PIC_TRY_ASSIGN(v.shCoefficients, arrayIn<uint16_t>(s, "links_sh_coeffs", path));
     PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", path));
+    PIC_TRY_ASSIGN(v.offset, arrayIn<uint16_t>(s, "links_offset", path));
     return v;
 }
 
@@ -688,6 +707,7 @@ std::vector<T> toVector(std::span<const T> s) {
 BakeView viewOf(const BakeData& bake) {
     BakeView v;
     v.surfels = bake.surfels;
+    v.surfelWeights = bake.surfelWeights;
     v.nodes = bake.nodes;
     v.levelOffsets = bake.levelOffsets;
     v.caches = bake.caches;
@@ -704,6 +724,7 @@ BakeView viewOf(const BakeData& bake) {
     v.shNodes = links.shNodes;
     v.shCoefficients = links.shCoefficients;
     v.tint = links.tint;
+    v.offset = links.offset;
     return v;
 }
 
@@ -718,6 +739,7 @@ std::array<std::span<const std::byte>, kSectionCount> sectionBytesOf(const BakeV
     return {
         std::as_bytes(std::span(params)),
         std::as_bytes(v.surfels),
+        std::as_bytes(v.surfelWeights),
         std::as_bytes(v.nodes),
         std::as_bytes(v.levelOffsets),
         std::as_bytes(v.caches),
@@ -731,6 +753,7 @@ std::array<std::span<const std::byte>, kSectionCount> sectionBytesOf(const BakeV
         std::as_bytes(v.shNodes),
         std::as_bytes(v.shCoefficients),
         std::as_bytes(v.tint),
+        std::as_bytes(v.offset),
     };
 }
 
@@ -842,6 +865,7 @@ Result<BakeData> readBakeFile(const std::string& path) {
     bake.defaults = decoded.params.defaults;
     bake.sceneHash = decoded.header.sceneHash;
     bake.surfels = toVector(v.surfels);
+    bake.surfelWeights = toVector(v.surfelWeights);
     bake.nodes = toVector(v.nodes);
     bake.levelOffsets = toVector(v.levelOffsets);
     bake.caches = toVector(v.caches);
@@ -862,6 +886,7 @@ Result<BakeData> readBakeFile(const std::string& path) {
     bake.links.shNodes = toVector(v.shNodes);
     bake.links.shCoefficients = toVector(v.shCoefficients);
     bake.links.tint = toVector(v.tint);
+    bake.links.offset = toVector(v.offset);
     return bake;
 }
 

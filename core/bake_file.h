@@ -26,6 +26,7 @@
 ///   params           JSON object: every BakeParams field (link_mode "sh"|"rtp", hierarchy
 ///                    "agglomerative"|"kdtree") and "defaults" {parameter: how it was chosen}
 ///   surfels          nS × gpu::Surfel (64 bytes)
+///   surfel_weights   nS × f32 flux weight, finite and positive (BakeData::surfelWeights)
 ///   nodes            (2·nS − 1) × gpu::Node (64 bytes); empty when nS = 0
 ///   levels           u32 level offsets, non-decreasing, ≤ node count
 ///   caches           nC × gpu::Cache (32 bytes)
@@ -39,6 +40,7 @@
 ///   links_sh_nodes   SH mode: nC·nL × u32 node index (padding: node 0 with zero coefficients)
 ///   links_sh_coeffs  SH mode: nC·nL·bands² × u16 half float; RTP mode: empty
 ///   links_tint       nC·nL × u32 link tint (core/color.h encodeLinkTint), both modes
+///   links_offset     nC·nL·3 × u16 finite half float, metres (LinkSet::offset), both modes
 ///
 /// Both directions check that the counts agree and that every node and cache index is in range
 /// (kNoNode / kNoCache aside; RTP padding links have factor 0), so the runtime can index the
@@ -56,7 +58,7 @@
 namespace pic {
 
 /// Format version written into, and required of, every bake file.
-inline constexpr uint32_t kBakeFormatVersion = 4;
+inline constexpr uint32_t kBakeFormatVersion = 5;
 /// Bytes of the header including its trailing checksum; the section table follows.
 inline constexpr uint64_t kBakeHeaderBytes = 48;
 /// Bytes of one section table entry.

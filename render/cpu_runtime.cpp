@@ -43,10 +43,13 @@ public:
           mRatioBound(bounceRatioBound(bake)),
           mDirectFlux(bake.surfels.size()),
           mNodeFlux(bake.nodes.size()),
+          mSpread(nodeSpread(bake)),
+          mNodeMoment(bake.nodes.size()),
+          mNodeGradient(bake.nodes.size()),
           mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)),
           mStencils(surfelStencils(scene, rays, bake)) {
-        // RTP links' directions and cone factors do not depend on the lights: unpacked once.
-        if (bake.links.mode == LinkMode::Rtp) mRtp = unpackRtpLinks(bake.links, bake.params.bandsY);
+        // Links' offsets, directions and cone factors do not depend on the lights: unpacked once.
+        mLinks = unpackLinks(bake.links, bake.params.bandsY);
     }
 
     Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
@@ -59,9 +62,12 @@ private:
     const BakeData& mBake;
     BounceParams mBounces;
     glm::vec3 mRatioBound;              ///< bounceRatioBound of the bake
-    RtpLinkTable mRtp;                  ///< RTP bakes only
+    LinkTable mLinks;
     std::vector<glm::vec3> mDirectFlux; ///< nS: flux from lights and emission, per update
     std::vector<glm::vec3> mNodeFlux;   ///< 2nS − 1: leaves hold the current bounce's surfel flux
+    NodeSpread mSpread;                 ///< fixed per bake
+    std::vector<glm::mat3> mNodeMoment;    ///< 2nS − 1: the flux's first moments
+    std::vector<glm::mat3> mNodeGradient;  ///< 2nS − 1: the flux's relative gradients
     CacheValues mValues;
     std::vector<CacheStencil> mStencils;  ///< nS: the caches each surfel's bounce reads
     CacheTextures mTextures;         ///< filled on demand from mValues
@@ -99,10 +105,11 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     for (int bounce = 1;; ++bounce) {
         t = Clock::now();
         pullFlux(mBake, mNodeFlux);
+        pullFluxGradients(mBake, mSpread, mNodeFlux, mNodeMoment, mNodeGradient);
         pullMs += millisecondsSince(t);
 
         t = Clock::now();
-        lightCaches(mBake, mNodeFlux, mRtp, mValues);
+        lightCaches(mBake, mNodeFlux, mNodeGradient, mLinks, mValues);
         cacheMs += millisecondsSince(t);
         s.bounces = bounce;
         s.surfelFlux = luminance(glm::vec3(total));

@@ -1,5 +1,7 @@
 #include "render/gpu_runtime.h"
 
+#include "render/cpu/pull.h"
+
 #include <chrono>
 
 #include "core/color.h"
@@ -59,8 +61,10 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
     PIC_TRY_ASSIGN(mNodeFlux, Buffer::create(ctx, mBake.nodes.size() * sizeof(glm::vec4), kTexels,
                                              MemoryUse::Device, "node flux"));
-    PIC_TRY_ASSIGN(mNodeRadiance, Buffer::create(ctx, mBake.nodes.size() * sizeof(uint32_t),
-                                                 kTexels, MemoryUse::Device, "node radiance"));
+    // Leaves have no flux gradient: the words surfel lighting leaves alone start at zero.
+    const std::vector<glm::uvec4> noLight(mBake.nodes.size(), glm::uvec4(0u));
+    PIC_TRY_ASSIGN(mNodeLight, Buffer::createWith(ctx, std::span<const glm::uvec4>(noLight),
+                                                  kTexels, "node light"));
     PIC_TRY_ASSIGN(mCacheY,
                    Buffer::create(ctx, 2 * nC * countY, kTexels, MemoryUse::Device, "caches Y"));
     PIC_TRY_ASSIGN(mCacheCo,
@@ -95,8 +99,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup,
                                                              options.maxLinkTexelWords));
     PIC_TRY(bindVisibility());
-    PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeRadiance));
-    PIC_TRY(mCacheLighting->bind(ctx, mNodeRadiance, mCacheY, mCacheCo, mCacheCg, mShTables));
+    PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeLight));
+    PIC_TRY(mCacheLighting->bind(ctx, mNodeLight, mCacheY, mCacheCo, mCacheCg, mShTables));
     mLightmapCopyOnHost = options.lightmapCopyOnHost.value_or(ctx.isCpuDevice());
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
@@ -113,7 +117,7 @@ Result<gpu::LightmapCopyPass*> GpuRuntime::lightmapCopyPass() {
 }
 
 Result<void> GpuRuntime::bindVisibility() {
-    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeRadiance,
+    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeLight,
                            &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
 }
 
@@ -335,27 +339,30 @@ Result<std::vector<glm::vec3>> GpuRuntime::runPull(std::span<const glm::vec3> le
     return downloadFlux(mNodeFlux, mBake.nodes.size());
 }
 
-Result<std::vector<uint32_t>> GpuRuntime::nodeRadiance() {
-    std::vector<uint32_t> packed(mBake.nodes.size());
-    PIC_TRY(mContext->download(mNodeRadiance, packed.data(), packed.size() * sizeof(uint32_t)));
+Result<std::vector<glm::uvec4>> GpuRuntime::nodeLight() {
+    std::vector<glm::uvec4> packed(mBake.nodes.size());
+    PIC_TRY(mContext->download(mNodeLight, packed.data(), packed.size() * sizeof(glm::uvec4)));
     return packed;
 }
 
-std::vector<uint32_t> packNodeRadiance(const BakeData& bake, std::span<const glm::vec3> nodeFlux) {
+std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
-    std::vector<uint32_t> radiance(nodeFlux.size());
+    std::vector<glm::mat3> moment(nodeFlux.size()), gradient(nodeFlux.size());
+    pullFluxGradients(bake, nodeSpread(bake), nodeFlux, moment, gradient);
+    std::vector<glm::uvec4> light(nodeFlux.size());
     for (size_t n = 0; n < nodeFlux.size(); ++n)
-        radiance[n] = packRgbe8(nodeFlux[n] * gpu::radianceScale(bake.nodes[n].area));
-    return radiance;
+        light[n] = glm::uvec4(gpu::packNodeGradients(gradient[n]),
+                              packRgbe8(nodeFlux[n] * gpu::radianceScale(bake.nodes[n].area)));
+    return light;
 }
 
 Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::vec3> nodeFlux) {
-    return runCacheLighting(packNodeRadiance(mBake, nodeFlux));
+    return runCacheLighting(packNodeLight(mBake, nodeFlux));
 }
 
-Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const uint32_t> nodeRadiance) {
-    PIC_CHECK_EQ(nodeRadiance.size(), mBake.nodes.size());
-    PIC_TRY(mContext->upload(mNodeRadiance, nodeRadiance.data(), nodeRadiance.size_bytes()));
+Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::uvec4> nodeLight) {
+    PIC_CHECK_EQ(nodeLight.size(), mBake.nodes.size());
+    PIC_TRY(mContext->upload(mNodeLight, nodeLight.data(), nodeLight.size_bytes()));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
         mCacheLighting->record(cmd);
         recordCacheReadback(cmd);
@@ -381,7 +388,7 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
         {"surfels", mSurfels->bytes()},
         {"pull_nodes", mPull->bytes()},
         {"node_flux", mNodeFlux.size()},
-        {"node_radiance", mNodeRadiance.size()},
+        {"node_light", mNodeLight.size()},
         {"caches", mCacheY.size() + mCacheCo.size() + mCacheCg.size()},
         {"textures", mLightmapCopy ? mLightmapCopy->bytes() : 0},
         mShadows ? std::pair<std::string, uint64_t>{"shadow_maps", mShadows->bytes()}

@@ -69,9 +69,10 @@ class LightmapCopyPass;
 
 /// The GPU backend. Besides the Runtime API it runs single passes on given inputs, so that
 /// tests compare each pass with its CPU twin on identical data. Not thread-safe.
-/// Each node's radiance Φ / (π·A) from its flux, as RGBE8: what surfel lighting (leaves) and
-/// the pull (inner nodes) write for cache lighting.
-std::vector<uint32_t> packNodeRadiance(const BakeData& bake, std::span<const glm::vec3> nodeFlux);
+/// Each node's light from its flux (pulled): its flux gradients (render/cpu/pull.h, packed by
+/// gpu::packNodeGradients) and its radiance Φ / (π·A) as RGBE8, what surfel lighting (leaves)
+/// and the pull (inner nodes) write for cache lighting (shaders/shared/pull.h).
+std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux);
 
 class GpuRuntime final : public Runtime {
 public:
@@ -96,14 +97,14 @@ public:
                                              const CacheValues& previous);
     /// Pull from the leaves `leaves` (nS): all 2nS − 1 node fluxes.
     Result<std::vector<glm::vec3>> runPull(std::span<const glm::vec3> leaves);
-    /// Cache lighting from `nodeFlux` (2nS − 1 nodes), uploaded as the radiance RGBE8 that
-    /// surfel lighting and the pull write (packNodeRadiance).
+    /// Cache lighting from `nodeFlux` (2nS − 1 nodes, pulled), uploaded as the node light that
+    /// surfel lighting and the pull write (packNodeLight).
     Result<CacheValues> runCacheLighting(std::span<const glm::vec3> nodeFlux);
-    /// Cache lighting from radiance packed already, so that a benchmark times the pass alone.
-    Result<CacheValues> runCacheLighting(std::span<const uint32_t> nodeRadiance);
-    /// Every node's radiance Φ / (π·A) as RGBE8, as the last update's surfel lighting
+    /// Cache lighting from node light packed already, so that a benchmark times the pass alone.
+    Result<CacheValues> runCacheLighting(std::span<const glm::uvec4> nodeLight);
+    /// Every node's light (shaders/shared/pull.h) as the last update's surfel lighting
     /// (leaves) and pull (inner nodes) wrote it.
-    Result<std::vector<uint32_t>> nodeRadiance();
+    Result<std::vector<glm::uvec4>> nodeLight();
     /// Light-map copy of `values` into the textures.
     Result<CacheTextures> runLightmapCopy(const CacheValues& values);
 
@@ -154,7 +155,7 @@ private:
     bool mLightmapCopyOnHost = false;
     gpu::PassTimer mTimer;
     gpu::Buffer mNodeFlux;   ///< vec4 per node, W RGB
-    gpu::Buffer mNodeRadiance;  ///< RGBE8 per node, Φ / (π·A) in W/(m²·sr), cache lighting's input
+    gpu::Buffer mNodeLight;  ///< 4 words per node (shaders/shared/pull.h), cache lighting's input
     gpu::Buffer mCacheY;     ///< half, nC·lY²
     gpu::Buffer mCacheCo;    ///< half, nC·lC²
     gpu::Buffer mCacheCg;    ///< half, nC·lC²

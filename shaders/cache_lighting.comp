@@ -11,6 +11,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #include "shared/bake_layout.h"
 #include "shared/cache_lighting.h"
+#include "shared/pull.h"
 #include "shared/sh_tables.h"
 
 layout(local_size_x = 64) in;
@@ -23,12 +24,12 @@ layout(constant_id = 5) const uint kTexelWords = 1u;  // words per texel of `lin
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 const uint kShPairs = (kCountY + 1u) / 2u;
-const uint kShWords = 2u + kShPairs + kShPairs % 2u;  // shared/cache_lighting.h shLinkWords
-const uint kLinkWords = kLinkForm == kLinkFormRtp ? 4u : kShWords;
+const uint kShWords = (4u + kShPairs + 3u) / 4u * 4u;  // shared/cache_lighting.h shLinkWords
+const uint kLinkWords = kLinkForm == kLinkFormRtp ? 8u : kShWords;
 const uint kLinkTexels = kLinkWords / kTexelWords;  // the host picks a divisor
 
 // Uniform texel buffers of uint words (shared/cache_lighting.h says why).
-layout(binding = 0) uniform usamplerBuffer nodeRadiance;  // RGBE8 per node
+layout(binding = 0) uniform usamplerBuffer nodeLight;  // RGBA32UI per node (shared/pull.h)
 layout(binding = 1) uniform usamplerBuffer links;  // the chunk's links, kTexelWords per texel
 layout(std430, binding = 2) writeonly buffer CacheY { float16_t cacheY[]; };
 layout(std430, binding = 3) writeonly buffer CacheCo { float16_t cacheCo[]; };
@@ -52,9 +53,19 @@ vec3 decodeLinkTint(uint code) {
     return vec3(uvec3(code, code >> 10u, code >> 20u) & 0x3FFu) * (1.0 / 1023.0);
 }
 
-/// The YCoCg radiance a link carries: its node's radiance times the link's tint.
-vec3 linkRadiance(uint node, uint tint) {
-    return rgbToYCoCg(unpackRgbe8(texelFetch(nodeRadiance, int(node)).x) * decodeLinkTint(tint));
+/// The YCoCg radiance a link carries: its node's radiance times the link's tint and, per
+/// channel, the node's flux spread at the link's offset d, max(0, 1 + r·d) (shared/pull.h).
+vec3 linkRadiance(uint node, uint tint, uint offsetXY, uint offsetZ) {
+    const uvec4 light = texelFetch(nodeLight, int(node));
+    const vec3 offset = vec3(unpackHalf2x16(offsetXY), unpackHalf2x16(offsetZ).x);
+    const vec4 a = unpackSnorm4x8(light.x);
+    const vec4 b = unpackSnorm4x8(light.y);
+    const vec3 rB = vec3(b.zw, unpackSnorm4x8(light.z).x);
+    const float scale = unpackHalf2x16(light.z >> 16u).x;
+    const vec3 spread = vec3(1.0) + scale * vec3(dot(a.xyz, offset), dot(vec3(a.w, b.xy), offset),
+                                                 dot(rB, offset));
+    return rgbToYCoCg(unpackRgbe8(light[kNodeLightRadianceWord]) * decodeLinkTint(tint) *
+                      max(spread, vec3(0.0)));
 }
 
 /// Adds link `slot` (within the chunk) to y, co, cg.
@@ -66,11 +77,12 @@ void addLink(uint slot) {
     }
     if (kLinkForm == kLinkFormRtp) {
         // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
-        const GpuRtpLink link = GpuRtpLink(words[0], words[1], words[2], words[3]);
+        const GpuRtpLink link =
+            GpuRtpLink(words[0], words[1], words[2], words[3], words[4], words[5], 0u, 0u);
         const vec2 visibleAndCone = unpackHalf2x16(link.visibleAndCone);
         const float visible = visibleAndCone.x;
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = linkRadiance(link.node, link.tint);
+        const vec3 radiance = linkRadiance(link.node, link.tint, link.offsetXY, link.offsetZ);
         float cone[kBandsY];
         coneZonal(visibleAndCone.y, cone);
         float basis[64];
@@ -84,12 +96,13 @@ void addLink(uint slot) {
             }
         }
     } else {
-        // SH-projected links: the node, its tint, then lY² half coefficients two per word,
-        // scaled by π·A at upload to take the node's radiance; chroma takes the first lC².
+        // SH-projected links: the node, its tint, its offset, then lY² half coefficients two
+        // per word, scaled by π·A at upload to take the node's radiance; chroma takes the
+        // first lC².
         if (words[0] == kNoNode) return;
-        const vec3 radiance = linkRadiance(words[0], words[1]);
+        const vec3 radiance = linkRadiance(words[0], words[1], words[2], words[3]);
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
-            const vec2 pair = unpackHalf2x16(words[2u + p]);
+            const vec2 pair = unpackHalf2x16(words[4u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {
                 const uint i = 2u * p + h;
                 if (i >= kCountY) break;

@@ -45,7 +45,7 @@ layout(std140, binding = 11) uniform Sh { ShTables sh; };
 layout(std430, binding = 12) writeonly buffer GroupFlux { vec4 groupFlux[]; };
 // Rays mode: bit i % 32 of word light·⌈nS/32⌉ + i/32 is set where light reaches surfel i.
 layout(binding = 13) uniform usamplerBuffer visibility;
-layout(std430, binding = 14) writeonly buffer NodeRadiance { uint nodeRadiance[]; };  // leaves
+layout(std430, binding = 14) writeonly buffer NodeLight { uvec4 nodeLight[]; };  // leaves (shared/pull.h)
 layout(binding = 15) uniform samplerBuffer directFluxTexels;  // binding 5, read by the bounce
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
@@ -124,7 +124,7 @@ void main() {
         }
         nodeFlux[i] = vec4(flux, 0.0);
         // Cache lighting reads the leaf's radiance Φ / (π·A) (paper 000 §4.7).
-        nodeRadiance[i] = packRgbe8(flux / (kPi * surfel.area));
+        nodeLight[i] = uvec4(0u, 0u, 0u, packRgbe8(flux / (kPi * surfel.area)));
     }
 
     // Workgroup sum of the flux for the progressive stop (the host adds the groups in double):

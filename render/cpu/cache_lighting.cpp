@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/sh.h"
+#include "render/cpu/pull.h"
 
 namespace pic {
 namespace {
@@ -71,17 +72,26 @@ struct CacheSh {
     }
 };
 
-/// A node's flux in RGB and in YCoCg.
+/// A node's flux in RGB and in YCoCg, its relative gradients (render/cpu/pull.h; empty: none)
+/// and the links' offsets.
 struct NodeFluxes {
     std::span<const glm::vec3> rgb;
     std::span<const glm::vec3> yCoCg;
+    std::span<const glm::mat3> gradient;
+    std::span<const glm::vec3> offset;
 };
 
-/// The YCoCg flux a link carries: its node's flux times the link's tint. Most links are
-/// neutral (their node has one colour), and those take the node's YCoCg as it is.
-inline glm::vec3 linkFlux(const NodeFluxes& flux, uint32_t node, uint32_t tint) {
-    if (tint == kNeutralLinkTint) return flux.yCoCg[node];
-    return rgbToYCoCg(flux.rgb[node] * decodeLinkTint(tint));
+/// The YCoCg flux link `slot` carries: its node's flux times the link's tint and, per channel,
+/// the node's linear spread at the centroid of what the link sees, max(0, 1 + r_c·d). Links
+/// that read a node's mean in its own colour (a leaf, or a node seen whole) take the node's
+/// YCoCg as it is.
+inline glm::vec3 linkFlux(const NodeFluxes& flux, uint32_t node, uint32_t tint, size_t slot) {
+    const bool spread = !flux.gradient.empty() && flux.offset[slot] != glm::vec3(0.0f);
+    if (tint == kNeutralLinkTint && !spread) return flux.yCoCg[node];
+    glm::vec3 rgb = flux.rgb[node] * decodeLinkTint(tint);
+    if (spread)
+        rgb *= glm::max(glm::vec3(1.0f) + flux.offset[slot] * flux.gradient[node], glm::vec3(0.0f));
+    return rgbToYCoCg(rgb);
 }
 
 /// Eq. 3 with SH-projected links: L = Σ Φ_node · tint · c_link.
@@ -98,7 +108,7 @@ void lightCachesSh(const BakeData& bake, const NodeFluxes& nodeFlux, CacheValues
             // Padding links hold zero coefficients; the file format also allows kNoNode there.
             const uint32_t node = links.shNodes[slot];
             if (node == kNoNode) continue;
-            const glm::vec3 flux = linkFlux(nodeFlux, node, links.tint[slot]);
+            const glm::vec3 flux = linkFlux(nodeFlux, node, links.tint[slot], slot);
             const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
             // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
             for (int i = 0; i < countY; ++i) {
@@ -117,8 +127,8 @@ void lightCachesSh(const BakeData& bake, const NodeFluxes& nodeFlux, CacheValues
 /// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · tint · factor · K_l(α) ·
 /// y_lm(direction).
 template <int BandsY>
-void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux,
-                    const RtpLinkTable& table, CacheValues& out) {
+void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux, const LinkTable& table,
+                    CacheValues& out) {
     const int bandsC = int(out.bandsC);
     const LinkSet& links = bake.links;
     const size_t nL = links.linksPerCache;
@@ -129,7 +139,7 @@ void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux,
             const float* w = table.weights.data() + slot * BandsY;
             // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
             if (w[0] == 0.0f) continue;
-            const glm::vec3 flux = linkFlux(nodeFlux, links.rtp[slot].node, links.tint[slot]);
+            const glm::vec3 flux = linkFlux(nodeFlux, links.rtp[slot].node, links.tint[slot], slot);
             shEvaluate(BandsY, table.directions[slot], basis.data());
             for (int l = 0; l < BandsY; ++l) {
                 const float fluxY = flux.x * w[l];
@@ -149,11 +159,16 @@ void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux,
 
 }  // namespace
 
-RtpLinkTable unpackRtpLinks(const LinkSet& links, uint32_t bandsY) {
-    PIC_CHECK(links.mode == LinkMode::Rtp);
+LinkTable unpackLinks(const LinkSet& links, uint32_t bandsY) {
     PIC_CHECK(bandsY >= 1 && bandsY <= uint32_t(kMaxShBands));
-    RtpLinkTable table;
+    PIC_CHECK_EQ(links.offset.size(), links.tint.size() * 3);
+    LinkTable table;
     table.bands = bandsY;
+    table.offsets.resize(links.tint.size());
+    parallelFor(0, links.tint.size(), [&](size_t slot) {
+        for (int i = 0; i < 3; ++i) table.offsets[slot][i] = halfToFloat(links.offset[slot * 3 + i]);
+    }, 4096);
+    if (links.mode != LinkMode::Rtp) return table;
     table.directions.resize(links.rtp.size());
     table.weights.resize(links.rtp.size() * bandsY);
     parallelFor(0, links.rtp.size(), [&](size_t slot) {
@@ -168,8 +183,10 @@ RtpLinkTable unpackRtpLinks(const LinkSet& links, uint32_t bandsY) {
 }
 
 void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
-                 const RtpLinkTable& rtp, CacheValues& out) {
+                 std::span<const glm::mat3> nodeGradient, const LinkTable& table,
+                 CacheValues& out) {
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
+    PIC_CHECK(nodeGradient.empty() || nodeGradient.size() == nodeFlux.size());
     const uint32_t bandsY = bake.params.bandsY, bandsC = bake.params.bandsC;
     const size_t nC = bake.caches.size();
     if (out.bandsY != bandsY || out.bandsC != bandsC || out.cacheCount() != nC)
@@ -177,11 +194,13 @@ void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
 
     const size_t nLinks = nC * bake.links.linksPerCache;
     PIC_CHECK_EQ(bake.links.tint.size(), nLinks);
-    // One YCoCg conversion per node serves all its neutral links.
+    PIC_CHECK_EQ(table.bands, bandsY);
+    PIC_CHECK_EQ(table.offsets.size(), nLinks);
+    // One YCoCg conversion per node serves all its links that read its mean.
     std::vector<glm::vec3> fluxYCoCg(nodeFlux.size());
     parallelFor(0, nodeFlux.size(), [&](size_t n) { fluxYCoCg[n] = rgbToYCoCg(nodeFlux[n]); },
                 4096);
-    const NodeFluxes fluxes{nodeFlux, fluxYCoCg};
+    const NodeFluxes fluxes{nodeFlux, fluxYCoCg, nodeGradient, table.offsets};
     if (bake.links.mode == LinkMode::Sh) {
         PIC_CHECK_EQ(bake.links.bands, bandsY);
         PIC_CHECK_EQ(bake.links.shNodes.size(), nLinks);
@@ -191,19 +210,18 @@ void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
         });
     } else {
         PIC_CHECK_EQ(bake.links.rtp.size(), nLinks);
-        PIC_CHECK_EQ(rtp.bands, bandsY);
-        PIC_CHECK_EQ(rtp.directions.size(), nLinks);
+        PIC_CHECK_EQ(table.directions.size(), nLinks);
         withBands(bandsY, [&](auto bands) {
-            lightCachesRtp<decltype(bands)::value>(bake, fluxes, rtp, out);
+            lightCachesRtp<decltype(bands)::value>(bake, fluxes, table, out);
         });
     }
 }
 
 void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux, CacheValues& out) {
-    const RtpLinkTable rtp = bake.links.mode == LinkMode::Rtp
-                                 ? unpackRtpLinks(bake.links, bake.params.bandsY)
-                                 : RtpLinkTable{};
-    lightCaches(bake, nodeFlux, rtp, out);
+    const NodeSpread spread = nodeSpread(bake);
+    std::vector<glm::mat3> moment(nodeFlux.size()), gradient(nodeFlux.size());
+    pullFluxGradients(bake, spread, nodeFlux, moment, gradient);
+    lightCaches(bake, nodeFlux, gradient, unpackLinks(bake.links, bake.params.bandsY), out);
 }
 
 }  // namespace pic

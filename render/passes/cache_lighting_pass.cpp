@@ -17,7 +17,7 @@ namespace {
 /// buffer is a multiple of 256 bytes (the largest minTexelBufferOffsetAlignment in use).
 constexpr uint32_t kChunkAlignment = 256;
 
-/// Node radiance, links, caches Y, Co, Cg, SH tables.
+/// Node light, links, caches Y, Co, Cg, SH tables.
 constexpr uint32_t kBindingCount = 6;
 
 /// The uint texel format of `words` 32-bit components.
@@ -45,14 +45,15 @@ uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t max
 
 }  // namespace
 
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, float nodeArea) {
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, const uint16_t* offset, float nodeArea) {
     // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
     const auto visible = float(double(link.factor) * std::numbers::pi * double(nodeArea));
     uint32_t half = floatToHalfClamped(std::max(visible, 0.0f));
     // A real link too faint for binary16 would read as padding; it keeps the smallest step.
     if (half == 0 && link.factor > 0.0f) half = 1;
     const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
-    return {link.node, link.directionOct, half | (cone << 16), tint};
+    return {link.node, link.directionOct, half | (cone << 16), tint,
+            uint32_t(offset[0]) | uint32_t(offset[1]) << 16, offset[2], 0, 0};
 }
 
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
@@ -97,7 +98,7 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
 
     KernelLayout layout;
     layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-    layout.bindings[0] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // node radiance
+    layout.bindings[0] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // node light
     layout.bindings[1] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // links
     layout.bindings[kBindingCount - 1] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
     layout.pushBytes = sizeof(CacheLightingPush);
@@ -120,9 +121,9 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
             [&](size_t i) {
                 const RtpLink& link = links.rtp[i];
                 // Padding (factor 0) may name any node; V = 0 marks it.
-                rtp[i] = link.factor > 0.0f
-                             ? packRtpLink(link, links.tint[i], bake.nodes[link.node].area)
-                             : GpuRtpLink{0, 0, 0, 0};
+                rtp[i] = link.factor > 0.0f ? packRtpLink(link, links.tint[i], &links.offset[i * 3],
+                                                          bake.nodes[link.node].area)
+                                            : GpuRtpLink{};
             },
             4096);
         PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const GpuRtpLink>(rtp),
@@ -139,9 +140,12 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 uint32_t* record = sh.data() + slot * words;
                 record[0] = node;
                 record[1] = links.tint[slot];
+                const uint16_t* offset = &links.offset[slot * 3];
+                record[2] = uint32_t(offset[0]) | uint32_t(offset[1]) << 16;
+                record[3] = offset[2];
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 for (uint32_t i = 0; i < countY; ++i)
-                    record[2 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
+                    record[4 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
                                          << (16 * (i % 2));
             },
             4096);
@@ -161,13 +165,13 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     return pass;
 }
 
-Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeRadiance,
+Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeLight,
                                      const Buffer& cacheY, const Buffer& cacheCo,
                                      const Buffer& cacheCg, const Buffer& shTables) {
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
     PIC_TRY_ASSIGN(mRadianceView,
-                   TexelView::create(context, nodeRadiance, VK_FORMAT_R32_UINT, "node radiance"));
+                   TexelView::create(context, nodeLight, VK_FORMAT_R32G32B32A32_UINT, "node light"));
     for (size_t k = 0; k < mChunkFirst.size(); ++k) {
         const std::array<BindingResource, kBindingCount> resources = {
             BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),

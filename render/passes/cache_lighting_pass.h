@@ -16,18 +16,19 @@
 
 namespace pic::gpu {
 
-/// The GPU's 16-byte form of a runtime-projected link with tint code `tint` whose node has area
-/// `nodeArea`: V = factor·π·A as binary16 (clamped to 65504, at least the smallest subnormal for
-/// a link with factor > 0) and 1 − cos α as binary16 (shaders/shared/cache_lighting.h).
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, float nodeArea);
+/// The GPU's 32-byte form of a runtime-projected link with tint code `tint` and offset `offset`
+/// (LinkSet::offset, 3 binary16) whose node has area `nodeArea`: V = factor·π·A as binary16
+/// (clamped to 65504, at least the smallest subnormal for a link with factor > 0) and
+/// 1 − cos α as binary16 (shaders/shared/cache_lighting.h).
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, const uint16_t* offset, float nodeArea);
 /// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
 /// c·π·A, clamped to ±65504.
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 
 class CacheLightingPass {
 public:
-    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint and lY² half
-    /// coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
+    /// Uploads the links (RTP: 32 bytes each, packRtpLink; SH: node index, tint, offset and lY²
+    /// half coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
     /// in uint texels of up to `maxTexelWords` words that the device supports and that divide
@@ -35,9 +36,9 @@ public:
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
                                                              bool cachePerSubgroup,
                                                              uint32_t maxTexelWords = 4);
-    /// Binds the node radiance (RGBE8 per node; its usage must allow uniform texel buffers),
-    /// the output caches (half) and the SH tables.
-    Result<void> bind(Context& context, const Buffer& nodeRadiance, const Buffer& cacheY,
+    /// Binds the node light (4 words per node, shaders/shared/pull.h; its usage must allow
+    /// uniform texel buffers), the output caches (half) and the SH tables.
+    Result<void> bind(Context& context, const Buffer& nodeLight, const Buffer& cacheY,
                       const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& shTables);
     void record(VkCommandBuffer cmd);
     /// Link bytes read per update.

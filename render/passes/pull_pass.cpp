@@ -1,10 +1,16 @@
 #include "render/passes/pull_pass.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <numbers>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
 
+#include "core/color.h"
+
+#include "render/cpu/pull.h"
 #include "shaders/shared/pull.h"
 #include "spirv/pull_comp.h"
 
@@ -12,6 +18,28 @@ namespace pic::gpu {
 
 float radianceScale(float area) {
     return float(1.0 / (std::numbers::pi * double(area)));
+}
+
+glm::uvec3 packNodeGradients(const glm::mat3& gradient) {
+    float largest = 0.0f;
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 3; ++i) largest = std::max(largest, std::abs(gradient[c][i]));
+    largest = std::min(largest, 65504.0f);
+    if (!(largest > 0.0f)) return glm::uvec3(0u);
+    // The scale rounds up, so that every component / scale lies in [−1, 1].
+    uint32_t scaleBits = floatToHalf(largest);
+    if (halfToFloat(uint16_t(scaleBits)) < largest) ++scaleBits;
+    const glm::mat3 r = gradient * (1.0f / halfToFloat(uint16_t(scaleBits)));
+    return {glm::packSnorm4x8(glm::vec4(r[0], r[1].x)),
+            glm::packSnorm4x8(glm::vec4(r[1].y, r[1].z, r[2].x, r[2].y)),
+            (glm::packSnorm4x8(glm::vec4(r[2].z, 0.0f, 0.0f, 0.0f)) & 0xFFu) | scaleBits << 16};
+}
+
+glm::mat3 unpackNodeGradients(const glm::uvec3& packed) {
+    const glm::vec4 a = glm::unpackSnorm4x8(packed.x), b = glm::unpackSnorm4x8(packed.y);
+    const float z = glm::unpackSnorm4x8(packed.z).x;
+    const float scale = halfToFloat(uint16_t(packed.z >> 16));
+    return glm::mat3(glm::vec3(a), glm::vec3(a.w, b.x, b.y), glm::vec3(b.z, b.w, z)) * scale;
 }
 
 Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake) {
@@ -29,20 +57,47 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     KernelLayout layout;
     layout.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
                        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                       VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
     layout.pushBytes = sizeof(PullPush);
     layout.specialization = {kPullModeLevel};
     PIC_TRY_ASSIGN(pass->mLevel, Kernel::create(context, kSpirvPullComp, layout, "pull (level)"));
     layout.specialization = {kPullModeTail};
     PIC_TRY_ASSIGN(pass->mTail, Kernel::create(context, kSpirvPullComp, layout, "pull (tail)"));
-    // Only the children and the area matter to the pull: 16 bytes per inner node instead of
-    // the 64-byte Node.
+    // The children, the area and the flux spread (render/cpu/pull.h).
+    const NodeSpread spread = nodeSpread(bake);
     std::vector<PullNode> inner(bake.nodes.size() - nS);
     for (size_t n = nS; n < bake.nodes.size(); ++n) {
         const Node& node = bake.nodes[n];
-        inner[n - nS] = {node.left, node.right, radianceScale(node.area), 0};
+        const glm::mat3& axes = spread.axes[n];
+        const glm::vec3 &low = spread.low[n], &centroid = spread.centroid[n];
+        inner[n - nS] = {node.left,
+                         node.right,
+                         radianceScale(node.area),
+                         0,
+                         axes[0],
+                         low.x,
+                         axes[1],
+                         low.y,
+                         axes[2],
+                         low.z,
+                         spread.inverseVariance[n],
+                         0.0f,
+                         spread.high[n],
+                         0.0f,
+                         spread.centroid[node.left] - centroid,
+                         0.0f,
+                         spread.centroid[node.right] - centroid,
+                         0.0f};
     }
     if (inner.empty()) return pass;  // a single surfel: nothing to pull
+    // The leaves' moments are zero and stay so: only inner nodes are written.
+    const std::vector<glm::vec4> zeros(3 * bake.nodes.size(), glm::vec4(0.0f));
+    PIC_TRY_ASSIGN(pass->mMoments,
+                   Buffer::createWith(context, std::span<const glm::vec4>(zeros),
+                                      VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "node moments"));
+    PIC_TRY_ASSIGN(pass->mMomentView, TexelView::create(context, pass->mMoments,
+                                                        VK_FORMAT_R32G32B32A32_SFLOAT, "node moments"));
     PIC_TRY_ASSIGN(pass->mInnerNodes,
                    Buffer::createWith(context, std::span<const PullNode>(inner),
                                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
@@ -54,16 +109,17 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     return pass;
 }
 
-Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeRadiance) {
+Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeLight) {
     if (!mInnerNodes.handle()) return {};
     PIC_TRY(mLevel.resetSets());
     PIC_TRY(mTail.resetSets());
     PIC_TRY_ASSIGN(mFluxView, TexelView::create(context, nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT,
                                                 "node flux"));
-    const std::array<BindingResource, 5> resources = {
-        BindingResource::storage(0, nodeFlux), BindingResource::texels(1, mInnerView),
-        BindingResource::storage(2, nodeRadiance), BindingResource::texels(3, mFluxView),
-        BindingResource::storage(4, mLevelOffsetBuffer)};
+    const std::array<BindingResource, 7> resources = {
+        BindingResource::storage(0, nodeFlux),          BindingResource::texels(1, mInnerView),
+        BindingResource::storage(2, nodeLight),         BindingResource::texels(3, mFluxView),
+        BindingResource::storage(4, mLevelOffsetBuffer), BindingResource::storage(5, mMoments),
+        BindingResource::texels(6, mMomentView)};
     PIC_TRY_ASSIGN(mLevelSet, mLevel.makeSet(resources));
     PIC_TRY_ASSIGN(mTailSet, mTail.makeSet(resources));
     return {};

@@ -1,8 +1,9 @@
 #pragma once
-/// Pull on the GPU (paper 000 Figure 2 step 3, §4.1): node flux = sum of its children's, one
-/// dispatch per hierarchy level, lowest first, and one for the small upper levels together
-/// (shaders/shared/pull.h); each inner node's radiance Φ / (π·A) is also
-/// written as RGBE8 for cache lighting (§4.7). CPU twin: render/cpu/pull.h.
+/// Pull on the GPU (paper 000 Figure 2 step 3, §4.1): node flux = sum of its children's, with
+/// the flux's first moment, one dispatch per hierarchy level, lowest first, and one for the
+/// small upper levels together (shaders/shared/pull.h); each inner node's light, its radiance
+/// Φ / (π·A) as RGBE8 (§4.7) and its flux gradients, is written for cache lighting. CPU twin:
+/// render/cpu/pull.h.
 
 #include <memory>
 #include <vector>
@@ -18,17 +19,23 @@ namespace pic::gpu {
 /// §4.1), as the pull scales it.
 float radianceScale(float area);
 
+/// Nine relative flux gradients (columns r_R, r_G, r_B, 1/m) as the pull packs them: snorm8 of
+/// a shared binary16 scale (shaders/shared/pull.h), and back.
+glm::uvec3 packNodeGradients(const glm::mat3& gradient);
+glm::mat3 unpackNodeGradients(const glm::uvec3& packed);
+
 class PullPass {
 public:
-    /// Uploads each inner node's two children and 1 / (π·area).
+    /// Uploads each inner node's two children, 1 / (π·area) and flux spread.
     static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake);
     /// Binds the node flux (vec4 per node; its usage must allow uniform texel buffers) and
-    /// node radiance (RGBE8 per node) buffers, whose leaves surfel lighting writes.
-    Result<void> bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeRadiance);
+    /// node light (4 words per node, shaders/shared/pull.h) buffers, whose leaves surfel
+    /// lighting writes.
+    Result<void> bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeLight);
     /// Records every level with a barrier after each (the tail's levels with one between
     /// them inside its workgroup), so a level reads finished children.
     void record(VkCommandBuffer cmd);
-    VkDeviceSize bytes() const { return mInnerNodes.size(); }
+    VkDeviceSize bytes() const { return mInnerNodes.size() + mMoments.size(); }
 
 private:
     PullPass() = default;
@@ -41,6 +48,8 @@ private:
     Buffer mInnerNodes;    ///< PullNode per inner node (none for a single surfel)
     TexelView mInnerView;  ///< mInnerNodes as RGBA32UI texels
     TexelView mFluxView;   ///< the node flux as RGBA32F texels
+    Buffer mMoments;        ///< 3 vec4 per node: the flux's first moment per channel
+    TexelView mMomentView;  ///< mMoments as RGBA32F texels
     uint32_t mSurfelCount = 0;
     std::vector<uint32_t> mLevelOffsets;
 };

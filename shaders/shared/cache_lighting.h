@@ -26,9 +26,9 @@ PIC_CONST(uint, kCachePerSubgroup, 1u);
 // Largest |radiance| a half-float cache coefficient holds; larger values are clamped.
 PIC_CONST(float, kHalfMax, 65504.0f);
 
-// A runtime-projected link as the GPU reads it: 16 bytes, one texel of 4 words (the bake's
-// RtpLink and its tint are 20). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written by
-// surfel lighting and the pull), so the link keeps V = factor·π·A instead of the factor:
+// A runtime-projected link as the GPU reads it: 32 bytes, two texels of 4 words (the bake's
+// RtpLink, tint and offset are 26). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written
+// by surfel lighting and the pull), so the link keeps V = factor·π·A instead of the factor:
 // Φ·factor = (Φ / (π·A))·V. V is the visible fraction of the node in the uniform model and
 // may exceed 1 where the flux weights favour the part the cache sees (binary16 holds it).
 struct GpuRtpLink {
@@ -36,17 +36,21 @@ struct GpuRtpLink {
     uint directionOct;    // unit direction cache → node, octahedral 2 × snorm16
     uint visibleAndCone;  // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
     uint tint;            // core/color.h encodeLinkTint
+    uint offsetXY;        // LinkSet::offset, binary16 x | binary16 y << 16, metres
+    uint offsetZ;         // binary16 z
+    uint pad0;
+    uint pad1;
 };
-PIC_STRUCT_CHECK(GpuRtpLink, 16);
+PIC_STRUCT_CHECK(GpuRtpLink, 32);
 
-// An SH-projected link as the GPU reads it: the node index, its tint, then its lY² binary16
-// coefficients (rescaled by π·A to take the node's radiance) two per 32-bit word, the last
-// word's high half zero when lY² is odd, and a zero word where that makes the count odd, so
-// that 2- or 4-word texels divide it: 4, 8, 10 words for lY = 2, 3, 4.
+// An SH-projected link as the GPU reads it: the node index, its tint, its offset as in
+// GpuRtpLink (two words), then its lY² binary16 coefficients (rescaled by π·A to take the
+// node's radiance) two per 32-bit word, the last word's high half zero when lY² is odd, and
+// zero words up to a multiple of 4, so that 2- or 4-word texels divide it: 8, 12, 12 words for
+// lY = 2, 3, 4.
 #ifdef __cplusplus
 inline constexpr uint shLinkWords(uint countY) {
-    const uint words = 2u + (countY + 1u) / 2u;
-    return words + words % 2u;
+    return (4u + (countY + 1u) / 2u + 3u) / 4u * 4u;
 }
 #endif
 

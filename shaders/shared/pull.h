@@ -1,8 +1,8 @@
 #ifndef PIC_SHADERS_SHARED_PULL_H
 #define PIC_SHADERS_SHARED_PULL_H
 // Pull (paper 000 Figure 2 step 3): one dispatch per hierarchy level. Besides the float flux
-// it writes each inner node's radiance Φ / (π·A) as RGBE8 (paper 000 §4.7), which cache
-// lighting reads.
+// and its first moment it writes each inner node's light as cache lighting reads it: its
+// radiance Φ / (π·A) as RGBE8 (paper 000 §4.7) and its flux gradients.
 #include "glue.h"
 
 PIC_NAMESPACE_BEGIN
@@ -17,23 +17,56 @@ PIC_CONST(uint, kPullModeLevel, 0u);
 PIC_CONST(uint, kPullModeTail, 1u);
 PIC_CONST(uint, kPullTailNodes, 256u);
 
-// An inner node as the pull reads it: one RGBA32UI texel. The pull reads the inner nodes and
+// An inner node as the pull reads it: eight RGBA32UI texels. The pull reads the inner nodes and
 // the children's flux as uniform texel buffers, gathers on lavapipe rather than a branch per
-// lane (shared/cache_lighting.h).
+// lane (shared/cache_lighting.h). Besides the children and 1 / (π·A) it holds the node's
+// flux spread (render/cpu/pull.h NodeSpread): its principal axes, the inverse variances along
+// them, the surfels' extent [low, high] along them and each child's flux centroid less the
+// node's.
 struct PullNode {
     uint left;  // child nodes
     uint right;
     float radianceScale;  // 1 / (π · area): flux W → radiance W/(m²·sr) of a Lambertian node
     uint pad0;
+    vec3 axis0;  // principal axes, orthonormal
+    float low0;  // least surfel coordinate along each axis about the centroid, ≤ 0, metres
+    vec3 axis1;
+    float low1;
+    vec3 axis2;
+    float low2;
+    vec3 inverseVariance;  // 1/m² per axis; 0 when the node's surfels share one point
+    float pad1;
+    vec3 high;  // greatest surfel coordinate along each axis about the centroid, ≥ 0
+    float pad2;
+    vec3 leftOffset;  // x̄_left − x̄_node, metres
+    float pad3;
+    vec3 rightOffset;  // x̄_right − x̄_node
+    float pad4;
 };
-PIC_STRUCT_CHECK(PullNode, 16);
+PIC_STRUCT_CHECK(PullNode, 128);
+PIC_CONST(uint, kPullNodeTexels, 8u);
 #ifndef __cplusplus
-// Inner node i of a uniform texel buffer of RGBA32UI texels, one per record.
+// Inner node i of a uniform texel buffer of RGBA32UI texels, kPullNodeTexels per record.
 PullNode fetchPullNode(usamplerBuffer records, uint i) {
-    const uvec4 t = texelFetch(records, int(i));
-    return PullNode(t.x, t.y, uintBitsToFloat(t.z), t.w);
+    const int t = int(i * kPullNodeTexels);
+    const uvec4 a = texelFetch(records, t);
+    const vec4 b = uintBitsToFloat(texelFetch(records, t + 1));
+    const vec4 c = uintBitsToFloat(texelFetch(records, t + 2));
+    const vec4 d = uintBitsToFloat(texelFetch(records, t + 3));
+    const vec4 e = uintBitsToFloat(texelFetch(records, t + 4));
+    const vec4 f = uintBitsToFloat(texelFetch(records, t + 5));
+    const vec4 g = uintBitsToFloat(texelFetch(records, t + 6));
+    const vec4 h = uintBitsToFloat(texelFetch(records, t + 7));
+    return PullNode(a.x, a.y, uintBitsToFloat(a.z), a.w, b.xyz, b.w, c.xyz, c.w, d.xyz, d.w,
+                    e.xyz, e.w, f.xyz, f.w, g.xyz, g.w, h.xyz, h.w);
 }
 #endif
+
+// A node as cache lighting reads it: one RGBA32UI texel. Words 0-2 hold its relative flux
+// gradients r_R, r_G, r_B (1/m, render/cpu/pull.h) as nine snorm8 of a shared binary16 scale:
+// word 0 r_R.xyz r_G.x, word 1 r_G.yz r_B.xy, word 2 r_B.z | scale << 16; word 3 its radiance
+// Φ / (π·A) as RGBE8. Leaves have no gradient (words 0-2 zero).
+PIC_CONST(uint, kNodeLightRadianceWord, 3u);
 
 struct PullPush {
     uint first;        // level mode: the level is nodes [first, end); tail mode: levels

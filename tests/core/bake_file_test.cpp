@@ -22,9 +22,10 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::string_view kAllSections[] = {
-    "params", "surfels",    "nodes",          "levels",          "caches",
-    "grid",   "grid_index", "lightmap",       "lightmap_index",  "lightmap_uvs",
-    "links",  "links_rtp",  "links_sh_nodes", "links_sh_coeffs", "links_tint",
+    "params",       "surfels",      "surfel_weights", "nodes",          "levels",
+    "caches",       "grid",         "grid_index",     "lightmap",       "lightmap_index",
+    "lightmap_uvs", "links",        "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
+    "links_tint",   "links_offset",
 };
 
 /// A hand-made bake: 4 surfels under a balanced hierarchy of 7 nodes, 2 grid caches and 1
@@ -116,6 +117,9 @@ BakeData makeBake(LinkMode mode) {
             bake.links.shCoefficients.push_back(static_cast<uint16_t>(0x3C00 + 37 * i));
     }
     for (uint32_t i = 0; i < nLinks; ++i) bake.links.tint.push_back(kNeutralLinkTint - 1025 * i);
+    for (uint32_t i = 0; i < nLinks * 3; ++i)
+        bake.links.offset.push_back(floatToHalf(0.125f * float(i) - 1.0f));
+    bake.surfelWeights = {0.5f, 1.0f, 2.0f, 1.25f};
     return bake;
 }
 
@@ -164,6 +168,8 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     EXPECT_EQ(a.links.shNodes, b.links.shNodes);
     EXPECT_EQ(a.links.shCoefficients, b.links.shCoefficients);
     EXPECT_EQ(a.links.tint, b.links.tint);
+    EXPECT_EQ(a.links.offset, b.links.offset);
+    EXPECT_EQ(a.surfelWeights, b.surfelWeights);
 }
 
 std::vector<char> readBytes(const std::string& path) {
@@ -378,8 +384,8 @@ TEST_F(BakeFile, TruncatedFileIsReportedAsTruncated) {
     const auto [file, bytes] = written(makeBake(LinkMode::Rtp));
     const Result<BakeFileInfo> info = inspectBakeFile(file);
     ASSERT_TRUE(info) << info.error().message;
-    const uint64_t nodesOffset = sectionOffsets(*info)[2];
-    ASSERT_EQ(info->sectionBytes[2].first, "nodes");
+    const uint64_t nodesOffset = sectionOffsets(*info)[3];
+    ASSERT_EQ(info->sectionBytes[3].first, "nodes");
 
     const uint64_t cuts[] = {10,                                             // in the header
                              kBakeHeaderBytes + kBakeSectionEntryBytes + 5,  // in the table
@@ -481,7 +487,7 @@ TEST_F(BakeFile, ResealedInconsistentCountsAreRefused) {
     auto [file, bytes] = written(makeBake(LinkMode::Rtp));
     const Result<BakeFileInfo> info = inspectBakeFile(file);
     ASSERT_TRUE(info) << info.error().message;
-    const size_t links = 10;
+    const size_t links = 11;
     ASSERT_EQ(info->sectionBytes[links].first, "links");
     const uint64_t offset = sectionOffsets(*info)[links];
     ASSERT_EQ(load<uint32_t>(bytes, offset + 4), 2u);
@@ -560,6 +566,14 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     shortTints.links.tint.pop_back();
     BakeData badTint = makeBake(LinkMode::Rtp);
     badTint.links.tint[4] = 0x40000000u;
+    BakeData shortOffsets = makeBake(LinkMode::Rtp);
+    shortOffsets.links.offset.pop_back();
+    BakeData nanOffset = makeBake(LinkMode::Sh);
+    nanOffset.links.offset[7] = 0x7E00u;
+    BakeData zeroWeight = makeBake(LinkMode::Rtp);
+    zeroWeight.surfelWeights[2] = 0.0f;
+    BakeData missingWeights = makeBake(LinkMode::Sh);
+    missingWeights.surfelWeights.clear();
     const std::pair<const BakeData*, const char*> cases[] = {
         {&missingNode, "2·nS − 1 = 7"},
         {&badGridIndex, "grid_index entry 3 refers to cache 3"},
@@ -573,6 +587,10 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
         {&badRtpNode, "RTP link 1 refers to node 9"},
         {&shortTints, "need 6 tints, found 5"},
         {&badTint, "tint 1073741824 of link 4"},
+        {&shortOffsets, "need 18 offset components, found 17"},
+        {&nanOffset, "offset of link 2 is not finite"},
+        {&zeroWeight, "flux weight of surfel 2 is 0"},
+        {&missingWeights, "0 surfel flux weights for nS = 4"},
     };
     for (const auto& [bake, expected] : cases) {
         const Result<void> ok = writeBakeFile(path("bad.pic"), *bake);

@@ -172,7 +172,7 @@ TEST_P(GpuRuntimeLightmapCopy, HostAndDeviceCopiesGiveTheSameTextures) {
         EXPECT_FALSE(hostStats.passMs.contains("lightmap_copy"));
         EXPECT_FALSE(deviceStats.passMs.contains("lightmap_copy"));
         if (update == 1) {
-            ASSERT_TRUE(device->runCacheLighting(std::vector<uint32_t>(b.bake.nodes.size(), 0)));
+            ASSERT_TRUE(device->runCacheLighting(std::vector<glm::uvec4>(b.bake.nodes.size(), glm::uvec4(0u))));
         }
         auto expectedTextures = device->textures();
         auto actualTextures = host->textures();

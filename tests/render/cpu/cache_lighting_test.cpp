@@ -31,10 +31,12 @@ BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t 
     bake.params.linkMode = mode;
     bake.surfels.resize(surfels);
     bake.nodes.resize(2 * surfels - 1);
+    for (Node& node : bake.nodes) node.left = node.right = kNoNode;
     bake.caches.resize(1);
     bake.links.mode = mode;
     bake.links.linksPerCache = nL;
     bake.links.tint.assign(nL, kNeutralLinkTint);
+    bake.links.offset.assign(size_t{nL} * 3, 0);
     if (mode == LinkMode::Sh) {
         bake.links.bands = bandsY;
         bake.links.shNodes.assign(nL, 0u);

@@ -21,14 +21,15 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
+TEST(GpuCacheLighting, RtpLinksPackIntoThirtyTwoBytes) {
     // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as binary16.
     const float area = 0.37f;
     const uint32_t tint = encodeLinkTint({0.25f, 1.0f, 0.5f}).code;
+    const uint16_t offset[3] = {floatToHalf(-0.5f), floatToHalf(2.0f), floatToHalf(0.125f)};
     const auto pack = [&](float visible, float oneMinusCos) {
         const gpu::RtpLink link{42, visible / (kPi * area), encodeOctahedral({0, 0, 1}),
                                 oneMinusCos};
-        return gpu::packRtpLink(link, tint, area);
+        return gpu::packRtpLink(link, tint, offset, area);
     };
     const auto visibleOf = [](const gpu::GpuRtpLink& l) {
         return halfToFloat(uint16_t(l.visibleAndCone & 0xFFFFu));
@@ -43,6 +44,8 @@ TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
             EXPECT_EQ(l.node, 42u);
             EXPECT_EQ(l.directionOct, encodeOctahedral({0, 0, 1}));
             EXPECT_EQ(l.tint, tint);
+            EXPECT_EQ(l.offsetXY, uint32_t(offset[0]) | uint32_t(offset[1]) << 16);
+            EXPECT_EQ(l.offsetZ, offset[2]);
             // binary16: relative 2^-11 for normal values, 2^-25 absolute below 2^-14.
             EXPECT_NEAR(visibleOf(l), visible, visible / 2048.0f);
             EXPECT_NEAR(coneOf(l), oneMinusCos, std::max(oneMinusCos / 2048.0f, 3e-8f));
@@ -76,9 +79,10 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
     auto gpu =
         test::gpuFor(b, {}, {.cachePerSubgroup = perSubgroup, .maxLinkTexelWords = texelWords});
     ASSERT_TRUE(gpu);
-    // A link is 4 words (RTP) or 2 + ⌈lY²/2⌉ rounded up to even; every device reads single
-    // words, and lavapipe texels of 2, 3 and 4 words, of which the pass takes 4 or 2 before 3.
-    const uint32_t linkWords = mode == LinkMode::Rtp ? 4 : gpu::shLinkWords(bandsY * bandsY);
+    // A link is 8 words (RTP) or 4 + ⌈lY²/2⌉ rounded up to a multiple of 4; every device
+    // reads single words, and lavapipe texels of 2, 3 and 4 words, of which the pass takes 4
+    // or 2 before 3.
+    const uint32_t linkWords = mode == LinkMode::Rtp ? 8 : gpu::shLinkWords(bandsY * bandsY);
     EXPECT_EQ(linkWords % gpu->linkTexelWords(), 0u);
     EXPECT_LE(gpu->linkTexelWords(), texelWords);
     if (texelWords == 1) {

@@ -54,12 +54,13 @@ TEST(GpuPull, NodeRadianceIsFluxOverPiAreaAsRgbe8) {
     // channel) besides the rounding (2^-8).
     auto direct = gpu->runDirect(defaultLightSet(b.scene));
     ASSERT_TRUE(direct) << direct.error().message;
-    auto leaves = gpu->nodeRadiance();
+    auto leaves = gpu->nodeLight();
     ASSERT_TRUE(leaves) << leaves.error().message;
     size_t lit = 0;
     for (size_t i = 0; i < nS; ++i) {
         const glm::vec3 expected = (*direct)[i] / (kPi * b.bake.surfels[i].area);
-        const glm::vec3 got = unpackRgbe8((*leaves)[i]);
+        const glm::vec3 got = unpackRgbe8((*leaves)[i][gpu::kNodeLightRadianceWord]);
+        ASSERT_EQ(glm::uvec3((*leaves)[i]), glm::uvec3(0u)) << "surfel " << i << " has a gradient";
         const float largest = std::max({expected.r, expected.g, expected.b});
         if (largest > 0.0f) ++lit;
         for (int c = 0; c < 3; ++c)
@@ -75,12 +76,50 @@ TEST(GpuPull, NodeRadianceIsFluxOverPiAreaAsRgbe8) {
     for (glm::vec3& f : flux) f = {u(rng), u(rng), u(rng)};
     auto pulled = gpu->runPull(flux);
     ASSERT_TRUE(pulled) << pulled.error().message;
-    auto radiance = gpu->nodeRadiance();
-    ASSERT_TRUE(radiance) << radiance.error().message;
+    auto light = gpu->nodeLight();
+    ASSERT_TRUE(light) << light.error().message;
     for (size_t n = nS; n < b.bake.nodes.size(); ++n)
-        ASSERT_EQ((*radiance)[n],
+        ASSERT_EQ((*light)[n][gpu::kNodeLightRadianceWord],
                   packRgbe8((*pulled)[n] * gpu::radianceScale(b.bake.nodes[n].area)))
             << "node " << n;
+}
+
+TEST(GpuPull, FluxGradientsMatchTheCpuTwin) {
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto gpu = test::gpuFor(b);
+    ASSERT_TRUE(gpu);
+    // Flux that grows along x, with a different slope per channel, plus noise: every inner
+    // node has a gradient to find.
+    const size_t nS = b.bake.surfels.size();
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 0.5f);
+    std::vector<glm::vec3> nodes(b.bake.nodes.size(), glm::vec3(0.0f));
+    for (size_t i = 0; i < nS; ++i) {
+        const float x = b.bake.surfels[i].position.x;
+        nodes[i] = glm::vec3(2.0f + x, 2.0f - x, 1.0f) + glm::vec3(u(rng), u(rng), u(rng));
+    }
+    auto pulled = gpu->runPull(std::span<const glm::vec3>(nodes.data(), nS));
+    ASSERT_TRUE(pulled) << pulled.error().message;
+    auto light = gpu->nodeLight();
+    ASSERT_TRUE(light) << light.error().message;
+    pullFlux(b.bake, nodes);
+    std::vector<glm::mat3> moment(nodes.size()), gradient(nodes.size());
+    pullFluxGradients(b.bake, nodeSpread(b.bake), nodes, moment, gradient);
+    size_t sloped = 0;
+    for (size_t n = nS; n < nodes.size(); ++n) {
+        const glm::mat3 got = gpu::unpackNodeGradients(glm::uvec3((*light)[n]));
+        float largest = 0.0f;
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < 3; ++i) largest = std::max(largest, std::abs(gradient[n][c][i]));
+        if (largest > 0.1f) ++sloped;
+        // snorm8 of a shared scale: half a step of 1/127, and float rounding besides.
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < 3; ++i)
+                ASSERT_NEAR(got[c][i], gradient[n][c][i], largest * 0.006f + 1e-6f)
+                    << "node " << n << " channel " << c << " axis " << i;
+    }
+    EXPECT_GT(sloped, (nodes.size() - nS) / 2);
 }
 
 }  // namespace
