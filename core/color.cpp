@@ -52,23 +52,6 @@ uint16_t magnitudeToHalf(uint32_t absBits) {
 
 }  // namespace
 
-glm::vec3 rgbToYCoCg(const glm::vec3& rgb) {
-    // Lifting steps of paper 000 eq. 7; t = (R + B)/2.
-    const float co = 0.5f * (rgb.r - rgb.b);
-    const float t = rgb.b + co;
-    const float cg = 0.5f * (rgb.g - t);
-    return {t + cg, co, cg};
-}
-
-glm::vec3 yCoCgToRgb(const glm::vec3& yCoCg) {
-    const float y = yCoCg.x;
-    const float co = yCoCg.y;
-    const float cg = yCoCg.z;
-    // The lifting steps of rgbToYCoCg undone in reverse order.
-    const float t = y - cg;
-    return {t + co, y + cg, t - co};
-}
-
 uint16_t floatToHalf(float value) {
     const uint32_t bits = std::bit_cast<uint32_t>(value);
     const auto sign = uint16_t((bits >> 16) & 0x8000u);
@@ -114,20 +97,6 @@ EncodedLinkTint encodeLinkTint(const glm::vec3& tint) {
     for (int c = 0; c < 3; ++c)
         code |= uint32_t(std::lround(std::min(t[c] / largest, 1.0f) * 1023.0f)) << (10 * c);
     return {code, largest};
-}
-
-glm::vec3 decodeOctahedral(uint32_t code) {
-    const auto fromSnorm16 = [](uint32_t bits) {
-        return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f);
-    };
-    const float u = fromSnorm16(code & 0xffffu);
-    const float v = fromSnorm16(code >> 16);
-    glm::vec3 dir(u, v, 1.0f - std::abs(u) - std::abs(v));
-    if (dir.z < 0.0f) {
-        dir.x = (1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        dir.y = (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-    }
-    return glm::normalize(dir);
 }
 
 uint32_t packRgbe8(const glm::vec3& rgb) {

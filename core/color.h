@@ -3,20 +3,34 @@
 /// vectors in 32 bits and the shared-exponent RGBE8 HDR format (paper 000 §4.7 uses a shared
 /// exponent too).
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace pic {
 
-/// Linear RGB to YCoCg: Y = R/4 + G/2 + B/4, Co = (R - B)/2, Cg = (-R + 2G - B)/4.
-glm::vec3 rgbToYCoCg(const glm::vec3& rgb);
+/// Linear RGB to YCoCg: Y = R/4 + G/2 + B/4, Co = (R - B)/2, Cg = (-R + 2G - B)/4. Inline,
+/// as the next: cache lighting converts per link.
+inline glm::vec3 rgbToYCoCg(const glm::vec3& rgb) {
+    // Lifting steps of paper 000 eq. 7; t = (R + B)/2.
+    const float co = 0.5f * (rgb.r - rgb.b);
+    const float t = rgb.b + co;
+    const float cg = 0.5f * (rgb.g - t);
+    return {t + cg, co, cg};
+}
 
 /// Exact inverse of rgbToYCoCg: t = Y - Cg, R = t + Co, G = Y + Cg, B = t - Co.
-glm::vec3 yCoCgToRgb(const glm::vec3& yCoCg);
+inline glm::vec3 yCoCgToRgb(const glm::vec3& yCoCg) {
+    // The lifting steps of rgbToYCoCg undone in reverse order.
+    const float t = yCoCg.x - yCoCg.z;
+    return {t + yCoCg.y, yCoCg.x + yCoCg.z, t - yCoCg.y};
+}
 
 /// IEEE binary16 bits of value, rounded to nearest even; subnormals are exact, magnitudes
 /// from 65520 up become ±inf, NaN stays NaN (quiet, sign and top payload bits kept).
@@ -48,15 +62,29 @@ inline float halfToFloat(uint16_t bits) {
 /// input need not be normalised; a zero or non-finite vector encodes +z.
 uint32_t encodeOctahedral(const glm::vec3& unitDir);
 
-/// Unit direction of an octahedral code from encodeOctahedral.
-glm::vec3 decodeOctahedral(uint32_t code);
+/// Unit direction of an octahedral code from encodeOctahedral (inline: the CPU twin's cache
+/// lighting decodes one per link and update).
+inline glm::vec3 decodeOctahedral(uint32_t code) {
+    const auto fromSnorm16 = [](uint32_t bits) {
+        return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f);
+    };
+    const float u = fromSnorm16(code & 0xffffu);
+    const float v = fromSnorm16(code >> 16);
+    glm::vec3 dir(u, v, 1.0f - std::abs(u) - std::abs(v));
+    if (dir.z < 0.0f) {
+        dir.x = (1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        dir.y = (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+    }
+    return glm::normalize(dir);
+}
 
 /// The chroma per luma (Co/Y, Cg/Y) of a YCoCg colour, clamped to what non-negative RGB
 /// allows (|Co| ≤ 2Y, |Cg| ≤ Y); (0, 0) where Y ≤ 0. The SH caches predict the chroma of
 /// their bands above lC from their luma with the ratio of band 0 (core/cache_values.h).
 inline glm::vec2 chromaPerLuma(const glm::vec3& yCoCg) {
     if (!(yCoCg.x > 0.0f)) return glm::vec2(0.0f);
-    return glm::clamp(glm::vec2(yCoCg.y, yCoCg.z) / yCoCg.x, glm::vec2(-2.0f, -1.0f), glm::vec2(2.0f, 1.0f));
+    return glm::clamp(glm::vec2(yCoCg.y, yCoCg.z) / yCoCg.x, glm::vec2(-2.0f, -1.0f),
+                      glm::vec2(2.0f, 1.0f));
 }
 
 /// A link's tint (bake/link_generation.h): per-channel multipliers of its factor, stored as
@@ -78,7 +106,8 @@ EncodedLinkTint encodeLinkTint(const glm::vec3& tint);
 /// The multipliers of a tint code, each in [0, 1] (shaders/cache_lighting.comp decodes the
 /// same way).
 inline glm::vec3 decodeLinkTint(uint32_t code) {
-    return glm::vec3(float(code & 0x3FFu), float((code >> 10) & 0x3FFu), float((code >> 20) & 0x3FFu)) *
+    return glm::vec3(float(code & 0x3FFu), float((code >> 10) & 0x3FFu),
+                     float((code >> 20) & 0x3FFu)) *
            (1.0f / 1023.0f);
 }
 

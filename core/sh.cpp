@@ -11,92 +11,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-/// Square root usable in constant expressions (Newton's iteration from above; x >= 0).
-constexpr double constexprSqrt(double x) {
-    if (x <= 0.0) return 0.0;
-    double root = x > 1.0 ? x : 1.0;
-    for (;;) {
-        const double next = 0.5 * (root + x / root);
-        if (next >= root) return root;
-        root = next;
-    }
-}
-
-/// Constants of the normalised associated-Legendre recurrence. With
-/// Q_l^m = c_m N_l^m P_l^m(z) / sin^m θ (c_0 = 1, c_m = √2), the basis is
-/// y_l^m = Q_l^m Re((x + iy)^m) and y_l^-m = Q_l^m Im((x + iy)^m), and
-///   Q_m^m = c_m sqrt((2m+1)/(4π) · (2m-1)!!/(2m)!!),
-///   Q_l^m = a_l^m z Q_{l-1}^m - b_l^m Q_{l-2}^m   (l > m, Q_{m-1}^m = 0).
-struct LegendreTables {
-    std::array<float, kMaxShBands> diagonal{};
-    std::array<std::array<float, kMaxShBands>, kMaxShBands> a{};  // [l][m]
-    std::array<std::array<float, kMaxShBands>, kMaxShBands> b{};  // [l][m]
-};
-
-constexpr LegendreTables makeLegendreTables() {
-    LegendreTables tables;
-    double doubleFactorialRatio = 1.0;  // (2m-1)!! / (2m)!!
-    for (int m = 0; m < kMaxShBands; ++m) {
-        if (m > 0) doubleFactorialRatio *= double(2 * m - 1) / double(2 * m);
-        const double c2 = m == 0 ? 1.0 : 2.0;
-        tables.diagonal[m] =
-            float(constexprSqrt(c2 * (2 * m + 1) / (4.0 * kPi) * doubleFactorialRatio));
-        for (int l = m + 1; l < kMaxShBands; ++l) {
-            const double l2m2 = double(l * l - m * m);
-            tables.a[l][m] = float(constexprSqrt((4.0 * l * l - 1.0) / l2m2));
-            tables.b[l][m] = float(constexprSqrt(double(2 * l + 1) * ((l - 1) * (l - 1) - m * m) /
-                                                 (double(2 * l - 3) * l2m2)));
-        }
-    }
-    return tables;
-}
-
-constexpr LegendreTables kLegendre = makeLegendreTables();
-
-/// Writes Q_L^M times the azimuthal factors: y_L^M, and y_L^-M for M > 0.
-template <int L, int M>
-inline void storeBasis(float q, float cosTerm, float sinTerm, float* out) {
-    if constexpr (M == 0) {
-        out[shIndex(L, 0)] = q;
-    } else {
-        out[shIndex(L, M)] = q * cosTerm;
-        out[shIndex(L, -M)] = q * sinTerm;
-    }
-}
-
-/// Order M, bands L .. Bands-1, by the upward recurrence from current = Q_{L-1}^M and
-/// previous = Q_{L-2}^M. Compile-time indices turn every table entry into an immediate.
-template <int Bands, int M, int L>
-inline void evaluateColumn(float z, float current, float previous, float cosTerm, float sinTerm,
-                           float* out) {
-    if constexpr (L < Bands) {
-        constexpr float a = kLegendre.a[L][M];
-        constexpr float b = kLegendre.b[L][M];
-        const float next = a * z * current - b * previous;
-        storeBasis<L, M>(next, cosTerm, sinTerm, out);
-        evaluateColumn<Bands, M, L + 1>(z, next, current, cosTerm, sinTerm, out);
-    }
-}
-
-/// Orders M .. Bands-1; (cosTerm, sinTerm) = Re, Im of (x + iy)^M = sin^M θ (cos Mφ, sin Mφ),
-/// advanced by one complex product per order.
-template <int Bands, int M>
-inline void evaluateOrders(const glm::vec3& d, float cosTerm, float sinTerm, float* out) {
-    if constexpr (M < Bands) {
-        constexpr float diagonal = kLegendre.diagonal[M];
-        storeBasis<M, M>(diagonal, cosTerm, sinTerm, out);
-        evaluateColumn<Bands, M, M + 1>(d.z, diagonal, 0.0f, cosTerm, sinTerm, out);
-        evaluateOrders<Bands, M + 1>(d, cosTerm * d.x - sinTerm * d.y,
-                                     cosTerm * d.y + sinTerm * d.x, out);
-    }
-}
-
-/// shEvaluate for a compile-time band count: straight-line code without loops or branches.
-template <int Bands>
-void evaluateBands(const glm::vec3& direction, float* out) {
-    evaluateOrders<Bands, 0>(direction, 1.0f, 0.0f, out);
-}
-
 /// Paper 000 appendix B recurrence for s_l(n) = (n+1) ∫_0^1 t^n P_l(t) dt.
 constexpr double lobeFactor(int l, double n) {
     double even = 1.0;                   // s_0
@@ -174,21 +88,21 @@ void shEvaluate(int bands, const glm::vec3& direction, float* out) {
     case 0:
         return;
     case 1:
-        return evaluateBands<1>(direction, out);
+        return shEvaluateFixed<1>(direction, out);
     case 2:
-        return evaluateBands<2>(direction, out);
+        return shEvaluateFixed<2>(direction, out);
     case 3:
-        return evaluateBands<3>(direction, out);
+        return shEvaluateFixed<3>(direction, out);
     case 4:
-        return evaluateBands<4>(direction, out);
+        return shEvaluateFixed<4>(direction, out);
     case 5:
-        return evaluateBands<5>(direction, out);
+        return shEvaluateFixed<5>(direction, out);
     case 6:
-        return evaluateBands<6>(direction, out);
+        return shEvaluateFixed<6>(direction, out);
     case 7:
-        return evaluateBands<7>(direction, out);
+        return shEvaluateFixed<7>(direction, out);
     case 8:
-        return evaluateBands<8>(direction, out);
+        return shEvaluateFixed<8>(direction, out);
     default:
         PIC_CHECK(bands >= 0 && bands <= kMaxShBands);
     }
@@ -197,10 +111,10 @@ void shEvaluate(int bands, const glm::vec3& direction, float* out) {
 ShRecurrence shRecurrence() {
     ShRecurrence out{};
     for (int m = 0; m < kMaxShBands; ++m) {
-        out.diagonal[m] = kLegendre.diagonal[m];
+        out.diagonal[m] = detail::kLegendre.diagonal[m];
         for (int l = 0; l < kMaxShBands; ++l) {
-            out.a[l][m] = kLegendre.a[l][m];
-            out.b[l][m] = kLegendre.b[l][m];
+            out.a[l][m] = detail::kLegendre.a[l][m];
+            out.b[l][m] = detail::kLegendre.b[l][m];
         }
     }
     return out;

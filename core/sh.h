@@ -19,6 +19,9 @@
 /// written with K_l = sqrt(4π/(2l+1)) c_l^0 of the lobe around z). Every kernel below is such
 /// a per-band factor K_l.
 
+#include <array>
+#include <numbers>
+
 #include <glm/vec3.hpp>
 
 namespace pic {
@@ -39,6 +42,98 @@ constexpr int shIndex(int l, int m) {
 /// Writes the shCount(bands) basis values y_l^m(direction) to out; bands in [0, kMaxShBands],
 /// direction unit length. Polynomial recurrences in x, y, z only: no trig, no allocation.
 void shEvaluate(int bands, const glm::vec3& direction, float* out);
+
+namespace detail {
+
+/// Square root usable in constant expressions (Newton's iteration from above; x >= 0).
+inline constexpr double constexprSqrt(double x) {
+    if (x <= 0.0) return 0.0;
+    double root = x > 1.0 ? x : 1.0;
+    for (;;) {
+        const double next = 0.5 * (root + x / root);
+        if (next >= root) return root;
+        root = next;
+    }
+}
+
+/// Constants of the normalised associated-Legendre recurrence. With
+/// Q_l^m = c_m N_l^m P_l^m(z) / sin^m θ (c_0 = 1, c_m = √2), the basis is
+/// y_l^m = Q_l^m Re((x + iy)^m) and y_l^-m = Q_l^m Im((x + iy)^m), and
+///   Q_m^m = c_m sqrt((2m+1)/(4π) · (2m-1)!!/(2m)!!),
+///   Q_l^m = a_l^m z Q_{l-1}^m - b_l^m Q_{l-2}^m   (l > m, Q_{m-1}^m = 0).
+struct LegendreTables {
+    std::array<float, kMaxShBands> diagonal{};
+    std::array<std::array<float, kMaxShBands>, kMaxShBands> a{};  // [l][m]
+    std::array<std::array<float, kMaxShBands>, kMaxShBands> b{};  // [l][m]
+};
+
+inline constexpr LegendreTables makeLegendreTables() {
+    LegendreTables tables;
+    double doubleFactorialRatio = 1.0;  // (2m-1)!! / (2m)!!
+    for (int m = 0; m < kMaxShBands; ++m) {
+        if (m > 0) doubleFactorialRatio *= double(2 * m - 1) / double(2 * m);
+        const double c2 = m == 0 ? 1.0 : 2.0;
+        tables.diagonal[m] = float(
+            constexprSqrt(c2 * (2 * m + 1) / (4.0 * std::numbers::pi) * doubleFactorialRatio));
+        for (int l = m + 1; l < kMaxShBands; ++l) {
+            const double l2m2 = double(l * l - m * m);
+            tables.a[l][m] = float(constexprSqrt((4.0 * l * l - 1.0) / l2m2));
+            tables.b[l][m] = float(constexprSqrt(double(2 * l + 1) * ((l - 1) * (l - 1) - m * m) /
+                                                 (double(2 * l - 3) * l2m2)));
+        }
+    }
+    return tables;
+}
+
+inline constexpr LegendreTables kLegendre = makeLegendreTables();
+
+/// Writes Q_L^M times the azimuthal factors: y_L^M, and y_L^-M for M > 0.
+template <int L, int M>
+inline void storeBasis(float q, float cosTerm, float sinTerm, float* out) {
+    if constexpr (M == 0) {
+        out[shIndex(L, 0)] = q;
+    } else {
+        out[shIndex(L, M)] = q * cosTerm;
+        out[shIndex(L, -M)] = q * sinTerm;
+    }
+}
+
+/// Order M, bands L .. Bands-1, by the upward recurrence from current = Q_{L-1}^M and
+/// previous = Q_{L-2}^M. Compile-time indices turn every table entry into an immediate.
+template <int Bands, int M, int L>
+inline void evaluateColumn(float z, float current, float previous, float cosTerm, float sinTerm,
+                           float* out) {
+    if constexpr (L < Bands) {
+        constexpr float a = kLegendre.a[L][M];
+        constexpr float b = kLegendre.b[L][M];
+        const float next = a * z * current - b * previous;
+        storeBasis<L, M>(next, cosTerm, sinTerm, out);
+        evaluateColumn<Bands, M, L + 1>(z, next, current, cosTerm, sinTerm, out);
+    }
+}
+
+/// Orders M .. Bands-1; (cosTerm, sinTerm) = Re, Im of (x + iy)^M = sin^M θ (cos Mφ, sin Mφ),
+/// advanced by one complex product per order.
+template <int Bands, int M>
+inline void evaluateOrders(const glm::vec3& d, float cosTerm, float sinTerm, float* out) {
+    if constexpr (M < Bands) {
+        constexpr float diagonal = kLegendre.diagonal[M];
+        storeBasis<M, M>(diagonal, cosTerm, sinTerm, out);
+        evaluateColumn<Bands, M, M + 1>(d.z, diagonal, 0.0f, cosTerm, sinTerm, out);
+        evaluateOrders<Bands, M + 1>(d, cosTerm * d.x - sinTerm * d.y,
+                                     cosTerm * d.y + sinTerm * d.x, out);
+    }
+}
+
+}  // namespace detail
+
+/// shEvaluate for a compile-time band count, inline: straight-line code without loops or
+/// branches, for kernels that evaluate a basis per link.
+template <int Bands>
+inline void shEvaluateFixed(const glm::vec3& direction, float* out) {
+    static_assert(Bands >= 0 && Bands <= kMaxShBands);
+    detail::evaluateOrders<Bands, 0>(direction, 1.0f, 0.0f, out);
+}
 
 /// The constants of shEvaluate's recurrence, for GPU shaders that evaluate the same basis:
 /// Q_m^m = diagonal[m], Q_l^m = a[l][m]·z·Q_{l−1}^m − b[l][m]·Q_{l−2}^m (l > m), with

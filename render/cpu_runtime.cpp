@@ -45,11 +45,14 @@ public:
           mNodeFlux(bake.nodes.size()),
           mSpread(nodeSpread(bake)),
           mNodeMoment(bake.nodes.size()),
-          mNodeGradient(bake.nodes.size()),
+          mCentreFlux(bake.nodes.size()),
+          mSlopes(bake.nodes.size()),
+          mNodeLight(bake.nodes.size()),
           mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)),
           mStencils(surfelStencils(scene, rays, bake)) {
-        // Links' offsets, directions and cone factors do not depend on the lights: unpacked once.
-        mLinks = unpackLinks(bake.links, bake.params.bandsY);
+        // Links' box points, directions and cone factors do not depend on the lights: unpacked
+        // once.
+        mLinks = unpackLinks(bake, mSpread);
     }
 
     Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
@@ -61,16 +64,18 @@ private:
     const EmbreeScene& mRays;
     const BakeData& mBake;
     BounceParams mBounces;
-    glm::vec3 mRatioBound;              ///< bounceRatioBound of the bake
+    glm::vec3 mRatioBound;  ///< bounceRatioBound of the bake
     LinkTable mLinks;
-    std::vector<glm::vec3> mDirectFlux; ///< nS: flux from lights and emission, per update
-    std::vector<glm::vec3> mNodeFlux;   ///< 2nS − 1: leaves hold the current bounce's surfel flux
-    NodeSpread mSpread;                 ///< fixed per bake
-    std::vector<glm::mat3> mNodeMoment;    ///< 2nS − 1: the flux's first moments
-    std::vector<glm::mat3> mNodeGradient;  ///< 2nS − 1: the flux's relative gradients
+    std::vector<glm::vec3> mDirectFlux;  ///< nS: flux from lights and emission, per update
+    std::vector<glm::vec3> mNodeFlux;  ///< 2nS − 1: leaves hold the current bounce's surfel flux
+    NodeSpread mSpread;                ///< fixed per bake
+    std::vector<glm::mat3> mNodeMoment;  ///< 2nS − 1: the flux's first moments
+    std::vector<glm::vec3> mCentreFlux;  ///< 2nS − 1: the limited spreads' centre flux
+    std::vector<glm::mat3> mSlopes;      ///< 2nS − 1: and their slopes
+    std::vector<NodeLight> mNodeLight;   ///< 2nS − 1: both as links read them
     CacheValues mValues;
     std::vector<CacheStencil> mStencils;  ///< nS: the caches each surfel's bounce reads
-    CacheTextures mTextures;         ///< filled on demand from mValues
+    CacheTextures mTextures;              ///< filled on demand from mValues
     bool mTexturesCurrent = false;
 };
 
@@ -105,11 +110,12 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     for (int bounce = 1;; ++bounce) {
         t = Clock::now();
         pullFlux(mBake, mNodeFlux);
-        pullFluxGradients(mBake, mSpread, mNodeFlux, mNodeMoment, mNodeGradient);
+        pullFluxSpread(mBake, mSpread, mNodeFlux, mNodeMoment, mCentreFlux, mSlopes);
         pullMs += millisecondsSince(t);
 
         t = Clock::now();
-        lightCaches(mBake, mNodeFlux, mNodeGradient, mLinks, mValues);
+        nodeLight(mCentreFlux, mSlopes, mNodeLight);
+        lightCaches(mBake, mNodeLight, mLinks, mValues);
         cacheMs += millisecondsSince(t);
         s.bounces = bounce;
         s.surfelFlux = luminance(glm::vec3(total));

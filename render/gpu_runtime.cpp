@@ -6,12 +6,12 @@
 
 #include "core/color.h"
 #include "render/cpu/lightmap_copy.h"
+#include "render/cpu/surfel_lighting.h"
 #include "render/passes/cache_lighting_pass.h"
 #include "render/passes/lightmap_copy_pass.h"
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
-#include "render/cpu/surfel_lighting.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/sh_tables.h"
 
@@ -91,12 +91,13 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                              {.levelsOfDetail = options.casterLevelsOfDetail,
                                               .equalFootprint = options.shadowEqualFootprint}));
     }
-    PIC_TRY_ASSIGN(mSurfels,
-                   SurfelLightingPass::create(ctx, mScene, mBake, surfelStencils(mScene, rays, mBake),
-                                              rays.epsilon(), mVisibility));
-    PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake));
+    PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake,
+                                                        surfelStencils(mScene, rays, mBake),
+                                                        rays.epsilon(), mVisibility));
+    const NodeSpread spread = nodeSpread(mBake);
+    PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake, spread));
     const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
-    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, cachePerSubgroup,
+    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, spread, cachePerSubgroup,
                                                              options.maxLinkTexelWords));
     PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeLight));
@@ -117,8 +118,8 @@ Result<gpu::LightmapCopyPass*> GpuRuntime::lightmapCopyPass() {
 }
 
 Result<void> GpuRuntime::bindVisibility() {
-    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeLight,
-                           &mCacheY, &mCacheCo, &mCacheCg, &mShTables});
+    return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeLight, &mCacheY,
+                           &mCacheCo, &mCacheCg, &mShTables});
 }
 
 Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
@@ -305,7 +306,8 @@ void GpuRuntime::readCaches(CacheValues& values) const {
     get(mCacheCg, values.cg);
 }
 
-Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights, UpdateStats* statsOut) {
+Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights,
+                                                     UpdateStats* statsOut) {
     UpdateStats local;
     UpdateStats& stats = statsOut ? *statsOut : local;
     stats = UpdateStats{};
@@ -347,12 +349,13 @@ Result<std::vector<glm::uvec4>> GpuRuntime::nodeLight() {
 
 std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
-    std::vector<glm::mat3> moment(nodeFlux.size()), gradient(nodeFlux.size());
-    pullFluxGradients(bake, nodeSpread(bake), nodeFlux, moment, gradient);
+    std::vector<glm::mat3> moment(nodeFlux.size()), slopes(nodeFlux.size());
+    std::vector<glm::vec3> centre(nodeFlux.size());
+    pullFluxSpread(bake, nodeSpread(bake), nodeFlux, moment, centre, slopes);
     std::vector<glm::uvec4> light(nodeFlux.size());
     for (size_t n = 0; n < nodeFlux.size(); ++n)
-        light[n] = glm::uvec4(gpu::packNodeGradients(gradient[n]),
-                              packRgbe8(nodeFlux[n] * gpu::radianceScale(bake.nodes[n].area)));
+        light[n] = glm::uvec4(gpu::packNodeSlopes(slopes[n]),
+                              packRgbe8(centre[n] * gpu::radianceScale(bake.nodes[n].area)));
     return light;
 }
 
@@ -396,7 +399,9 @@ std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
     };
 }
 
-uint64_t GpuRuntime::linkBytesPerBounce() const { return mCacheLighting->linkBytes(); }
+uint64_t GpuRuntime::linkBytesPerBounce() const {
+    return mCacheLighting->linkBytes();
+}
 
 uint32_t GpuRuntime::linkTexelWords() const {
     return mCacheLighting->texelWords();

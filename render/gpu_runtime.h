@@ -24,9 +24,10 @@ namespace pic {
 
 /// How to run the GPU backend.
 struct GpuRuntimeOptions {
-    std::string deviceName;        ///< --device: substring of the Vulkan device name; empty = best
-    bool validation = false;       ///< Vulkan validation layer when installed (PIC_VK_VALIDATION overrides)
-    uint32_t shadowMapSize = 1024; ///< texels per side of each shadow-map layer
+    std::string deviceName;  ///< --device: substring of the Vulkan device name; empty = best
+    bool validation =
+        false;  ///< Vulkan validation layer when installed (PIC_VK_VALIDATION overrides)
+    uint32_t shadowMapSize = 1024;  ///< texels per side of each shadow-map layer
     /// Layers with coarse texels draw simplified casters (gpu::ShadowMapOptions); off only
     /// to measure what that changes.
     bool casterLevelsOfDetail = true;
@@ -67,13 +68,14 @@ class CacheLightingPass;
 class LightmapCopyPass;
 }  // namespace gpu
 
-/// The GPU backend. Besides the Runtime API it runs single passes on given inputs, so that
-/// tests compare each pass with its CPU twin on identical data. Not thread-safe.
-/// Each node's light from its flux (pulled): its flux gradients (render/cpu/pull.h, packed by
-/// gpu::packNodeGradients) and its radiance Φ / (π·A) as RGBE8, what surfel lighting (leaves)
-/// and the pull (inner nodes) write for cache lighting (shaders/shared/pull.h).
+/// Each node's light from its flux (pulled): its limited flux spread (render/cpu/pull.h), the
+/// slopes packed by gpu::packNodeSlopes and the radiance at the box centre as RGBE8, what
+/// surfel lighting (leaves) and the pull (inner nodes) write for cache lighting
+/// (shaders/shared/pull.h).
 std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux);
 
+/// The GPU backend. Besides the Runtime API it runs single passes on given inputs, so that
+/// tests compare each pass with its CPU twin on identical data. Not thread-safe.
 class GpuRuntime final : public Runtime {
 public:
     /// `scene`, `rays` (for its ray offset) and `bake` must outlive the runtime.
@@ -129,7 +131,8 @@ private:
     /// The counts and host time of the visibility the latest update prepared and recorded.
     void addVisibilityStats(UpdateStats& stats) const;
     Result<void> prepareLights(const LightSet& lights);
-    Result<void> submitTimed(const std::function<void(VkCommandBuffer)>& record, UpdateStats& stats);
+    Result<void> submitTimed(const std::function<void(VkCommandBuffer)>& record,
+                             UpdateStats& stats);
     Result<void> uploadFlux(std::span<const glm::vec3> flux, gpu::Buffer& buffer);
     Result<std::vector<glm::vec3>> downloadFlux(const gpu::Buffer& buffer, size_t count);
     Result<void> uploadCaches(const CacheValues& values);

@@ -24,8 +24,8 @@ layout(constant_id = 5) const uint kTexelWords = 1u;  // words per texel of `lin
 const uint kCountY = kBandsY * kBandsY;
 const uint kCountC = kBandsC * kBandsC;
 const uint kShPairs = (kCountY + 1u) / 2u;
-const uint kShWords = (4u + kShPairs + 3u) / 4u * 4u;  // shared/cache_lighting.h shLinkWords
-const uint kLinkWords = kLinkForm == kLinkFormRtp ? 8u : kShWords;
+const uint kShWords = (3u + kShPairs + 3u) / 4u * 4u;  // shared/cache_lighting.h shLinkWords
+const uint kLinkWords = kLinkForm == kLinkFormRtp ? 4u : kShWords;
 const uint kLinkTexels = kLinkWords / kTexelWords;  // the host picks a divisor
 
 // Uniform texel buffers of uint words (shared/cache_lighting.h says why).
@@ -53,40 +53,41 @@ vec3 decodeLinkTint(uint code) {
     return vec3(uvec3(code, code >> 10u, code >> 20u) & 0x3FFu) * (1.0 / 1023.0);
 }
 
-/// The YCoCg radiance a link carries: its node's radiance times the link's tint and, per
-/// channel, the node's flux spread at the link's offset d, max(0, 1 + r·d) (shared/pull.h).
-vec3 linkRadiance(uint node, uint tint, uint offsetXY, uint offsetZ) {
+/// The YCoCg radiance a link carries: its node's spread at the link's box point u,
+/// radiance·(1 + slopes·u) per channel (shared/pull.h; ≥ 0 for u in the box), times its tint.
+vec3 linkRadiance(uint node, vec3 tint, uint point) {
     const uvec4 light = texelFetch(nodeLight, int(node));
-    const vec3 offset = vec3(unpackHalf2x16(offsetXY), unpackHalf2x16(offsetZ).x);
+    const vec3 u = unpackSnorm4x8(point).xyz;
     const vec4 a = unpackSnorm4x8(light.x);
     const vec4 b = unpackSnorm4x8(light.y);
-    const vec3 rB = vec3(b.zw, unpackSnorm4x8(light.z).x);
-    const float scale = unpackHalf2x16(light.z >> 16u).x;
-    const vec3 spread = vec3(1.0) + scale * vec3(dot(a.xyz, offset), dot(vec3(a.w, b.xy), offset),
-                                                 dot(rB, offset));
-    return rgbToYCoCg(unpackRgbe8(light[kNodeLightRadianceWord]) * decodeLinkTint(tint) *
-                      max(spread, vec3(0.0)));
+    const vec3 slopesB = vec3(b.zw, unpackSnorm4x8(light.z).x);
+    const vec3 spread =
+        vec3(1.0) + vec3(dot(a.xyz, u), dot(vec3(a.w, b.xy), u), dot(slopesB, u));
+    return rgbToYCoCg(unpackRgbe8(light[kNodeLightRadianceWord]) * tint * spread);
 }
 
 /// Adds link `slot` (within the chunk) to y, co, cg.
 void addLink(uint slot) {
-    uint words[2 + 64 / 2];  // kLinkWords at most, for lY ≤ 8 as basis[64] below
+    uint words[4 + 64 / 2];  // kLinkWords at most, for lY ≤ 8 as basis[64] below
     [[unroll]] for (uint t = 0u; t < kLinkTexels; ++t) {
         const uvec4 texel = texelFetch(links, int(slot * kLinkTexels + t));
         [[unroll]] for (uint c = 0u; c < kTexelWords; ++c) words[t * kTexelWords + c] = texel[c];
     }
     if (kLinkForm == kLinkFormRtp) {
         // §4.6: the node's cone projected at runtime, V·K_l(α)·y_lm(direction).
-        const GpuRtpLink link =
-            GpuRtpLink(words[0], words[1], words[2], words[3], words[4], words[5], 0u, 0u);
+        const GpuRtpLink link = GpuRtpLink(words[0], words[1], words[2], words[3]);
         const vec2 visibleAndCone = unpackHalf2x16(link.visibleAndCone);
         const float visible = visibleAndCone.x;
         if (visible == 0.0) return;  // padding
-        const vec3 radiance = linkRadiance(link.node, link.tint, link.offsetXY, link.offsetZ);
+        const vec3 tint =
+            vec3(link.nodeAndRed >> 24u, link.directionAndGreen >> 24u, link.pointAndBlue >> 24u) *
+            (1.0 / 255.0);
+        const vec3 radiance =
+            linkRadiance(link.nodeAndRed & 0xFFFFFFu, tint, link.pointAndBlue);
         float cone[kBandsY];
         coneZonal(visibleAndCone.y, cone);
         float basis[64];
-        shEvaluate(decodeOctahedral(link.directionOct), basis);
+        shEvaluate(decodeOctahedral12(link.directionAndGreen), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float w = visible * cone[kShBandOf[i]] * basis[i];
             y[i] += radiance.x * w;
@@ -96,13 +97,13 @@ void addLink(uint slot) {
             }
         }
     } else {
-        // SH-projected links: the node, its tint, its offset, then lY² half coefficients two
-        // per word, scaled by π·A at upload to take the node's radiance; chroma takes the
+        // SH-projected links: the node, its tint, its box point, then lY² half coefficients
+        // two per word, scaled by π·A at upload to take the node's radiance; chroma takes the
         // first lC².
         if (words[0] == kNoNode) return;
-        const vec3 radiance = linkRadiance(words[0], words[1], words[2], words[3]);
+        const vec3 radiance = linkRadiance(words[0], decodeLinkTint(words[1]), words[2]);
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
-            const vec2 pair = unpackHalf2x16(words[4u + p]);
+            const vec2 pair = unpackHalf2x16(words[3u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {
                 const uint i = 2u * p + h;
                 if (i >= kCountY) break;

@@ -1,8 +1,8 @@
 #version 460
 // Pull (paper 000 Figure 2 step 3, §4.1): every node of one level gets the sum of its two
 // children's flux and the flux's first moment about its centroid, and writes its light for
-// cache lighting: its radiance Φ / (π·A) as RGBE8 (§4.7) and its limited relative flux
-// gradients (shared/pull.h). Dispatched level by level, lowest first, then the small upper
+// cache lighting: its flux's limited linear spread, the radiance at its box centre as RGBE8
+// (§4.7) and the slopes along the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
 // levels in one workgroup. CPU twin: render/cpu/pull.cpp.
 #extension GL_GOOGLE_include_directive : require
 #include "shared/pull.h"
@@ -21,36 +21,43 @@ layout(std430, binding = 5) coherent buffer NodeMoment { vec4 nodeMoment[]; };
 layout(binding = 6) uniform samplerBuffer childMoment;  // nodeMoment as RGBA32F (level mode)
 layout(push_constant) uniform Push { PullPush pc; };
 
-/// render/cpu/pull.cpp limitedGradient: the gradient of the fitted spread in the node's axes,
-/// scaled so the spread stays ≥ 0 over the surfels' extent, over Φ.
-vec3 limitedGradient(PullNode inner, float flux, vec3 moment) {
-    if (!(flux > 0.0)) return vec3(0.0);
-    const mat3 axes = mat3(inner.axis0, inner.axis1, inner.axis2);
-    const vec3 g = (moment * axes) * inner.inverseVariance;
-    const vec3 lowest = min(g * vec3(inner.low0, inner.low1, inner.low2), g * inner.high);
-    const float drop = -(lowest.x + lowest.y + lowest.z);
-    const float limit = drop > flux ? flux / drop : 1.0;
-    return axes * (g * (limit / flux));
+/// render/cpu/pull.cpp limitedSpread: the fitted spread's gradient in the node's axes, scaled
+/// so the spread stays ≥ 0 over the surfels' box; returns the flux at the box centre and sets
+/// the slopes along the axes per half extent, relative to it.
+float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes) {
+    slopes = vec3(0.0);
+    if (!(flux > 0.0)) return 0.0;
+    const vec3 low = vec3(inner.low0, inner.low1, inner.low2);
+    const vec3 centre = 0.5 * (low + inner.high);
+    const vec3 halfExtent = 0.5 * (inner.high - low);
+    vec3 g = (moment * mat3(inner.axis0, inner.axis1, inner.axis2)) * inner.inverseVariance;
+    float atCentre = flux + dot(g, centre);
+    vec3 change = abs(g * halfExtent);
+    const float swing = change.x + change.y + change.z;
+    if (swing > atCentre) {
+        g *= flux / (swing - dot(g, centre));
+        atCentre = flux + dot(g, centre);
+    }
+    if (!(atCentre > 0.0)) return 0.0;
+    slopes = g * halfExtent * (1.0 / atCentre);
+    change = abs(slopes);
+    const float sum = change.x + change.y + change.z;
+    if (sum > 1.0) slopes *= 1.0 / sum;
+    return atCentre;
 }
 
-float maxAbs(vec3 v) {
-    const vec3 a = abs(v);
-    return max(a.x, max(a.y, a.z));
+/// snorm8 of v ∈ [−1, 1] rounded towards zero (shared/pull.h), in the low byte.
+uint snorm8TowardsZero(float v) {
+    return uint(int(trunc(clamp(v, -1.0, 1.0) * 127.0))) & 0xFFu;
 }
 
-/// Nine gradient components as snorm8 of a shared binary16 scale (shared/pull.h).
-uvec3 packGradients(vec3 r, vec3 g, vec3 b) {
-    const float largest = min(max(maxAbs(r), max(maxAbs(g), maxAbs(b))), 65504.0);
-    if (!(largest > 0.0)) return uvec3(0u);
-    // The scale rounds up, so that every component / scale lies in [−1, 1].
-    uint scaleBits = packHalf2x16(vec2(largest, 0.0)) & 0xFFFFu;
-    if (unpackHalf2x16(scaleBits).x < largest) ++scaleBits;
-    const float inverse = 1.0 / unpackHalf2x16(scaleBits).x;
-    r *= inverse;
-    g *= inverse;
-    b *= inverse;
-    return uvec3(packSnorm4x8(vec4(r, g.x)), packSnorm4x8(vec4(g.yz, b.xy)),
-                 (packSnorm4x8(vec4(b.z, 0.0, 0.0, 0.0)) & 0xFFu) | (scaleBits << 16));
+/// The nine slopes as shared/pull.h packs them.
+uvec3 packSlopes(vec3 r, vec3 g, vec3 b) {
+    return uvec3(snorm8TowardsZero(r.x) | snorm8TowardsZero(r.y) << 8 | snorm8TowardsZero(r.z) << 16 |
+                     snorm8TowardsZero(g.x) << 24,
+                 snorm8TowardsZero(g.y) | snorm8TowardsZero(g.z) << 8 | snorm8TowardsZero(b.x) << 16 |
+                     snorm8TowardsZero(b.y) << 24,
+                 snorm8TowardsZero(b.z));
 }
 
 /// Writes inner node `node` from its children's flux and moments.
@@ -58,15 +65,16 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
                vec3 rightMoment[3]) {
     const vec3 flux = leftFlux + rightFlux;
     nodeFlux[node] = vec4(flux, 0.0);
-    vec3 r[3];
+    vec3 centre, slopes[3];
     for (int c = 0; c < 3; ++c) {
         vec3 m = leftMoment[c] + rightMoment[c];
         m += leftFlux[c] * inner.leftOffset;
         m += rightFlux[c] * inner.rightOffset;
         nodeMoment[3u * node + uint(c)] = vec4(m, 0.0);
-        r[c] = limitedGradient(inner, flux[c], m);
+        centre[c] = limitedSpread(inner, flux[c], m, slopes[c]);
     }
-    nodeLight[node] = uvec4(packGradients(r[0], r[1], r[2]), packRgbe8(flux * inner.radianceScale));
+    nodeLight[node] =
+        uvec4(packSlopes(slopes[0], slopes[1], slopes[2]), packRgbe8(centre * inner.radianceScale));
 }
 
 void main() {

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <type_traits>
 
+#include <glm/gtc/matrix_access.hpp>
+
 #include "core/color.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -16,6 +18,9 @@ namespace {
 
 /// Caches per task: a cache costs nL links.
 constexpr size_t kCacheGrain = 16;
+
+/// How many links ahead cache lighting prefetches a link's node light.
+constexpr size_t kPrefetchLinks = 8;
 
 /// Every binary16 pattern as float. The GPU reads half links natively; on the CPU one 256 KiB
 /// table lookup per coefficient is cheaper than converting bits in the inner loop.
@@ -35,15 +40,24 @@ const float* halfTable() {
 template <class Body>
 void withBands(uint32_t bands, Body&& body) {
     switch (bands) {
-    case 1: return body(std::integral_constant<int, 1>{});
-    case 2: return body(std::integral_constant<int, 2>{});
-    case 3: return body(std::integral_constant<int, 3>{});
-    case 4: return body(std::integral_constant<int, 4>{});
-    case 5: return body(std::integral_constant<int, 5>{});
-    case 6: return body(std::integral_constant<int, 6>{});
-    case 7: return body(std::integral_constant<int, 7>{});
-    case 8: return body(std::integral_constant<int, 8>{});
-    default: PIC_CHECK(bands >= 1 && bands <= uint32_t(kMaxShBands));
+    case 1:
+        return body(std::integral_constant<int, 1>{});
+    case 2:
+        return body(std::integral_constant<int, 2>{});
+    case 3:
+        return body(std::integral_constant<int, 3>{});
+    case 4:
+        return body(std::integral_constant<int, 4>{});
+    case 5:
+        return body(std::integral_constant<int, 5>{});
+    case 6:
+        return body(std::integral_constant<int, 6>{});
+    case 7:
+        return body(std::integral_constant<int, 7>{});
+    case 8:
+        return body(std::integral_constant<int, 8>{});
+    default:
+        PIC_CHECK(bands >= 1 && bands <= uint32_t(kMaxShBands));
     }
 }
 
@@ -72,121 +86,149 @@ struct CacheSh {
     }
 };
 
-/// A node's flux in RGB and in YCoCg, its relative gradients (render/cpu/pull.h; empty: none)
-/// and the links' offsets.
-struct NodeFluxes {
-    std::span<const glm::vec3> rgb;
-    std::span<const glm::vec3> yCoCg;
-    std::span<const glm::mat3> gradient;
-    std::span<const glm::vec3> offset;
-};
-
-/// The YCoCg flux link `slot` carries: its node's flux times the link's tint and, per channel,
-/// the node's linear spread at the centroid of what the link sees, max(0, 1 + r_c·d). Links
-/// that read a node's mean in its own colour (a leaf, or a node seen whole) take the node's
-/// YCoCg as it is.
-inline glm::vec3 linkFlux(const NodeFluxes& flux, uint32_t node, uint32_t tint, size_t slot) {
-    const bool spread = !flux.gradient.empty() && flux.offset[slot] != glm::vec3(0.0f);
-    if (tint == kNeutralLinkTint && !spread) return flux.yCoCg[node];
-    glm::vec3 rgb = flux.rgb[node] * decodeLinkTint(tint);
-    if (spread)
-        rgb *= glm::max(glm::vec3(1.0f) + flux.offset[slot] * flux.gradient[node], glm::vec3(0.0f));
-    return rgbToYCoCg(rgb);
+/// The YCoCg flux link `slot` carries: its node's spread at the link's box point times the
+/// link's tint. Neutral links (81 % of the atrium's) stay in YCoCg, where the spread is linear
+/// too; tinted ones multiply in RGB.
+inline glm::vec3 linkFlux(const NodeLight& node, uint32_t tint, const glm::vec3& point) {
+    const glm::vec3 flux = node.centre + node.spread * point;
+    if (tint == kNeutralLinkTint) return flux;
+    return rgbToYCoCg(glm::max(yCoCgToRgb(flux), glm::vec3(0.0f)) * decodeLinkTint(tint));
 }
 
 /// Eq. 3 with SH-projected links: L = Σ Φ_node · tint · c_link.
 template <int BandsY>
-void lightCachesSh(const BakeData& bake, const NodeFluxes& nodeFlux, CacheValues& out) {
+void lightCachesSh(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
+                   CacheValues& out) {
     constexpr int countY = shCount(BandsY);
     const int countC = shCount(int(out.bandsC));
     const LinkSet& links = bake.links;
     const size_t nL = links.linksPerCache;
     const float* half = halfTable();
-    parallelFor(0, bake.caches.size(), [&](size_t c) {
-        CacheSh<BandsY> sh;
-        for (size_t slot = c * nL; slot < (c + 1) * nL; ++slot) {
-            // Padding links hold zero coefficients; the file format also allows kNoNode there.
-            const uint32_t node = links.shNodes[slot];
-            if (node == kNoNode) continue;
-            const glm::vec3 flux = linkFlux(nodeFlux, node, links.tint[slot], slot);
-            const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
-            // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
-            for (int i = 0; i < countY; ++i) {
-                const float k = half[coefficients[i]];
-                sh.y[i] += flux.x * k;
-                if (i < countC) {
-                    sh.co[i] += flux.y * k;
-                    sh.cg[i] += flux.z * k;
+    parallelFor(
+        0, bake.caches.size(),
+        [&](size_t c) {
+            CacheSh<BandsY> sh;
+            for (size_t slot = c * nL; slot < (c + 1) * nL; ++slot) {
+                // Padding links hold zero coefficients; the file format also allows kNoNode there.
+                const uint32_t node = links.shNodes[slot];
+                if (node == kNoNode) continue;
+                const glm::vec3 flux = linkFlux(light[node], links.tint[slot], table.points[slot]);
+                const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
+                // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
+                for (int i = 0; i < countY; ++i) {
+                    const float k = half[coefficients[i]];
+                    sh.y[i] += flux.x * k;
+                    if (i < countC) {
+                        sh.co[i] += flux.y * k;
+                        sh.cg[i] += flux.z * k;
+                    }
                 }
             }
-        }
-        sh.store(c, countC, out);
-    }, kCacheGrain);
+            sh.store(c, countC, out);
+        },
+        kCacheGrain);
 }
 
 /// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · tint · factor · K_l(α) ·
 /// y_lm(direction).
 template <int BandsY>
-void lightCachesRtp(const BakeData& bake, const NodeFluxes& nodeFlux, const LinkTable& table,
+void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
                     CacheValues& out) {
     const int bandsC = int(out.bandsC);
     const LinkSet& links = bake.links;
     const size_t nL = links.linksPerCache;
-    parallelFor(0, bake.caches.size(), [&](size_t c) {
-        CacheSh<BandsY> sh;
-        std::array<float, shCount(BandsY)> basis;
-        for (size_t slot = c * nL; slot < (c + 1) * nL; ++slot) {
-            const float* w = table.weights.data() + slot * BandsY;
-            // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
-            if (w[0] == 0.0f) continue;
-            const glm::vec3 flux = linkFlux(nodeFlux, links.rtp[slot].node, links.tint[slot], slot);
-            shEvaluate(BandsY, table.directions[slot], basis.data());
-            for (int l = 0; l < BandsY; ++l) {
-                const float fluxY = flux.x * w[l];
-                for (int i = l * l; i < (l + 1) * (l + 1); ++i) sh.y[i] += fluxY * basis[i];
-                if (l < bandsC) {
-                    const float fluxCo = flux.y * w[l], fluxCg = flux.z * w[l];
-                    for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
-                        sh.co[i] += fluxCo * basis[i];
-                        sh.cg[i] += fluxCg * basis[i];
+    parallelFor(
+        0, bake.caches.size(),
+        [&, bandsC](size_t c) {
+            CacheSh<BandsY> sh;
+            std::array<float, shCount(BandsY)> basis;
+            const size_t end = (c + 1) * nL;
+            for (size_t slot = c * nL; slot < end; ++slot) {
+                // The nodes are scattered: fetch a later link's ahead of its use.
+                if (slot + kPrefetchLinks < end)
+                    __builtin_prefetch(&light[links.rtp[slot + kPrefetchLinks].node]);
+                const float* w = table.weights.data() + slot * BandsY;
+                // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
+                if (w[0] == 0.0f) continue;
+                const glm::vec3 flux =
+                    linkFlux(light[links.rtp[slot].node], links.tint[slot], table.points[slot]);
+                shEvaluateFixed<BandsY>(table.directions[slot], basis.data());
+                for (int l = 0; l < BandsY; ++l) {
+                    const float fluxY = flux.x * w[l];
+                    for (int i = l * l; i < (l + 1) * (l + 1); ++i) sh.y[i] += fluxY * basis[i];
+                    if (l < bandsC) {
+                        const float fluxCo = flux.y * w[l], fluxCg = flux.z * w[l];
+                        for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
+                            sh.co[i] += fluxCo * basis[i];
+                            sh.cg[i] += fluxCg * basis[i];
+                        }
                     }
                 }
             }
-        }
-        sh.store(c, shCount(bandsC), out);
-    }, kCacheGrain);
+            sh.store(c, shCount(bandsC), out);
+        },
+        kCacheGrain);
 }
 
 }  // namespace
 
-LinkTable unpackLinks(const LinkSet& links, uint32_t bandsY) {
+LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
+    const LinkSet& links = bake.links;
+    const uint32_t bandsY = bake.params.bandsY;
     PIC_CHECK(bandsY >= 1 && bandsY <= uint32_t(kMaxShBands));
     PIC_CHECK_EQ(links.offset.size(), links.tint.size() * 3);
+    PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
     LinkTable table;
     table.bands = bandsY;
-    table.offsets.resize(links.tint.size());
-    parallelFor(0, links.tint.size(), [&](size_t slot) {
-        for (int i = 0; i < 3; ++i) table.offsets[slot][i] = halfToFloat(links.offset[slot * 3 + i]);
-    }, 4096);
-    if (links.mode != LinkMode::Rtp) return table;
+    const bool rtp = links.mode == LinkMode::Rtp;
+    PIC_CHECK_EQ((rtp ? links.rtp.size() : links.shNodes.size()), links.tint.size());
+    table.points.resize(links.tint.size());
+    parallelFor(
+        0, links.tint.size(),
+        [&](size_t slot) {
+            const uint32_t node = rtp ? links.rtp[slot].node : links.shNodes[slot];
+            if (node >= bake.nodes.size()) return;  // SH padding may name kNoNode
+            glm::vec3 offset;
+            for (int i = 0; i < 3; ++i) offset[i] = halfToFloat(links.offset[slot * 3 + i]);
+            // Through the code the GPU's links carry, so both backends read the same point.
+            table.points[slot] = decodeBoxPoint(encodeBoxPoint(spread, node, offset));
+        },
+        4096);
+    if (!rtp) return table;
     table.directions.resize(links.rtp.size());
     table.weights.resize(links.rtp.size() * bandsY);
-    parallelFor(0, links.rtp.size(), [&](size_t slot) {
-        const RtpLink& link = links.rtp[slot];
-        table.directions[slot] = decodeOctahedral(link.directionOct);
-        std::array<double, kMaxShBands> cone;
-        coneZonalBands(int(bandsY), double(link.oneMinusCosAlpha), cone.data());
-        for (uint32_t l = 0; l < bandsY; ++l)
-            table.weights[slot * bandsY + l] = float(double(link.factor) * cone[l]);
-    }, 1024);
+    parallelFor(
+        0, links.rtp.size(),
+        [&](size_t slot) {
+            const RtpLink& link = links.rtp[slot];
+            table.directions[slot] = decodeOctahedral(link.directionOct);
+            std::array<double, kMaxShBands> cone;
+            coneZonalBands(int(bandsY), double(link.oneMinusCosAlpha), cone.data());
+            for (uint32_t l = 0; l < bandsY; ++l)
+                table.weights[slot * bandsY + l] = float(double(link.factor) * cone[l]);
+        },
+        1024);
     return table;
 }
 
-void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
-                 std::span<const glm::mat3> nodeGradient, const LinkTable& table,
+void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,
+               std::span<NodeLight> out) {
+    PIC_CHECK_EQ(slopes.size(), centreFlux.size());
+    PIC_CHECK_EQ(out.size(), centreFlux.size());
+    parallelFor(
+        0, centreFlux.size(),
+        [&](size_t n) {
+            const glm::vec3 centre = centreFlux[n];
+            out[n].centre = rgbToYCoCg(centre);
+            for (int k = 0; k < 3; ++k)
+                out[n].spread[k] = rgbToYCoCg(centre * glm::row(slopes[n], k));
+        },
+        4096);
+}
+
+void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
                  CacheValues& out) {
-    PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
-    PIC_CHECK(nodeGradient.empty() || nodeGradient.size() == nodeFlux.size());
+    PIC_CHECK_EQ(light.size(), bake.nodes.size());
     const uint32_t bandsY = bake.params.bandsY, bandsC = bake.params.bandsC;
     const size_t nC = bake.caches.size();
     if (out.bandsY != bandsY || out.bandsC != bandsC || out.cacheCount() != nC)
@@ -195,33 +237,31 @@ void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
     const size_t nLinks = nC * bake.links.linksPerCache;
     PIC_CHECK_EQ(bake.links.tint.size(), nLinks);
     PIC_CHECK_EQ(table.bands, bandsY);
-    PIC_CHECK_EQ(table.offsets.size(), nLinks);
-    // One YCoCg conversion per node serves all its links that read its mean.
-    std::vector<glm::vec3> fluxYCoCg(nodeFlux.size());
-    parallelFor(0, nodeFlux.size(), [&](size_t n) { fluxYCoCg[n] = rgbToYCoCg(nodeFlux[n]); },
-                4096);
-    const NodeFluxes fluxes{nodeFlux, fluxYCoCg, nodeGradient, table.offsets};
+    PIC_CHECK_EQ(table.points.size(), nLinks);
     if (bake.links.mode == LinkMode::Sh) {
         PIC_CHECK_EQ(bake.links.bands, bandsY);
         PIC_CHECK_EQ(bake.links.shNodes.size(), nLinks);
         PIC_CHECK_EQ(bake.links.shCoefficients.size(), nLinks * bandsY * bandsY);
         withBands(bandsY, [&](auto bands) {
-            lightCachesSh<decltype(bands)::value>(bake, fluxes, out);
+            lightCachesSh<decltype(bands)::value>(bake, light, table, out);
         });
     } else {
         PIC_CHECK_EQ(bake.links.rtp.size(), nLinks);
         PIC_CHECK_EQ(table.directions.size(), nLinks);
         withBands(bandsY, [&](auto bands) {
-            lightCachesRtp<decltype(bands)::value>(bake, fluxes, table, out);
+            lightCachesRtp<decltype(bands)::value>(bake, light, table, out);
         });
     }
 }
 
 void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux, CacheValues& out) {
     const NodeSpread spread = nodeSpread(bake);
-    std::vector<glm::mat3> moment(nodeFlux.size()), gradient(nodeFlux.size());
-    pullFluxGradients(bake, spread, nodeFlux, moment, gradient);
-    lightCaches(bake, nodeFlux, gradient, unpackLinks(bake.links, bake.params.bandsY), out);
+    std::vector<glm::mat3> moment(nodeFlux.size()), slopes(nodeFlux.size());
+    std::vector<glm::vec3> centre(nodeFlux.size());
+    pullFluxSpread(bake, spread, nodeFlux, moment, centre, slopes);
+    std::vector<NodeLight> light(nodeFlux.size());
+    nodeLight(centre, slopes, light);
+    lightCaches(bake, light, unpackLinks(bake, spread), out);
 }
 
 }  // namespace pic

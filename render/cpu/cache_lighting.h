@@ -11,37 +11,52 @@
 
 #include "core/bake_data.h"
 #include "core/cache_values.h"
+#include "render/cpu/pull.h"
 
 namespace pic {
 
 /// Links unpacked once per bake, indexed like LinkSet::tint (link j of cache c at c·nL + j):
-/// everything of a link but its node's flux is fixed at bake time, so a runtime decodes the
-/// offsets and, for runtime-projected links, the direction and the cone's zonal factors K_l(α)
-/// (core/sh.h coneZonal) once instead of at every update.
+/// everything of a link but its node's flux is fixed at bake time, so a runtime decodes, once
+/// instead of at every update, where in its node's box each link reads the node's spread and,
+/// for runtime-projected links, the direction and the cone's zonal factors K_l(α) (core/sh.h
+/// coneZonal).
 struct LinkTable {
     uint32_t bands = 0;                 ///< lY
-    std::vector<glm::vec3> offsets;     ///< nC·nL LinkSet::offset, metres
+    std::vector<glm::vec3> points;      ///< nC·nL box coordinates of LinkSet::offset in the
+                                        ///< link's node (render/cpu/pull.h encodeBoxPoint)
     std::vector<glm::vec3> directions;  ///< RTP: nC·nL unit directions cache → node
-    std::vector<float> weights;         ///< RTP: nC·nL·lY band weights factor·K_l(α); 0 for padding
+    std::vector<float> weights;  ///< RTP: nC·nL·lY band weights factor·K_l(α); 0 for padding
 };
 
-/// Unpacks the links of `links` for lY = bandsY bands.
-LinkTable unpackLinks(const LinkSet& links, uint32_t bandsY);
+/// Unpacks the links of `bake` for its lY bands, their offsets in the boxes of `spread`
+/// (nodeSpread(bake)).
+LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread);
 
-/// Lights every cache of the bake from `nodeFlux` (2nS − 1 nodes, W per RGB channel) into
-/// `out` (resized to nC caches with the bake's lY, lC): L = Σ_links Φ_link·transport in YCoCg
-/// (core/color.h), in W/(m²·sr). Φ_link is the node's flux times the link's tint and, with
-/// `nodeGradient` (render/cpu/pull.h pullFluxGradients; empty: the node's mean), its linear
-/// spread at the link's offset, max(0, 1 + r_c·d) per channel.
+/// A node's light as its links read it, in YCoCg: its limited flux spread's flux at the box
+/// centre and the change per box coordinate (column k: centre ∘ the slopes along axis k), so
+/// that a link at box point u reads centre + spread·u.
+struct NodeLight {
+    glm::vec3 centre{0.0f};
+    glm::mat3 spread{0.0f};
+};
+
+/// The node light of every node from its limited flux spread (render/cpu/pull.h
+/// pullFluxSpread: `centreFlux`, W per RGB channel, and `slopes`) into `out` (same size).
+void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,
+               std::span<NodeLight> out);
+
+/// Lights every cache of the bake from its nodes' light (nodeLight, 2nS − 1 nodes) into `out`
+/// (resized to nC caches with the bake's lY, lC): L = Σ_links Φ_link·transport in YCoCg
+/// (core/color.h), in W/(m²·sr). Φ_link is the node's flux spread at the link's box point u
+/// times the link's tint, centre·(1 + slopes·u)·tint per RGB channel.
 ///   SH links: transport = the link's lY² half-float coefficients; Y takes all of them, Co and
 ///             Cg the first lC².
 ///   RTP links: transport = factor·K_l(α)·y_lm(direction), the projection of the node's cone
 ///             (core/sh.h shAddCone), from the unpacked table; Y to lY bands, Co and Cg to lC
 ///             bands.
-/// Padding links contribute nothing. Nothing is clamped but the spread: radiance is as linear
-/// as the flux. `table` must be unpackLinks(bake.links, lY).
-void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux,
-                 std::span<const glm::mat3> nodeGradient, const LinkTable& table,
+/// Padding links contribute nothing. Nothing is clamped: radiance is as linear as the flux,
+/// and the limited spread is ≥ 0 over every node's box. `table` must be unpackLinks(bake, ·).
+void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
                  CacheValues& out);
 
 /// lightCaches with the spread and the table computed on the way (one-off use; a runtime

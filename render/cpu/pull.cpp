@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -16,11 +17,14 @@ void pullFlux(const BakeData& bake, std::span<glm::vec3> nodeFlux) {
     // so one parallel loop per level, in order, is a complete pull (one dispatch per level on
     // the GPU).
     for (size_t level = 1; level < bake.levelOffsets.size(); ++level) {
-        parallelFor(bake.levelOffsets[level - 1], bake.levelOffsets[level], [&](size_t n) {
-            const Node& node = bake.nodes[n];
-            PIC_DCHECK(node.left < n && node.right < n);
-            nodeFlux[n] = nodeFlux[node.left] + nodeFlux[node.right];
-        }, 1024);
+        parallelFor(
+            bake.levelOffsets[level - 1], bake.levelOffsets[level],
+            [&](size_t n) {
+                const Node& node = bake.nodes[n];
+                PIC_DCHECK(node.left < n && node.right < n);
+                nodeFlux[n] = nodeFlux[node.left] + nodeFlux[node.right];
+            },
+            1024);
     }
 }
 
@@ -67,8 +71,8 @@ NodeSpread nodeSpread(const BakeData& bake) {
         const Node& node = bake.nodes[n];
         if (node.left == kNoNode) {
             const Surfel& s = bake.surfels[n];
-            const double w = (bake.surfelWeights.empty() ? 1.0 : double(bake.surfelWeights[n])) *
-                             double(s.area);
+            const double w =
+                (bake.surfelWeights.empty() ? 1.0 : double(bake.surfelWeights[n])) * double(s.area);
             const glm::dvec3 x(s.position);
             weight[n] = w;
             first[n] = w * x;
@@ -85,66 +89,120 @@ NodeSpread nodeSpread(const BakeData& bake) {
     spread.inverseVariance.assign(nodes, glm::vec3(0.0f));
     spread.low.assign(nodes, glm::vec3(0.0f));
     spread.high.assign(nodes, glm::vec3(0.0f));
-    parallelFor(0, nodes, [&](size_t n) {
-        if (!(weight[n] > 0.0)) return;  // no area: nothing spreads
-        const glm::dvec3 mean = first[n] / weight[n];
-        spread.centroid[n] = glm::vec3(mean);
-        const Node& node = bake.nodes[n];
-        if (node.left == kNoNode) return;
-        const glm::dmat3 covariance = second[n] / weight[n] - glm::outerProduct(mean, mean);
-        const double trace = covariance[0][0] + covariance[1][1] + covariance[2][2];
-        if (!(trace > 0.0)) return;  // every surfel at one point: no spread to fit
-        glm::dvec3 variance;
-        glm::dmat3 axes;
-        symmetricEigen(covariance, variance, axes);
-        spread.axes[n] = glm::mat3(axes);
-        for (int i = 0; i < 3; ++i)
-            spread.inverseVariance[n][i] = float(1.0 / (std::max(variance[i], 0.0) + 1e-6 * trace));
-        glm::dvec3 low(0.0), high(0.0);
-        for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
-            const glm::dvec3 y = glm::transpose(axes) * (glm::dvec3(bake.surfels[s].position) - mean);
-            low = glm::min(low, y);
-            high = glm::max(high, y);
-        }
-        spread.low[n] = glm::vec3(low);
-        spread.high[n] = glm::vec3(high);
-    }, 256);
+    parallelFor(
+        0, nodes,
+        [&](size_t n) {
+            if (!(weight[n] > 0.0)) return;  // no area: nothing spreads
+            const glm::dvec3 mean = first[n] / weight[n];
+            spread.centroid[n] = glm::vec3(mean);
+            const Node& node = bake.nodes[n];
+            if (node.left == kNoNode) return;
+            const glm::dmat3 covariance = second[n] / weight[n] - glm::outerProduct(mean, mean);
+            const double trace = covariance[0][0] + covariance[1][1] + covariance[2][2];
+            if (!(trace > 0.0)) return;  // every surfel at one point: no spread to fit
+            glm::dvec3 variance;
+            glm::dmat3 axes;
+            symmetricEigen(covariance, variance, axes);
+            spread.axes[n] = glm::mat3(axes);
+            for (int i = 0; i < 3; ++i)
+                spread.inverseVariance[n][i] =
+                    float(1.0 / (std::max(variance[i], 0.0) + 1e-6 * trace));
+            glm::dvec3 low(0.0), high(0.0);
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
+                const glm::dvec3 y =
+                    glm::transpose(axes) * (glm::dvec3(bake.surfels[s].position) - mean);
+                low = glm::min(low, y);
+                high = glm::max(high, y);
+            }
+            spread.low[n] = glm::vec3(low);
+            spread.high[n] = glm::vec3(high);
+        },
+        256);
     return spread;
 }
 
-glm::vec3 limitedGradient(const NodeSpread& spread, size_t node, float flux, const glm::vec3& moment) {
-    if (!(flux > 0.0f)) return glm::vec3(0.0f);
-    const glm::mat3& axes = spread.axes[node];
-    const glm::vec3 g = (moment * axes) * spread.inverseVariance[node];  // in the axes' frame
-    // The least of Φ + g·y over the box: each axis at the end where g·y is lowest.
-    const glm::vec3 lowest = glm::min(g * spread.low[node], g * spread.high[node]);
-    const float drop = -(lowest.x + lowest.y + lowest.z);
-    const float limit = drop > flux ? flux / drop : 1.0f;
-    return axes * (g * (limit / flux));
+ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
+                            const glm::vec3& moment) {
+    if (!(flux > 0.0f)) return {};
+    // The box as centre ± half extent about x̄_n, in the axes' frame.
+    const glm::vec3 centre = 0.5f * (spread.low[node] + spread.high[node]);
+    const glm::vec3 half = 0.5f * (spread.high[node] - spread.low[node]);
+    glm::vec3 g = (moment * spread.axes[node]) * spread.inverseVariance[node];
+    // The least of Φ + g·y over the box is Φ + g·centre − Σ_k |g_k|·half_k: where it is
+    // negative, scale g until it is 0 (the drop Σ|g|·half − g·centre then exceeds Φ ≥ 0).
+    float atCentre = flux + glm::dot(g, centre);
+    glm::vec3 change = glm::abs(g * half);
+    const float swing = change.x + change.y + change.z;
+    if (swing > atCentre) {
+        g *= flux / (swing - glm::dot(g, centre));
+        atCentre = flux + glm::dot(g, centre);
+    }
+    if (!(atCentre > 0.0f)) return {};
+    ChannelSpread out{atCentre, g * half * (1.0f / atCentre)};
+    // Σ|slopes| ≤ 1 holds up to rounding; keep it exact, so no point of the box reads < 0.
+    change = glm::abs(out.slopes);
+    const float sum = change.x + change.y + change.z;
+    if (sum > 1.0f) out.slopes *= 1.0f / sum;
+    return out;
 }
 
-void pullFluxGradients(const BakeData& bake, const NodeSpread& spread,
-                       std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
-                       std::span<glm::mat3> gradient) {
+void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
+                    std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
+                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes) {
     const size_t nS = bake.surfels.size();
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
     PIC_CHECK_EQ(moment.size(), bake.nodes.size());
-    PIC_CHECK_EQ(gradient.size(), bake.nodes.size());
+    PIC_CHECK_EQ(centreFlux.size(), bake.nodes.size());
+    PIC_CHECK_EQ(slopes.size(), bake.nodes.size());
     PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
-    std::fill(moment.begin(), moment.begin() + nS, glm::mat3(0.0f));
-    std::fill(gradient.begin(), gradient.begin() + nS, glm::mat3(0.0f));
-    for (size_t level = 1; level < bake.levelOffsets.size(); ++level) {
-        parallelFor(bake.levelOffsets[level - 1], bake.levelOffsets[level], [&](size_t n) {
-            const Node& node = bake.nodes[n];
-            glm::mat3 m = moment[node.left] + moment[node.right];
-            for (const uint32_t child : {node.left, node.right}) {
-                const glm::vec3 offset = spread.centroid[child] - spread.centroid[n];
-                for (int c = 0; c < 3; ++c) m[c] += nodeFlux[child][c] * offset;
-            }
-            moment[n] = m;
-            for (int c = 0; c < 3; ++c) gradient[n][c] = limitedGradient(spread, n, nodeFlux[n][c], m[c]);
-        }, 1024);
+    // Leaves (and any node the levels leave out) read their own flux, evenly.
+    const size_t innerBegin = bake.levelOffsets.empty() ? nS : bake.levelOffsets.front();
+    const size_t innerEnd = bake.levelOffsets.empty() ? nS : bake.levelOffsets.back();
+    for (const auto& [begin, end] :
+         {std::pair{size_t{0}, innerBegin}, std::pair{innerEnd, nodeFlux.size()}}) {
+        std::fill(moment.begin() + begin, moment.begin() + end, glm::mat3(0.0f));
+        std::copy(nodeFlux.begin() + begin, nodeFlux.begin() + end, centreFlux.begin() + begin);
+        std::fill(slopes.begin() + begin, slopes.begin() + end, glm::mat3(0.0f));
     }
+    for (size_t level = 1; level < bake.levelOffsets.size(); ++level) {
+        parallelFor(
+            bake.levelOffsets[level - 1], bake.levelOffsets[level],
+            [&](size_t n) {
+                const Node& node = bake.nodes[n];
+                glm::mat3 m = moment[node.left] + moment[node.right];
+                for (const uint32_t child : {node.left, node.right}) {
+                    const glm::vec3 offset = spread.centroid[child] - spread.centroid[n];
+                    for (int c = 0; c < 3; ++c) m[c] += nodeFlux[child][c] * offset;
+                }
+                moment[n] = m;
+                for (int c = 0; c < 3; ++c) {
+                    const ChannelSpread channel = limitedSpread(spread, n, nodeFlux[n][c], m[c]);
+                    centreFlux[n][c] = channel.centre;
+                    slopes[n][c] = channel.slopes;
+                }
+            },
+            1024);
+    }
+}
+
+uint32_t encodeBoxPoint(const NodeSpread& spread, size_t node, const glm::vec3& offset) {
+    const glm::vec3 low = spread.low[node], high = spread.high[node];
+    const glm::vec3 y = offset * spread.axes[node];  // axesᵀ·offset
+    uint32_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float half = 0.5f * (high[k] - low[k]);
+        const float u = half > 0.0f ? (y[k] - 0.5f * (low[k] + high[k])) / half : 0.0f;
+        const float clamped = std::isfinite(u) ? std::clamp(u, -1.0f, 1.0f) : 0.0f;
+        code |= uint32_t(uint8_t(int8_t(std::lround(clamped * 127.0f)))) << (8 * k);
+    }
+    return code;
+}
+
+glm::vec3 decodeBoxPoint(uint32_t code) {
+    glm::vec3 u;
+    for (int k = 0; k < 3; ++k)
+        u[k] = std::max(float(int8_t(uint8_t(code >> (8 * k)))) / 127.0f, -1.0f);
+    return u;
 }
 
 }  // namespace pic

@@ -29,14 +29,16 @@ void pullFlux(const BakeData& bake, std::span<glm::vec3> nodeFlux);
 /// limiter): every part of the node then reads a flux ≥ 0 and the parts still sum to Φ_n, where
 /// clamping negative parts to 0 would make light (one sunlit corner of a floor node made the
 /// living room's caches 18 % too bright). A link whose visible part has its centroid at
-/// x̄_n + d (LinkSet::offset) reads Φ_n·(1 + r_n·d), r_n = g_n / Φ_n: a far wall lit at one
-/// end sends more light to a cache that sees that end.
+/// x̄_n + d (LinkSet::offset) reads Φ_n + g_n·d: a far wall lit at one end sends more light to
+/// a cache that sees that end. The visible part's centroid lies among the node's surfels, so
+/// within the box [low, high], and links carry it in box coordinates (encodeBoxPoint).
 struct NodeSpread {
-    std::vector<glm::vec3> centroid;         ///< x̄_n per node, metres
-    std::vector<glm::mat3> axes;             ///< principal axes of C_n (orthonormal columns)
-    std::vector<glm::vec3> inverseVariance;  ///< 1 / (eigenvalue + λ_n) per axis, 1/m²; 0 for leaves
-    std::vector<glm::vec3> low;              ///< extent of the surfels about x̄_n along the axes:
-    std::vector<glm::vec3> high;             ///< low ≤ 0 ≤ high, metres
+    std::vector<glm::vec3> centroid;  ///< x̄_n per node, metres
+    std::vector<glm::mat3> axes;      ///< principal axes of C_n (orthonormal columns)
+    std::vector<glm::vec3>
+        inverseVariance;          ///< 1 / (eigenvalue + λ_n) per axis, 1/m²; 0 for leaves
+    std::vector<glm::vec3> low;   ///< extent of the surfels about x̄_n along the axes:
+    std::vector<glm::vec3> high;  ///< low ≤ 0 ≤ high, metres
 };
 
 /// The spread of every node of `bake` from its surfels and flux weights (bake.surfelWeights;
@@ -44,17 +46,38 @@ struct NodeSpread {
 /// nodes, whose moment has no component across them.
 NodeSpread nodeSpread(const BakeData& bake);
 
+/// A node's flux as its links read it, per channel: the limited linear spread's flux at the
+/// centre of the node's box, and its relative slopes along the box's axes per half extent. A
+/// point of the box at box coordinates u ∈ [−1, 1]³ (encodeBoxPoint) reads
+/// centre·(1 + slopes·u). The limiter keeps the spread ≥ 0 over the box, which is exactly
+/// Σ_k |slopes_k| ≤ 1 (the least corner reads centre·(1 − Σ_k |slopes_k|)).
+struct ChannelSpread {
+    float centre = 0.0f;     ///< W: Φ_n + g_n·c_n, c_n the box centre about x̄_n
+    glm::vec3 slopes{0.0f};  ///< (g_n·axis_k)·halfExtent_k / centre
+};
+
+/// The limited spread of one channel of `node` from its flux Φ and moment M (the twin of the
+/// GPU pull's): g = axes·(axesᵀ·M ∘ inverseVariance), scaled so that Φ + g·y ≥ 0 over the
+/// box [low, high] in the axes' frame, then evaluated about the box centre.
+ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
+                            const glm::vec3& moment);
+
 /// From pulled `nodeFlux`: the first moments M_n (`moment`, column c = channel c, W·m; the
 /// leaves' are 0) summed up the hierarchy like the flux, M_n = Σ_children M_k + Φ_k ⊗ (x̄_k −
-/// x̄_n), and every node's limited relative gradient r_n (`gradient`, column c = g_n,c / Φ_n,c,
-/// 1/m; 0 where Φ_n,c = 0 and for leaves).
-void pullFluxGradients(const BakeData& bake, const NodeSpread& spread,
-                       std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
-                       std::span<glm::mat3> gradient);
+/// x̄_n), and every node's limited spread: `centreFlux` (W per channel; a leaf's own flux) and
+/// `slopes` (column c = channel c's slopes; 0 for leaves).
+void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
+                    std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
+                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes);
 
-/// The limited relative gradient of one channel from its flux Φ and moment M (the twin of the
-/// GPU pull's): g = axes·(axesᵀ·M ∘ inverseVariance), scaled so that Φ + g·y ≥ 0 over the box
-/// [low, high] in the axes' frame, over Φ.
-glm::vec3 limitedGradient(const NodeSpread& spread, size_t node, float flux, const glm::vec3& moment);
+/// Box coordinates of a point at `offset` from the flux centroid of `node` (a link's
+/// LinkSet::offset): u_k = (axis_k·offset − centre_k) / halfExtent_k, clamped to [−1, 1], 0
+/// along an axis the box is flat on; as three snorm8 in bits 0-23, the form the GPU's links
+/// carry (shaders/shared/cache_lighting.h), so that both backends read the same points. One
+/// step is 1/127 of a half extent, so a link reads its node's spread within 1/127 of its flux.
+uint32_t encodeBoxPoint(const NodeSpread& spread, size_t node, const glm::vec3& offset);
+
+/// The box coordinates of a code from encodeBoxPoint, each in [−1, 1] (GLSL unpackSnorm4x8).
+glm::vec3 decodeBoxPoint(uint32_t code);
 
 }  // namespace pic

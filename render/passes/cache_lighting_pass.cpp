@@ -45,15 +45,26 @@ uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t max
 
 }  // namespace
 
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, const uint16_t* offset, float nodeArea) {
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, float nodeArea) {
+    PIC_CHECK(link.node < (1u << kGpuLinkNodeBits));
     // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
     const auto visible = float(double(link.factor) * std::numbers::pi * double(nodeArea));
     uint32_t half = floatToHalfClamped(std::max(visible, 0.0f));
     // A real link too faint for binary16 would read as padding; it keeps the smallest step.
     if (half == 0 && link.factor > 0.0f) half = 1;
     const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
-    return {link.node, link.directionOct, half | (cone << 16), tint,
-            uint32_t(offset[0]) | uint32_t(offset[1]) << 16, offset[2], 0, 0};
+    // snorm16 → snorm12 per octahedral coordinate, unorm10 → unorm8 per tint channel.
+    const auto snorm12 = [](uint32_t snorm16) {
+        return uint32_t(std::lround(float(int16_t(uint16_t(snorm16))) * (2047.0f / 32767.0f))) &
+               0xFFFu;
+    };
+    const auto unorm8 = [&](int channel) {
+        return uint32_t(std::lround(float((tint >> (10 * channel)) & 0x3FFu) * (255.0f / 1023.0f)));
+    };
+    return {link.node | unorm8(0) << 24,
+            snorm12(link.directionOct & 0xFFFFu) | snorm12(link.directionOct >> 16) << 12 |
+                unorm8(1) << 24,
+            half | (cone << 16), (point & 0xFFFFFFu) | unorm8(2) << 24};
 }
 
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
@@ -63,15 +74,29 @@ uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
 
 Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
                                                                      const BakeData& bake,
+                                                                     const NodeSpread& spread,
                                                                      bool cachePerSubgroup,
                                                                      uint32_t maxTexelWords) {
     std::unique_ptr<CacheLightingPass> pass(new CacheLightingPass());
     // Per subgroup: as many caches per workgroup as it has subgroups of the default size (the
     // shader strides over any the device leaves, should it launch fewer).
-    pass->mCachesPerGroup = cachePerSubgroup
-        ? std::max<uint32_t>(kCacheLightingGroup / context.subgroupSize(), 1)
-        : kCacheLightingGroup;
+    pass->mCachesPerGroup =
+        cachePerSubgroup ? std::max<uint32_t>(kCacheLightingGroup / context.subgroupSize(), 1)
+                         : kCacheLightingGroup;
     const LinkSet& links = bake.links;
+    if (bake.nodes.size() > (size_t{1} << kGpuLinkNodeBits))
+        return fail(ErrorCode::Unsupported,
+                    "the bake has {} hierarchy nodes ({} surfels); GPU links address at most "
+                    "{} nodes ({} surfels): bake fewer surfels or relight on the CPU twin",
+                    bake.nodes.size(), bake.surfels.size(), size_t{1} << kGpuLinkNodeBits,
+                    size_t{1} << (kGpuLinkNodeBits - 1));
+    PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
+    // Where each link reads its node's spread, as the CPU twin's unpackLinks decodes it.
+    const auto boxPoint = [&](size_t slot, uint32_t node) {
+        glm::vec3 offset;
+        for (int i = 0; i < 3; ++i) offset[i] = halfToFloat(links.offset[slot * 3 + i]);
+        return encodeBoxPoint(spread, node, offset);
+    };
     pass->mRtpForm = links.mode == LinkMode::Rtp;
     pass->mCacheCount = uint32_t(bake.caches.size());
     pass->mLinksPerCache = links.linksPerCache;
@@ -121,9 +146,10 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
             [&](size_t i) {
                 const RtpLink& link = links.rtp[i];
                 // Padding (factor 0) may name any node; V = 0 marks it.
-                rtp[i] = link.factor > 0.0f ? packRtpLink(link, links.tint[i], &links.offset[i * 3],
-                                                          bake.nodes[link.node].area)
-                                            : GpuRtpLink{};
+                rtp[i] = link.factor > 0.0f
+                             ? packRtpLink(link, links.tint[i], boxPoint(i, link.node),
+                                           bake.nodes[link.node].area)
+                             : GpuRtpLink{};
             },
             4096);
         PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const GpuRtpLink>(rtp),
@@ -140,12 +166,10 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 uint32_t* record = sh.data() + slot * words;
                 record[0] = node;
                 record[1] = links.tint[slot];
-                const uint16_t* offset = &links.offset[slot * 3];
-                record[2] = uint32_t(offset[0]) | uint32_t(offset[1]) << 16;
-                record[3] = offset[2];
+                record[2] = node == kNoNode ? 0u : boxPoint(slot, node);
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 for (uint32_t i = 0; i < countY; ++i)
-                    record[4 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
+                    record[3 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
                                          << (16 * (i % 2));
             },
             4096);
@@ -170,8 +194,8 @@ Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeLight,
                                      const Buffer& cacheCg, const Buffer& shTables) {
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
-    PIC_TRY_ASSIGN(mRadianceView,
-                   TexelView::create(context, nodeLight, VK_FORMAT_R32G32B32A32_UINT, "node light"));
+    PIC_TRY_ASSIGN(mRadianceView, TexelView::create(context, nodeLight, VK_FORMAT_R32G32B32A32_UINT,
+                                                    "node light"));
     for (size_t k = 0; k < mChunkFirst.size(); ++k) {
         const std::array<BindingResource, kBindingCount> resources = {
             BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),

@@ -12,28 +12,33 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
+#include "render/cpu/pull.h"
 #include "shaders/shared/cache_lighting.h"
 
 namespace pic::gpu {
 
-/// The GPU's 32-byte form of a runtime-projected link with tint code `tint` and offset `offset`
-/// (LinkSet::offset, 3 binary16) whose node has area `nodeArea`: V = factor·π·A as binary16
-/// (clamped to 65504, at least the smallest subnormal for a link with factor > 0) and
-/// 1 − cos α as binary16 (shaders/shared/cache_lighting.h).
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, const uint16_t* offset, float nodeArea);
+/// The GPU's 16-byte form of a runtime-projected link with tint code `tint` (core/color.h
+/// encodeLinkTint) and box point `point` (render/cpu/pull.h encodeBoxPoint) whose node has
+/// area `nodeArea` (shaders/shared/cache_lighting.h): the node index (below 2^24), V =
+/// factor·π·A as binary16 (clamped to 65504, at least the smallest subnormal for a link with
+/// factor > 0), 1 − cos α as binary16, the direction as 2 × snorm12 and the tint as 3 × unorm8.
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, float nodeArea);
 /// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
 /// c·π·A, clamped to ±65504.
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 
 class CacheLightingPass {
 public:
-    /// Uploads the links (RTP: 32 bytes each, packRtpLink; SH: node index, tint, offset and lY²
-    /// half coefficients, radianceShCoefficient, in shLinkWords(lY²) words).
+    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box point and
+    /// lY² half coefficients, radianceShCoefficient, in shLinkWords(lY²) words), their box
+    /// points in the boxes of `spread` (nodeSpread(bake)). Fails naming the count where the
+    /// bake has more nodes than a GPU link addresses (2^24).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
     /// in uint texels of up to `maxTexelWords` words that the device supports and that divide
     /// a link: 4 or 2 words before 3, else one.
     static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
+                                                             const NodeSpread& spread,
                                                              bool cachePerSubgroup,
                                                              uint32_t maxTexelWords = 4);
     /// Binds the node light (4 words per node, shaders/shared/pull.h; its usage must allow

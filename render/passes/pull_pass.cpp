@@ -20,29 +20,31 @@ float radianceScale(float area) {
     return float(1.0 / (std::numbers::pi * double(area)));
 }
 
-glm::uvec3 packNodeGradients(const glm::mat3& gradient) {
-    float largest = 0.0f;
-    for (int c = 0; c < 3; ++c)
-        for (int i = 0; i < 3; ++i) largest = std::max(largest, std::abs(gradient[c][i]));
-    largest = std::min(largest, 65504.0f);
-    if (!(largest > 0.0f)) return glm::uvec3(0u);
-    // The scale rounds up, so that every component / scale lies in [−1, 1].
-    uint32_t scaleBits = floatToHalf(largest);
-    if (halfToFloat(uint16_t(scaleBits)) < largest) ++scaleBits;
-    const glm::mat3 r = gradient * (1.0f / halfToFloat(uint16_t(scaleBits)));
-    return {glm::packSnorm4x8(glm::vec4(r[0], r[1].x)),
-            glm::packSnorm4x8(glm::vec4(r[1].y, r[1].z, r[2].x, r[2].y)),
-            (glm::packSnorm4x8(glm::vec4(r[2].z, 0.0f, 0.0f, 0.0f)) & 0xFFu) | scaleBits << 16};
+namespace {
+
+/// snorm8 of v ∈ [−1, 1] rounded towards zero, in the low byte.
+uint32_t snorm8TowardsZero(float v) {
+    return uint32_t(uint8_t(int8_t(std::trunc(std::clamp(v, -1.0f, 1.0f) * 127.0f))));
 }
 
-glm::mat3 unpackNodeGradients(const glm::uvec3& packed) {
+}  // namespace
+
+glm::uvec3 packNodeSlopes(const glm::mat3& slopes) {
+    std::array<uint32_t, 9> bytes;
+    for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) bytes[3 * c + k] = snorm8TowardsZero(slopes[c][k]);
+    return {bytes[0] | bytes[1] << 8 | bytes[2] << 16 | bytes[3] << 24,
+            bytes[4] | bytes[5] << 8 | bytes[6] << 16 | bytes[7] << 24, bytes[8]};
+}
+
+glm::mat3 unpackNodeSlopes(const glm::uvec3& packed) {
     const glm::vec4 a = glm::unpackSnorm4x8(packed.x), b = glm::unpackSnorm4x8(packed.y);
     const float z = glm::unpackSnorm4x8(packed.z).x;
-    const float scale = halfToFloat(uint16_t(packed.z >> 16));
-    return glm::mat3(glm::vec3(a), glm::vec3(a.w, b.x, b.y), glm::vec3(b.z, b.w, z)) * scale;
+    return glm::mat3(glm::vec3(a), glm::vec3(a.w, b.x, b.y), glm::vec3(b.z, b.w, z));
 }
 
-Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake) {
+Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake,
+                                                   const NodeSpread& spread) {
     std::unique_ptr<PullPass> pass(new PullPass());
     const size_t nS = bake.surfels.size();
     pass->mSurfelCount = uint32_t(nS);
@@ -55,17 +57,18 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
            offsets[pass->mTailLevel - 1] - offsets[pass->mTailLevel - 2] <= kPullTailNodes)
         --pass->mTailLevel;
     KernelLayout layout;
-    layout.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                       VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
+    layout.bindings = {
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
     layout.pushBytes = sizeof(PullPush);
     layout.specialization = {kPullModeLevel};
     PIC_TRY_ASSIGN(pass->mLevel, Kernel::create(context, kSpirvPullComp, layout, "pull (level)"));
     layout.specialization = {kPullModeTail};
     PIC_TRY_ASSIGN(pass->mTail, Kernel::create(context, kSpirvPullComp, layout, "pull (tail)"));
     // The children, the area and the flux spread (render/cpu/pull.h).
-    const NodeSpread spread = nodeSpread(bake);
+    PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
     std::vector<PullNode> inner(bake.nodes.size() - nS);
     for (size_t n = nS; n < bake.nodes.size(); ++n) {
         const Node& node = bake.nodes[n];
@@ -96,8 +99,9 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     PIC_TRY_ASSIGN(pass->mMoments,
                    Buffer::createWith(context, std::span<const glm::vec4>(zeros),
                                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "node moments"));
-    PIC_TRY_ASSIGN(pass->mMomentView, TexelView::create(context, pass->mMoments,
-                                                        VK_FORMAT_R32G32B32A32_SFLOAT, "node moments"));
+    PIC_TRY_ASSIGN(
+        pass->mMomentView,
+        TexelView::create(context, pass->mMoments, VK_FORMAT_R32G32B32A32_SFLOAT, "node moments"));
     PIC_TRY_ASSIGN(pass->mInnerNodes,
                    Buffer::createWith(context, std::span<const PullNode>(inner),
                                       VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, "pull nodes"));
@@ -116,8 +120,8 @@ Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buff
     PIC_TRY_ASSIGN(mFluxView, TexelView::create(context, nodeFlux, VK_FORMAT_R32G32B32A32_SFLOAT,
                                                 "node flux"));
     const std::array<BindingResource, 7> resources = {
-        BindingResource::storage(0, nodeFlux),          BindingResource::texels(1, mInnerView),
-        BindingResource::storage(2, nodeLight),         BindingResource::texels(3, mFluxView),
+        BindingResource::storage(0, nodeFlux),           BindingResource::texels(1, mInnerView),
+        BindingResource::storage(2, nodeLight),          BindingResource::texels(3, mFluxView),
         BindingResource::storage(4, mLevelOffsetBuffer), BindingResource::storage(5, mMoments),
         BindingResource::texels(6, mMomentView)};
     PIC_TRY_ASSIGN(mLevelSet, mLevel.makeSet(resources));

@@ -1,9 +1,9 @@
 #pragma once
 /// Pull on the GPU (paper 000 Figure 2 step 3, §4.1): node flux = sum of its children's, with
 /// the flux's first moment, one dispatch per hierarchy level, lowest first, and one for the
-/// small upper levels together (shaders/shared/pull.h); each inner node's light, its radiance
-/// Φ / (π·A) as RGBE8 (§4.7) and its flux gradients, is written for cache lighting. CPU twin:
-/// render/cpu/pull.h.
+/// small upper levels together (shaders/shared/pull.h); each inner node's light, the radiance
+/// of its flux spread at its box centre as RGBE8 (§4.7) and the spread's slopes, is written
+/// for cache lighting. CPU twin: render/cpu/pull.h.
 
 #include <memory>
 #include <vector>
@@ -12,6 +12,7 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
+#include "render/cpu/pull.h"
 
 namespace pic::gpu {
 
@@ -19,15 +20,17 @@ namespace pic::gpu {
 /// §4.1), as the pull scales it.
 float radianceScale(float area);
 
-/// Nine relative flux gradients (columns r_R, r_G, r_B, 1/m) as the pull packs them: snorm8 of
-/// a shared binary16 scale (shaders/shared/pull.h), and back.
-glm::uvec3 packNodeGradients(const glm::mat3& gradient);
-glm::mat3 unpackNodeGradients(const glm::uvec3& packed);
+/// A node's nine spread slopes (columns: the R, G, B slopes of render/cpu/pull.h ChannelSpread)
+/// as the pull packs them, snorm8 rounded towards zero (shaders/shared/pull.h), and back.
+glm::uvec3 packNodeSlopes(const glm::mat3& slopes);
+glm::mat3 unpackNodeSlopes(const glm::uvec3& packed);
 
 class PullPass {
 public:
-    /// Uploads each inner node's two children, 1 / (π·area) and flux spread.
-    static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake);
+    /// Uploads each inner node's two children, 1 / (π·area) and flux spread (`spread` =
+    /// nodeSpread(bake)).
+    static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake,
+                                                    const NodeSpread& spread);
     /// Binds the node flux (vec4 per node; its usage must allow uniform texel buffers) and
     /// node light (4 words per node, shaders/shared/pull.h) buffers, whose leaves surfel
     /// lighting writes.
@@ -45,11 +48,11 @@ private:
     VkDescriptorSet mTailSet = VK_NULL_HANDLE;
     uint32_t mTailLevel = 0;    ///< levels [mTailLevel, end) are the tail's
     Buffer mLevelOffsetBuffer;  ///< the bake's level offsets
-    Buffer mInnerNodes;    ///< PullNode per inner node (none for a single surfel)
-    TexelView mInnerView;  ///< mInnerNodes as RGBA32UI texels
-    TexelView mFluxView;   ///< the node flux as RGBA32F texels
-    Buffer mMoments;        ///< 3 vec4 per node: the flux's first moment per channel
-    TexelView mMomentView;  ///< mMoments as RGBA32F texels
+    Buffer mInnerNodes;         ///< PullNode per inner node (none for a single surfel)
+    TexelView mInnerView;       ///< mInnerNodes as RGBA32UI texels
+    TexelView mFluxView;        ///< the node flux as RGBA32F texels
+    Buffer mMoments;            ///< 3 vec4 per node: the flux's first moment per channel
+    TexelView mMomentView;      ///< mMoments as RGBA32F texels
     uint32_t mSurfelCount = 0;
     std::vector<uint32_t> mLevelOffsets;
 };

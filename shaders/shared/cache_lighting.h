@@ -26,31 +26,31 @@ PIC_CONST(uint, kCachePerSubgroup, 1u);
 // Largest |radiance| a half-float cache coefficient holds; larger values are clamped.
 PIC_CONST(float, kHalfMax, 65504.0f);
 
-// A runtime-projected link as the GPU reads it: 32 bytes, two texels of 4 words (the bake's
-// RtpLink, tint and offset are 26). Its node's flux comes as radiance Φ / (π·A) (RGBE8, written
-// by surfel lighting and the pull), so the link keeps V = factor·π·A instead of the factor:
-// Φ·factor = (Φ / (π·A))·V. V is the visible fraction of the node in the uniform model and
-// may exceed 1 where the flux weights favour the part the cache sees (binary16 holds it).
+// A runtime-projected link as the GPU reads it: 16 bytes, one texel of 4 words (the bake's
+// RtpLink, tint and offset are 26). Its node's light comes as the radiance of its flux spread
+// (shared/pull.h, written by surfel lighting and the pull), so the link keeps V = factor·π·A
+// instead of the factor: Φ·factor = (Φ / (π·A))·V. V is the visible fraction of the node in
+// the uniform model and may exceed 1 where the flux weights favour the part the cache sees
+// (binary16 holds it). The tint (core/color.h encodeLinkTint, there 3 × unorm10) is three
+// unorm8 in the words' top bytes, within 1/510 of its largest channel; the direction
+// (core/color.h encodeOctahedral, there 2 × snorm16) is 2 × snorm12, within 0.05°.
 struct GpuRtpLink {
-    uint node;            // index into the node array
-    uint directionOct;    // unit direction cache → node, octahedral 2 × snorm16
-    uint visibleAndCone;  // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
-    uint tint;            // core/color.h encodeLinkTint
-    uint offsetXY;        // LinkSet::offset, binary16 x | binary16 y << 16, metres
-    uint offsetZ;         // binary16 z
-    uint pad0;
-    uint pad1;
+    uint nodeAndRed;         // node index (bits 0-23) | tint R << 24
+    uint directionAndGreen;  // unit direction cache → node, octahedral x | y << 12 | tint G << 24
+    uint visibleAndCone;     // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
+    uint pointAndBlue;       // box point (render/cpu/pull.h encodeBoxPoint) | tint B << 24
 };
-PIC_STRUCT_CHECK(GpuRtpLink, 32);
+PIC_STRUCT_CHECK(GpuRtpLink, 16);
+PIC_CONST(uint, kGpuLinkNodeBits, 24u);
 
-// An SH-projected link as the GPU reads it: the node index, its tint, its offset as in
-// GpuRtpLink (two words), then its lY² binary16 coefficients (rescaled by π·A to take the
-// node's radiance) two per 32-bit word, the last word's high half zero when lY² is odd, and
-// zero words up to a multiple of 4, so that 2- or 4-word texels divide it: 8, 12, 12 words for
+// An SH-projected link as the GPU reads it: the node index, its tint (unorm10 as in the bake),
+// its box point, then its lY² binary16 coefficients (rescaled by π·A to take the node's
+// radiance) two per 32-bit word, the last word's high half zero when lY² is odd, and zero
+// words up to a multiple of 4, so that 2- or 4-word texels divide it: 8, 8, 12 words for
 // lY = 2, 3, 4.
 #ifdef __cplusplus
 inline constexpr uint shLinkWords(uint countY) {
-    return (4u + (countY + 1u) / 2u + 3u) / 4u * 4u;
+    return (3u + (countY + 1u) / 2u + 3u) / 4u * 4u;
 }
 #endif
 

@@ -2,7 +2,7 @@
 #define PIC_SHADERS_SHARED_PULL_H
 // Pull (paper 000 Figure 2 step 3): one dispatch per hierarchy level. Besides the float flux
 // and its first moment it writes each inner node's light as cache lighting reads it: its
-// radiance Φ / (π·A) as RGBE8 (paper 000 §4.7) and its flux gradients.
+// radiance Φ / (π·A) as RGBE8 (paper 000 §4.7) and its flux's limited linear spread.
 #include "glue.h"
 
 PIC_NAMESPACE_BEGIN
@@ -62,10 +62,12 @@ PullNode fetchPullNode(usamplerBuffer records, uint i) {
 }
 #endif
 
-// A node as cache lighting reads it: one RGBA32UI texel. Words 0-2 hold its relative flux
-// gradients r_R, r_G, r_B (1/m, render/cpu/pull.h) as nine snorm8 of a shared binary16 scale:
-// word 0 r_R.xyz r_G.x, word 1 r_G.yz r_B.xy, word 2 r_B.z | scale << 16; word 3 its radiance
-// Φ / (π·A) as RGBE8. Leaves have no gradient (words 0-2 zero).
+// A node as cache lighting reads it: one RGBA32UI texel (render/cpu/pull.h ChannelSpread).
+// Words 0-2 hold the slopes of its limited flux spread per channel along its box's axes, nine
+// snorm8 rounded towards zero so that each channel's Σ|slope| stays ≤ 1: word 0 R.xyz G.x,
+// word 1 G.yz B.xy, word 2 B.z in bits 0-7; word 3 the spread's radiance at the box centre,
+// centre / (π·A), as RGBE8. A link at box point u reads radiance·(1 + slopes·u) per channel.
+// Leaves have no slopes (words 0-2 zero).
 PIC_CONST(uint, kNodeLightRadianceWord, 3u);
 
 struct PullPush {

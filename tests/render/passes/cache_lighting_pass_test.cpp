@@ -21,15 +21,16 @@ namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
 
-TEST(GpuCacheLighting, RtpLinksPackIntoThirtyTwoBytes) {
+TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
     // factor = V / (π·A) (bake/link_generation.cpp); the GPU keeps V as binary16.
     const float area = 0.37f;
     const uint32_t tint = encodeLinkTint({0.25f, 1.0f, 0.5f}).code;
-    const uint16_t offset[3] = {floatToHalf(-0.5f), floatToHalf(2.0f), floatToHalf(0.125f)};
-    const auto pack = [&](float visible, float oneMinusCos) {
-        const gpu::RtpLink link{42, visible / (kPi * area), encodeOctahedral({0, 0, 1}),
+    const uint32_t point = 0x7F80C1u;  // box point (−63, −128 → −1, 127) / 127
+    const glm::vec3 direction = glm::normalize(glm::vec3(0.3f, -0.5f, -0.8f));
+    const auto pack = [&](float visible, float oneMinusCos, uint32_t node = 42) {
+        const gpu::RtpLink link{node, visible / (kPi * area), encodeOctahedral(direction),
                                 oneMinusCos};
-        return gpu::packRtpLink(link, tint, offset, area);
+        return gpu::packRtpLink(link, tint, point, area);
     };
     const auto visibleOf = [](const gpu::GpuRtpLink& l) {
         return halfToFloat(uint16_t(l.visibleAndCone & 0xFFFFu));
@@ -41,16 +42,33 @@ TEST(GpuCacheLighting, RtpLinksPackIntoThirtyTwoBytes) {
     for (const float visible : {5.5f, 1.0f, 0.75f, 0.3f, 1e-3f}) {
         for (const float oneMinusCos : {2.0f, 0.5f, 1e-2f, 3e-5f, 1e-7f}) {
             const gpu::GpuRtpLink l = pack(visible, oneMinusCos);
-            EXPECT_EQ(l.node, 42u);
-            EXPECT_EQ(l.directionOct, encodeOctahedral({0, 0, 1}));
-            EXPECT_EQ(l.tint, tint);
-            EXPECT_EQ(l.offsetXY, uint32_t(offset[0]) | uint32_t(offset[1]) << 16);
-            EXPECT_EQ(l.offsetZ, offset[2]);
+            EXPECT_EQ(l.nodeAndRed & 0xFFFFFFu, 42u);
+            EXPECT_EQ(l.pointAndBlue & 0xFFFFFFu, point);
             // binary16: relative 2^-11 for normal values, 2^-25 absolute below 2^-14.
             EXPECT_NEAR(visibleOf(l), visible, visible / 2048.0f);
             EXPECT_NEAR(coneOf(l), oneMinusCos, std::max(oneMinusCos / 2048.0f, 3e-8f));
         }
     }
+    // The tint as unorm8 in the top bytes, within half a step.
+    const gpu::GpuRtpLink l = pack(1.0f, 0.1f, (1u << 24) - 1);
+    EXPECT_EQ(l.nodeAndRed & 0xFFFFFFu, (1u << 24) - 1);
+    const glm::vec3 tint8 =
+        glm::vec3(l.nodeAndRed >> 24, l.directionAndGreen >> 24, l.pointAndBlue >> 24) / 255.0f;
+    const glm::vec3 expected = decodeLinkTint(tint);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(tint8[c], expected[c], 0.5f / 255.0f + 1e-6f);
+    EXPECT_EQ(gpu::packRtpLink({1, 1.0f, 0, 0.1f}, kNeutralLinkTint, 0, 1.0f).nodeAndRed >> 24,
+              255u);
+    // The direction as 2 × snorm12, decoded as shaders/lib/sh.glsl decodeOctahedral12 does.
+    const auto snorm12 = [](uint32_t bits) {
+        return std::max(float(int32_t(bits << 20) >> 20) / 2047.0f, -1.0f);
+    };
+    const uint32_t oct = l.directionAndGreen;
+    const float u = snorm12(oct & 0xFFFu), v = snorm12((oct >> 12) & 0xFFFu);
+    glm::vec3 decoded(u, v, 1.0f - std::abs(u) - std::abs(v));
+    if (decoded.z < 0.0f)
+        decoded = {(1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f),
+                   (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f), decoded.z};
+    EXPECT_GT(glm::dot(glm::normalize(decoded), direction), std::cos(0.05f * kPi / 180.0f));
     // A link too faint for binary16 keeps its smallest step instead of reading as padding;
     // padding (factor 0) stays 0; V saturates at 65504.
     EXPECT_EQ(pack(1e-9f, 0.1f).visibleAndCone & 0xFFFFu, 1u);
@@ -79,10 +97,10 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
     auto gpu =
         test::gpuFor(b, {}, {.cachePerSubgroup = perSubgroup, .maxLinkTexelWords = texelWords});
     ASSERT_TRUE(gpu);
-    // A link is 8 words (RTP) or 4 + ⌈lY²/2⌉ rounded up to a multiple of 4; every device
+    // A link is 4 words (RTP) or 3 + ⌈lY²/2⌉ rounded up to a multiple of 4; every device
     // reads single words, and lavapipe texels of 2, 3 and 4 words, of which the pass takes 4
     // or 2 before 3.
-    const uint32_t linkWords = mode == LinkMode::Rtp ? 8 : gpu::shLinkWords(bandsY * bandsY);
+    const uint32_t linkWords = mode == LinkMode::Rtp ? 4 : gpu::shLinkWords(bandsY * bandsY);
     EXPECT_EQ(linkWords % gpu->linkTexelWords(), 0u);
     EXPECT_LE(gpu->linkTexelWords(), texelWords);
     if (texelWords == 1) {
