@@ -99,6 +99,20 @@ EncodedLinkTint encodeLinkTint(const glm::vec3& tint) {
     return {code, largest};
 }
 
+glm::vec3 decodeOctahedral(uint32_t code) {
+    const auto fromSnorm16 = [](uint32_t bits) {
+        return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f);
+    };
+    const float u = fromSnorm16(code & 0xffffu);
+    const float v = fromSnorm16(code >> 16);
+    glm::vec3 dir(u, v, 1.0f - std::abs(u) - std::abs(v));
+    if (dir.z < 0.0f) {
+        dir.x = (1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f);
+        dir.y = (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+    }
+    return glm::normalize(dir);
+}
+
 uint32_t packRgbe8(const glm::vec3& rgb) {
     // Negative and NaN channels fail `c > 0` and store 0.
     const auto clampChannel = [](float c) { return c > 0.0f ? std::min(c, kRgbe8Max) : 0.0f; };

@@ -3,20 +3,17 @@
 /// vectors in 32 bits and the shared-exponent RGBE8 HDR format (paper 000 §4.7 uses a shared
 /// exponent too).
 
-#include <algorithm>
 #include <bit>
-#include <cmath>
 #include <cstdint>
 
 #include <glm/common.hpp>
-#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace pic {
 
 /// Linear RGB to YCoCg: Y = R/4 + G/2 + B/4, Co = (R - B)/2, Cg = (-R + 2G - B)/4. Inline,
-/// as the next: cache lighting converts per link.
+/// as is its inverse: the CPU twin's cache lighting converts per tinted link.
 inline glm::vec3 rgbToYCoCg(const glm::vec3& rgb) {
     // Lifting steps of paper 000 eq. 7; t = (R + B)/2.
     const float co = 0.5f * (rgb.r - rgb.b);
@@ -62,21 +59,8 @@ inline float halfToFloat(uint16_t bits) {
 /// input need not be normalised; a zero or non-finite vector encodes +z.
 uint32_t encodeOctahedral(const glm::vec3& unitDir);
 
-/// Unit direction of an octahedral code from encodeOctahedral (inline: the CPU twin's cache
-/// lighting decodes one per link and update).
-inline glm::vec3 decodeOctahedral(uint32_t code) {
-    const auto fromSnorm16 = [](uint32_t bits) {
-        return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f);
-    };
-    const float u = fromSnorm16(code & 0xffffu);
-    const float v = fromSnorm16(code >> 16);
-    glm::vec3 dir(u, v, 1.0f - std::abs(u) - std::abs(v));
-    if (dir.z < 0.0f) {
-        dir.x = (1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f);
-        dir.y = (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f);
-    }
-    return glm::normalize(dir);
-}
+/// Unit direction of an octahedral code from encodeOctahedral.
+glm::vec3 decodeOctahedral(uint32_t code);
 
 /// The chroma per luma (Co/Y, Cg/Y) of a YCoCg colour, clamped to what non-negative RGB
 /// allows (|Co| ≤ 2Y, |Cg| ≤ Y); (0, 0) where Y ≤ 0. The SH caches predict the chroma of

@@ -86,7 +86,7 @@ struct CacheSh {
     }
 };
 
-/// The YCoCg flux link `slot` carries: its node's spread at the link's box point times the
+/// The YCoCg flux a link carries: its node's spread at the link's box point times the
 /// link's tint. Neutral links (81 % of the atrium's) stay in YCoCg, where the spread is linear
 /// too; tinted ones multiply in RGB.
 inline glm::vec3 linkFlux(const NodeLight& node, uint32_t tint, const glm::vec3& point) {
