@@ -191,6 +191,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     HierarchyParams hierarchyParams;
     hierarchyParams.method = p.hierarchy;
     hierarchyParams.sceneExtent = scene.bounds.diagonal();
+    hierarchyParams.rays = rays.get();
     PIC_TRY_ASSIGN(SurfelHierarchy hierarchy, buildHierarchy(std::move(surfels), hierarchyParams));
     bake.surfels = std::move(hierarchy.surfels);
     bake.nodes = std::move(hierarchy.nodes);

@@ -23,7 +23,7 @@ struct BakeOptions {
     std::optional<float> gridCell;
     std::optional<float> lightmapTexel;
     LinkMode linkMode = LinkMode::Rtp;
-    HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
+    HierarchyMethod hierarchy = HierarchyMethod::Visible;
     uint32_t linkSamples = 16;
     uint32_t exposureRays = 64;
     LinkReads linkReads = LinkReads::Visible;

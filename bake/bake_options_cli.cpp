@@ -11,8 +11,10 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     mTexelOption = command.add_option("--lightmap-texel", mLightmapTexel,
                                       "light-map texel size in metres (default: about 8k texels over the scene's area)");
     command.add_option("--link-mode", mLinkMode, "sh or rtp (default rtp)")->check(CLI::IsMember({"sh", "rtp"}));
-    command.add_option("--hierarchy", mHierarchy, "agglomerative or kdtree (default agglomerative)")
-        ->check(CLI::IsMember({"agglomerative", "kdtree"}));
+    command.add_option("--hierarchy", mHierarchy,
+                       "visible (clusters that cannot see each other stay apart), agglomerative "
+                       "(the paper's) or kdtree (default visible)")
+        ->check(CLI::IsMember({"visible", "agglomerative", "kdtree"}));
     command.add_option("--link-samples", mOptions.linkSamples, "visibility rays per node estimate (default 16)");
     command.add_option("--exposure-rays", mOptions.exposureRays,
                        "rays per surfel that weight a node's flux towards its exposed surfels; 0: the "
@@ -34,7 +36,9 @@ BakeOptions BakeOptionFlags::toOptions() const {
     if (*mGridOption) options.gridCell = mGridCell;
     if (*mTexelOption) options.lightmapTexel = mLightmapTexel;
     options.linkMode = mLinkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
-    options.hierarchy = mHierarchy == "kdtree" ? HierarchyMethod::KdTree : HierarchyMethod::Agglomerative;
+    options.hierarchy = mHierarchy == "kdtree"          ? HierarchyMethod::KdTree
+                        : mHierarchy == "agglomerative" ? HierarchyMethod::Agglomerative
+                                                        : HierarchyMethod::Visible;
     options.linkReads = mLinkReads == "node" ? LinkReads::Node : LinkReads::Visible;
     return options;
 }

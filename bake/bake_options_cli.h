@@ -24,7 +24,7 @@ private:
     BakeOptions mOptions;
     uint32_t mSurfels = 0, mLinks = 0, mBands = 0, mChromaBands = 0;
     float mGridCell = 0.0f, mLightmapTexel = 0.0f;
-    std::string mLinkMode = "rtp", mHierarchy = "agglomerative", mLinkReads = "visible";
+    std::string mLinkMode = "rtp", mHierarchy = "visible", mLinkReads = "visible";
     CLI::Option* mSurfelsOption = nullptr;
     CLI::Option* mLinksOption = nullptr;
     CLI::Option* mBandsOption = nullptr;

@@ -23,9 +23,6 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 const char* toString(LinkMode mode) { return mode == LinkMode::Sh ? "sh" : "rtp"; }
-const char* toString(HierarchyMethod method) {
-    return method == HierarchyMethod::KdTree ? "kdtree" : "agglomerative";
-}
 
 std::string humanBytes(uint64_t bytes) {
     if (bytes >= (1ull << 30)) return fmt::format("{:.2f} GiB", bytes / double(1ull << 30));
@@ -89,7 +86,7 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                scene.triangles.size(), scene.materials.size(), scene.lights.size(), scene.cameras.size(),
                scene.totalArea, scene.bounds.extent().x, scene.bounds.extent().y, scene.bounds.extent().z);
     fmt::print("  surfels nS      {}\n", withDefault("surfels", std::to_string(p.surfels)));
-    fmt::print("  hierarchy       {}, {} nodes, {} levels\n", toString(p.hierarchy), bake->nodes.size(),
+    fmt::print("  hierarchy       {}, {} nodes, {} levels\n", hierarchyName(p.hierarchy), bake->nodes.size(),
                bake->levelOffsets.size() - 1);
     fmt::print("  grid cell       {}\n", withDefault("grid_cell", fmt::format("{:.4g} m", p.gridCell)));
     fmt::print("  grid caches     {} vertices of {}x{}x{}, {} inside solid geometry ({} copy a neighbour)\n",
@@ -156,7 +153,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     out["file_bytes"] = info->fileSize;
     out["seconds"] = seconds;
     out["params"] = {{"grid_cell", p.gridCell}, {"lightmap_texel", p.lightmapTexel},
-                     {"hierarchy", toString(p.hierarchy)}, {"link_samples", p.linkSamples},
+                     {"hierarchy", hierarchyName(p.hierarchy)}, {"link_samples", p.linkSamples},
                      {"exposure_rays", p.exposureRays},
                      {"link_reads", p.linkReads == LinkReads::Node ? "node" : "visible"},
                      {"relax_iterations", p.relaxIterations}, {"seed", p.seed}};
@@ -174,7 +171,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     fmt::print("  links: {} per cache, {}, bands y {} c {}\n", info->linksPerCache, toString(p.linkMode),
                p.bandsY, p.bandsC);
     fmt::print("  grid cell {:.4g} m, light-map texel {:.4g} m, hierarchy {}, seed {}\n", p.gridCell,
-               p.lightmapTexel, toString(p.hierarchy), p.seed);
+               p.lightmapTexel, hierarchyName(p.hierarchy), p.seed);
     for (const auto& [name, bytes] : info->sectionBytes) fmt::print("  section {:<16} {}\n", name, humanBytes(bytes));
     fmt::print("  file {}\n", humanBytes(info->fileSize));
     for (const auto& [stage, s] : seconds.items()) fmt::print("  stage {:<14} {:.2f} s\n", stage, s.get<double>());

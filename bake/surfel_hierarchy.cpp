@@ -79,9 +79,13 @@ Result<void> validate(const std::vector<Surfel>& surfels, const HierarchyParams&
     if (surfels.size() > kMaxSurfels)
         return fail(ErrorCode::InvalidInput, "surfel hierarchy: {} surfels, at most {} supported",
                     surfels.size(), kMaxSurfels);
-    if (params.method != HierarchyMethod::Agglomerative && params.method != HierarchyMethod::KdTree)
+    if (params.method != HierarchyMethod::Agglomerative &&
+        params.method != HierarchyMethod::KdTree && params.method != HierarchyMethod::Visible)
         return fail(ErrorCode::InvalidInput, "surfel hierarchy: unknown method {}",
                     static_cast<uint32_t>(params.method));
+    if (params.method == HierarchyMethod::Visible && !params.rays)
+        return fail(ErrorCode::InvalidInput,
+                    "surfel hierarchy: method visible needs the scene's rays");
     if (!(std::isfinite(params.normalWeight) && params.normalWeight >= 0.0f))
         return fail(ErrorCode::InvalidInput,
                     "surfel hierarchy: normal weight C_n = {} must be finite and >= 0",
@@ -176,11 +180,13 @@ std::vector<uint32_t> mortonOrder(const std::vector<Surfel>& surfels) {
     return order;
 }
 
-// The weights of the metric d(a, b), with the spatial term's normalisation folded in.
+// The weights of the metric d(a, b), with the spatial term's normalisation folded in, and
+// the scene's rays for the occlusion term (none: geometry only).
 struct Metric {
     float invExtent2 = 1.0f;
     float normalWeight = 0.0f;
     float balanceWeight = 0.0f;
+    const EmbreeScene* rays = nullptr;
 };
 
 // A cluster that has not been merged yet, with what the metric reads of it.
@@ -213,23 +219,54 @@ float distance(const ActiveCluster& a, const ActiveCluster& b, const Metric& met
            metric.balanceWeight * std::abs(a.area - b.area) / std::max(a.area, b.area);
 }
 
+// Clusters that cannot see each other (the two faces of a wall, a room's floor and the next
+// room's) merge only when no cluster they see is in reach: a node that straddles a wall
+// spreads the light of one side over the other (paper 000 §5.2 (c)). The penalty exceeds the
+// rest of the metric (at most 1 + 2·C_n + C_b) and stays below kClassPenalty.
+constexpr float kOcclusionPenalty = 4.0f;
+// The segment tested joins the clusters' centres, each lifted off its surface along its mean
+// normal by this fraction of their distance, so that neighbours on a bent or curved surface
+// (the sagitta between them is about d²/8r) and across a corner still see each other.
+constexpr float kOcclusionLift = 0.25f;
+
+// Whether the scene blocks the segment between clusters a and b (a before b in cluster order,
+// so that the test is the same from either side).
+bool occluded(const ActiveCluster& a, const ActiveCluster& b, const EmbreeScene& rays) {
+    const float d = glm::distance(a.center, b.center);
+    const glm::vec3 from = a.center + (kOcclusionLift * d) * a.normal;
+    const glm::vec3 delta = b.center + (kOcclusionLift * d) * b.normal - from;
+    const float length = glm::length(delta);
+    const float epsilon = rays.epsilon();
+    if (!(length > 2.0f * epsilon)) return false;
+    return rays.occluded(from, delta / length, epsilon, length - epsilon);
+}
+
 // Position of the cluster nearest to active[i] among the kSearchRadius positions on either
-// side; ties go to the lowest position, which orders all candidate pairs totally.
+// side; ties go to the lowest position, which orders all candidate pairs totally. The
+// occlusion term is tested in order of the rest of the metric, only while it can still
+// change the answer.
 uint32_t nearestInWindow(const std::vector<ActiveCluster>& active, size_t i, const Metric& metric) {
     size_t begin = i > kSearchRadius ? i - kSearchRadius : 0;
     size_t end = std::min(active.size(), i + kSearchRadius + 1);
-    float best = std::numeric_limits<float>::infinity();
-    size_t nearest = i == begin ? i + 1 : begin;
+    std::array<std::pair<float, uint32_t>, 2 * kSearchRadius> candidates;
+    size_t count = 0;
     for (size_t j = begin; j < end; ++j) {
         if (j == i) continue;
         float d =
             j < i ? distance(active[j], active[i], metric) : distance(active[i], active[j], metric);
-        if (d < best) {
-            best = d;
-            nearest = j;
-        }
+        candidates[count++] = {d, static_cast<uint32_t>(j)};
     }
-    return static_cast<uint32_t>(nearest);
+    const auto first = candidates.begin(), last = candidates.begin() + count;
+    if (!metric.rays) return std::min_element(first, last)->second;
+    std::sort(first, last);
+    std::pair<float, uint32_t> best{std::numeric_limits<float>::infinity(), 0};
+    for (auto it = first; it != last && it->first <= best.first; ++it) {
+        const size_t j = it->second;
+        const bool blocked = j < i ? occluded(active[j], active[i], *metric.rays)
+                                   : occluded(active[i], active[j], *metric.rays);
+        best = std::min(best, {it->first + (blocked ? kOcclusionPenalty : 0.0f), it->second});
+    }
+    return best.second;
 }
 
 // Hierarchical agglomerative clustering under the paper's metric, in the parallel
@@ -248,7 +285,8 @@ BuildTree buildAgglomerative(const std::vector<Surfel>& surfels, const Hierarchy
     BuildTree tree{nS, {}};
     tree.children.reserve(nS - 1);
     const Metric metric{1.0f / (params.sceneExtent * params.sceneExtent), params.normalWeight,
-                        params.balanceWeight};
+                        params.balanceWeight,
+                        params.method == HierarchyMethod::Visible ? params.rays : nullptr};
 
     std::vector<ClusterGeometry> geometry(2 * size_t{nS} - 1);
     std::vector<uint32_t> order = mortonOrder(surfels);

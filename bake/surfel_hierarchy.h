@@ -7,6 +7,7 @@
 
 #include "core/bake_data.h"
 #include "core/error.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 
@@ -16,6 +17,11 @@ struct HierarchyParams {
     float normalWeight = 0.1f;    ///< C_n, weight of 1 − ⟨m_a, m_b⟩ in the metric
     float balanceWeight = 0.02f;  ///< C_b, weight of |A_a − A_b| / max(A_a, A_b) in the metric
     float sceneExtent = 1.0f;     ///< ‖x_max − x_min‖ of the scene in metres, > 0
+    /// The scene's rays, which HierarchyMethod::Visible needs: clusters that cannot see each
+    /// other (the two faces of a wall, a room's floor and the next room's, a cabinet's back and
+    /// the wall behind it) merge only when no cluster they see is in reach, so that a node does
+    /// not spread the light of one side of a wall over the other (paper 000 §5.2 (c)).
+    const EmbreeScene* rays = nullptr;
 };
 
 /// Surfels in leaf order and the 2·nS − 1 nodes over them, laid out as documented in

@@ -31,11 +31,12 @@ namespace {
 using Json = nlohmann::ordered_json;
 constexpr double kPi = std::numbers::pi;
 
-/// The five band-0 RGB estimates of one cache (see the header), in W/(m²·sr) × y00.
+/// The six band-0 RGB estimates of one cache (see the header), in W/(m²·sr) × y00.
 struct Estimates {
-    glm::dvec3 traced{0.0}, gather{0.0}, cut{0.0}, mean{0.0}, linked{0.0};
+    glm::dvec3 traced{0.0}, gather{0.0}, cut{0.0}, mean{0.0}, spread{0.0}, linked{0.0};
     Estimates& operator+=(const Estimates& o) {
-        traced += o.traced, gather += o.gather, cut += o.cut, mean += o.mean, linked += o.linked;
+        traced += o.traced, gather += o.gather, cut += o.cut, mean += o.mean, spread += o.spread;
+        linked += o.linked;
         return *this;
     }
 };
@@ -69,12 +70,14 @@ Json ratiosJson(const Estimates& e, uint32_t caches) {
             {"representation", lumaRatio(e.gather, e.traced)},
             {"cut_coverage", lumaRatio(e.cut, e.gather)},
             {"node_mean_radiance", lumaRatio(e.mean, e.cut)},
-            {"visibility_estimate", lumaRatio(e.linked, e.mean)},
+            {"node_spread_radiance", lumaRatio(e.spread, e.cut)},
+            {"visibility_estimate", lumaRatio(e.linked, e.spread)},
             {"channels", {{"linked_over_traced", channelRatios(e.linked, e.traced)},
                           {"representation", channelRatios(e.gather, e.traced)},
                           {"cut_coverage", channelRatios(e.cut, e.gather)},
                           {"node_mean_radiance", channelRatios(e.mean, e.cut)},
-                          {"visibility_estimate", channelRatios(e.linked, e.mean)}}}};
+                          {"node_spread_radiance", channelRatios(e.spread, e.cut)},
+                          {"visibility_estimate", channelRatios(e.linked, e.spread)}}}};
 }
 
 }  // namespace
@@ -130,6 +133,24 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 read[c] *= colour[c] * weightedArea[node] / colouredArea[node][c];
         return read;
     };
+    // What a link reads for surfel s with the node's flux spread (render/cpu/pull.h): the
+    // modelled radiance times the limited spread at the surfel's box point over the flux.
+    const NodeSpread spread = nodeSpread(*bake);
+    std::vector<glm::mat3> moment(bake->nodes.size()), slopes(bake->nodes.size());
+    std::vector<glm::vec3> centreFlux(bake->nodes.size());
+    pullFluxSpread(*bake, spread, flux, moment, centreFlux, slopes);
+    auto spreadModelled = [&](uint32_t node, uint32_t s) {
+        glm::dvec3 read = modelled(node, s);
+        if (node < nS) return read;
+        const glm::vec3 u = decodeBoxPoint(
+            encodeBoxPoint(spread, node, bake->surfels[s].position - spread.centroid[node]));
+        for (int c = 0; c < 3; ++c)
+            read[c] *=
+                flux[node][c] > 0.0f
+                    ? centreFlux[node][c] * (1.0f + glm::dot(slopes[node][c], u)) / flux[node][c]
+                    : 0.0f;
+        return read;
+    };
 
     const size_t nC = bake->caches.size();
     const size_t examined = std::min<size_t>(std::max(params.caches, 1u), nC);
@@ -182,6 +203,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 if (!view.visible) continue;
                 e.cut += radiance[s] * (double(view.solidAngle) * y00);
                 e.mean += modelled(n, s) * (double(view.solidAngle) * y00);
+                e.spread += spreadModelled(n, s) * (double(view.solidAngle) * y00);
             }
         }
         // Uniform directions over the cache's sphere (hemisphere for light-map caches).
@@ -222,19 +244,20 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
 
     std::printf("%s: one bounce, %zu of %zu caches, nL %u (%s)\n", params.scenePath.c_str(), examined,
                 nC, nL, bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");
-    std::printf("  %-9s %7s %14s %15s %10s %11s %11s\n", "caches", "count", "linked/traced",
-                "representation", "coverage", "node mean", "visibility");
-    const char* factors[] = {"linked_over_traced", "representation", "cut_coverage",
-                             "node_mean_radiance", "visibility_estimate"};
+    std::printf("  %-9s %7s %14s %15s %10s %11s %11s %11s\n", "caches", "count", "linked/traced",
+                "representation", "coverage", "node mean", "node spread", "visibility");
+    const char* factors[] = {"linked_over_traced", "representation",       "cut_coverage",
+                             "node_mean_radiance", "node_spread_radiance", "visibility_estimate"};
     for (const char* kind : {"all", "grid", "lightmap"}) {
         const Json& r = json[kind];
-        std::printf("  %-9s %7u %14.4f %15.4f %10.4f %11.4f %11.4f\n", kind, r["caches"].get<uint32_t>(),
-                    r[factors[0]].get<double>(), r[factors[1]].get<double>(), r[factors[2]].get<double>(),
-                    r[factors[3]].get<double>(), r[factors[4]].get<double>());
+        std::printf("  %-9s %7u %14.4f %15.4f %10.4f %11.4f %11.4f %11.4f\n", kind,
+                    r["caches"].get<uint32_t>(), r[factors[0]].get<double>(), r[factors[1]].get<double>(),
+                    r[factors[2]].get<double>(), r[factors[3]].get<double>(), r[factors[4]].get<double>(),
+                    r[factors[5]].get<double>());
         // The same factors per channel, R G B, under their luma.
         std::printf("  %-9s %7s", "", "R G B");
-        const int widths[] = {14, 15, 10, 11, 11};
-        for (int f = 0; f < 5; ++f) {
+        const int widths[] = {14, 15, 10, 11, 11, 11};
+        for (int f = 0; f < 6; ++f) {
             const Json& c = r["channels"][factors[f]];
             char text[32];
             std::snprintf(text, sizeof text, "%.2f %.2f %.2f", c[0].get<double>(), c[1].get<double>(),

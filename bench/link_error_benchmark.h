@@ -1,7 +1,7 @@
 #pragma once
 /// `picbench links`: where the linked caches' error comes from. Bakes a scene, lights the
 /// surfels directly (one bounce, so that errors do not compound) and, for a sample of caches,
-/// compares the band-0 luma (and each RGB channel) of five estimates of the same incident
+/// compares the band-0 luma (and each RGB channel) of six estimates of the same incident
 /// radiance:
 ///   traced    ray-traced radiance of what the first runtime bounce holds (the truth):
 ///             emitters seen directly and punctual light reflected once, with shadow rays,
@@ -11,10 +11,14 @@
 ///             spread by the bake's flux weights, Φ·w/(π·Σ w·a) (Φ/(πA) with uniform
 ///             weights), per channel in the surfels' colours κ, Φ·w·κ/(π·Σ w·κ·a), with
 ///             visible-part reads (the links' tints), exact visibility,
-///   linked    the runtime's cache (estimated visibility).
+///   spread    the same with the node's limited linear flux spread (render/cpu/pull.h)
+///             evaluated at each surfel: what the runtime's links read, with exact visibility,
+///   linked    the runtime's cache (estimated visibility, the spread read at each link's box
+///             point).
 /// Their ratios factor linked/traced into the surfel representation (gather/traced), the
-/// coverage of the cut (cut/gather), the node radiance model (mean/cut) and the visibility
-/// estimate (linked/mean). Writes JSON; never asserts.
+/// coverage of the cut (cut/gather), the node radiance model with the spread (spread/cut) and
+/// the visibility estimate (linked/spread); mean/cut, the model without the spread, is printed
+/// beside them. Writes JSON; never asserts.
 
 #include <string>
 

@@ -30,7 +30,22 @@ enum class LinkMode : uint32_t {
 enum class HierarchyMethod : uint32_t {
     Agglomerative = 0,  ///< clustering with the paper's metric
     KdTree = 1,         ///< median-split kd-tree (fast)
+    Visible = 2,        ///< the paper's clustering, keeping apart clusters that cannot see
+                        ///< each other (bake/surfel_hierarchy.h)
 };
+
+/// The method's name in the CLI, the bake file and reports.
+inline const char* hierarchyName(HierarchyMethod method) {
+    switch (method) {
+    case HierarchyMethod::Agglomerative:
+        return "agglomerative";
+    case HierarchyMethod::KdTree:
+        return "kdtree";
+    case HierarchyMethod::Visible:
+        return "visible";
+    }
+    return "unknown";
+}
 
 /// Whose flux a link reads (bake/link_generation.h).
 enum class LinkReads : uint32_t {
@@ -48,7 +63,7 @@ struct BakeParams {
     float gridCell = 0.0f;           ///< metres
     float lightmapTexel = 0.0f;      ///< metres
     LinkMode linkMode = LinkMode::Rtp;
-    HierarchyMethod hierarchy = HierarchyMethod::Agglomerative;
+    HierarchyMethod hierarchy = HierarchyMethod::Visible;
     uint32_t linkSamples = 16;       ///< visibility rays per node estimate
     uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
                                      ///< (bake/surfel_exposure.h); 0: uniform node radiance

@@ -137,10 +137,6 @@ const char* linkModeName(LinkMode mode) {
     return mode == LinkMode::Sh ? "sh" : "rtp";
 }
 
-const char* hierarchyName(HierarchyMethod method) {
-    return method == HierarchyMethod::KdTree ? "kdtree" : "agglomerative";
-}
-
 const char* linkReadsName(LinkReads reads) {
     return reads == LinkReads::Node ? "node" : "visible";
 }
@@ -152,8 +148,10 @@ Result<void> checkParams(const BakeParams& p, ErrorCode code, const std::string&
     if (p.linkMode != LinkMode::Sh && p.linkMode != LinkMode::Rtp)
         return fail(code, "{}: link mode {} is neither sh (0) nor rtp (1)", what,
                     static_cast<uint32_t>(p.linkMode));
-    if (p.hierarchy != HierarchyMethod::Agglomerative && p.hierarchy != HierarchyMethod::KdTree)
-        return fail(code, "{}: hierarchy method {} is neither agglomerative (0) nor kdtree (1)",
+    if (p.hierarchy != HierarchyMethod::Agglomerative && p.hierarchy != HierarchyMethod::KdTree &&
+        p.hierarchy != HierarchyMethod::Visible)
+        return fail(code,
+                    "{}: hierarchy method {} is none of agglomerative (0), kdtree (1), visible (2)",
                     what, static_cast<uint32_t>(p.hierarchy));
     if (!std::isfinite(p.gridCell) || p.gridCell < 0.0f)
         return fail(code, "{}: grid cell {} m is not a finite non-negative length", what,
@@ -455,7 +453,7 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     // The name lists follow the enumerators' values.
     PIC_TRY_ASSIGN(const uint32_t linkMode, reader.oneOf("link_mode", {"sh", "rtp"}));
     PIC_TRY_ASSIGN(const uint32_t hierarchy,
-                   reader.oneOf("hierarchy", {"agglomerative", "kdtree"}));
+                   reader.oneOf("hierarchy", {"agglomerative", "kdtree", "visible"}));
     p.linkMode = static_cast<LinkMode>(linkMode);
     p.hierarchy = static_cast<HierarchyMethod>(hierarchy);
     PIC_TRY_ASSIGN(p.linkSamples, reader.u32("link_samples"));

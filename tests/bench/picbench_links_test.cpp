@@ -36,11 +36,12 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
         const nlohmann::json& r = report.at(kind);
         const double product = r.at("representation").get<double>() *
                                r.at("cut_coverage").get<double>() *
-                               r.at("node_mean_radiance").get<double>() *
+                               r.at("node_spread_radiance").get<double>() *
                                r.at("visibility_estimate").get<double>();
         EXPECT_NEAR(product, r.at("linked_over_traced").get<double>(), 1e-9);
         for (const char* factor : {"linked_over_traced", "representation", "cut_coverage",
-                                   "node_mean_radiance", "visibility_estimate"}) {
+                                   "node_mean_radiance", "node_spread_radiance",
+                                   "visibility_estimate"}) {
             const double value = r.at(factor).get<double>();
             EXPECT_TRUE(std::isfinite(value)) << factor;
             EXPECT_GT(value, 0.8) << factor;
