@@ -2,9 +2,8 @@
 # Accuracy of the cache term against the path-traced reference on the test scenes and the
 # living room, with the default bake (exposure flux weights, links that read the part they
 # see, the visible hierarchy) and with paper 000's (--exposure-rays 0 --link-reads node
-# --hierarchy agglomerative), the nL sweep on
-# cornell and the one-bounce decomposition of the linked caches' error: the commands of
-# docs/accuracy.md. Writes JSON and side-by-side PNGs into ${OUT:-accuracy}/<default|paper>/.
+# --hierarchy agglomerative), the nL sweep on cornell and the one-bounce decomposition of the
+# linked caches' error: the commands of docs/accuracy.md. Writes JSON and side-by-side PNGs into ${OUT:-accuracy}/<default|paper>/.
 # Usage: bash bench/run_accuracy.sh [build-dir]
 set -euo pipefail
 BUILD=${1:-build}
