@@ -119,6 +119,14 @@ void addLink(uint slot) {
 }
 
 void store(uint local) {
+    // Band 0 of each RGB channel never below 0 (the CPU twin's CacheSh::store says why).
+    const vec3 band0 = yCoCgToRgb(vec3(y[0], co[0], cg[0]));
+    if (any(lessThan(band0, vec3(0.0)))) {
+        const vec3 raised = rgbToYCoCg(max(band0, vec3(0.0)));
+        y[0] = raised.x;
+        co[0] = raised.y;
+        cg[0] = raised.z;
+    }
     const uint cache = pc.firstCache + local;
     [[unroll]] for (uint i = 0u; i < kCountY; ++i) cacheY[cache * kCountY + i] = toHalf(y[i]);
     [[unroll]] for (uint i = 0u; i < kCountC; ++i) {

@@ -69,8 +69,16 @@ struct CacheSh {
     std::array<float, kCountY> co{};  // only the first lC² are used
     std::array<float, kCountY> cg{};
 
-    /// Stores cache c (lC² chroma coefficients) into out.
-    void store(size_t c, int countC, CacheValues& out) const {
+    /// Stores cache c (lC² chroma coefficients) into out. Band 0 of each RGB channel is that
+    /// channel's mean radiance, a sum of non-negative fluxes; where they cancel to nothing,
+    /// the spread's and YCoCg's rounding can leave a channel a few ulps below 0, which is
+    /// raised to 0 (shaders/cache_lighting.comp does the same).
+    void store(size_t c, int countC, CacheValues& out) {
+        const glm::vec3 band0 = yCoCgToRgb(glm::vec3(y[0], co[0], cg[0]));
+        if (band0.r < 0.0f || band0.g < 0.0f || band0.b < 0.0f) {
+            const glm::vec3 raised = rgbToYCoCg(glm::max(band0, glm::vec3(0.0f)));
+            y[0] = raised.x, co[0] = raised.y, cg[0] = raised.z;
+        }
         float* dstY = out.y.data() + c * kCountY;
         float* dstCo = out.co.data() + c * countC;
         float* dstCg = out.cg.data() + c * countC;
