@@ -163,6 +163,10 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     p.linkSamples = options.linkSamples;
     if (p.linkSamples < 1 || p.linkSamples > 1024)
         return fail(ErrorCode::InvalidInput, "--link-samples must be in [1, 1024], got {}", p.linkSamples);
+    p.linkFinalSamples = options.linkFinalSamples;
+    if (p.linkFinalSamples < 1 || p.linkFinalSamples > 1024)
+        return fail(ErrorCode::InvalidInput, "--link-final-samples must be in [1, 1024], got {}",
+                    p.linkFinalSamples);
     p.exposureRays = options.exposureRays;
     if (p.exposureRays > 1024)
         return fail(ErrorCode::InvalidInput, "--exposure-rays must be in [0, 1024], got {}", p.exposureRays);
@@ -242,6 +246,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.mode = p.linkMode;
     linkParams.bands = p.bandsY;
     linkParams.samplesPerNode = p.linkSamples;
+    linkParams.finalSamplesPerNode = p.linkFinalSamples;
     linkParams.seed = p.seed;
     linkParams.reads = p.linkReads;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));

@@ -25,6 +25,7 @@ struct BakeOptions {
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Visible;
     uint32_t linkSamples = 16;
+    uint32_t linkFinalSamples = 64;
     uint32_t exposureRays = 64;
     LinkReads linkReads = LinkReads::Visible;
     uint32_t relaxIterations = 4;

@@ -15,7 +15,11 @@ void BakeOptionFlags::addTo(CLI::App& command) {
                        "visible (clusters that cannot see each other stay apart), agglomerative "
                        "(the paper's) or kdtree (default visible)")
         ->check(CLI::IsMember({"visible", "agglomerative", "kdtree"}));
-    command.add_option("--link-samples", mOptions.linkSamples, "visibility rays per node estimate (default 16)");
+    command.add_option(
+        "--link-samples", mOptions.linkSamples,
+        "visibility rays per node estimate while choosing a cache's links (default 16)");
+    command.add_option("--link-final-samples", mOptions.linkFinalSamples,
+                       "visibility rays of each linked node's final estimate (default 64)");
     command.add_option("--exposure-rays", mOptions.exposureRays,
                        "rays per surfel that weight a node's flux towards its exposed surfels; 0: the "
                        "paper's uniform node radiance (default 64)");

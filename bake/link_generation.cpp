@@ -80,7 +80,8 @@ public:
         Rng rng(mParams.seed, cacheIndex);
 
         auto evaluate = [&](uint32_t node) {
-            NodeEstimate e = estimate(node, cache, rng, scratch.samples, rays);
+            NodeEstimate e =
+                estimate(node, cache, mParams.samplesPerNode, rng, scratch.samples, rays);
             scratch.estimates.push_back(e);
             return static_cast<uint32_t>(scratch.estimates.size() - 1);
         };
@@ -123,7 +124,11 @@ public:
         }
         // The cut was chosen by the estimates themselves, so it keeps the nodes whose estimates
         // came out low (winner's curse): re-estimating the sampled nodes with fresh rays makes
-        // the final values unbiased. A node whose fresh samples all miss is not linked.
+        // the final values unbiased. A node whose fresh samples all miss is not linked. The
+        // fresh estimate is what the cache keeps, so it draws more rays: with 16 rays a node's
+        // visible solid angle is off by tens of per cent per cache, and neighbouring caches
+        // that drew differently show as blotches (docs/accuracy.md). Only the nL linked nodes
+        // draw them, and a node with fewer surfels is exact.
         Rng fresh(mParams.seed ^ 0xA5A5A5A5A5A5A5A5ull, cacheIndex);
         chosen.clear();
         for (uint32_t e : closed) {
@@ -131,8 +136,9 @@ public:
                 chosen.push_back(e);
                 continue;
             }
-            NodeEstimate again = estimate(scratch.estimates[e].node, cache, fresh,
-                                          scratch.samples, rays);
+            NodeEstimate again =
+                estimate(scratch.estimates[e].node, cache, mParams.finalSamplesPerNode, fresh,
+                         scratch.samples, rays);
             if (again.visible <= 0.0f) continue;
             // Both sample sets bound the part the cache sees.
             again.firstVisible = std::min(again.firstVisible, scratch.estimates[e].firstVisible);
@@ -221,19 +227,18 @@ private:
         e.readScale = float(whole / weightedArea(n));
     }
 
-    /// Estimates a node from up to K of its surfels: all of them when it has at most K (exact),
-    /// else K drawn in proportion to w·a (stratified over the node's contiguous range of the
+    /// Estimates a node from up to k of its surfels: all of them when it has at most k (exact),
+    /// else k drawn in proportion to w·a (stratified over the node's contiguous range of the
     /// prefix sums), one occlusion ray each. Drawn by weight, sample j estimates
     /// Σ w·Ω·V / Σ w·a by Ω_j·V_j / a_j with bounded variance however uneven the weights; with
     /// uniform weights n·Ω_j is the usual estimate of the solid angle, which the drawn samples
     /// also give for the priority and the cone (that of the node's weighted part).
-    NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, Rng& rng,
+    NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, uint32_t k, Rng& rng,
                           std::vector<VisibleSample>& samples, uint64_t& rays) const {
         const Node& node = mNodes[nodeIndex];
         NodeEstimate e;
         e.node = nodeIndex;
         e.sampleBegin = static_cast<uint32_t>(samples.size());
-        const uint32_t k = mParams.samplesPerNode;
         const uint32_t taken = std::min(node.surfelCount, k);
         e.taken = taken;
         e.exact = node.surfelCount <= k;
@@ -254,7 +259,7 @@ private:
             const Surfel& surfel = mSurfels[s];
             const SurfelView view = viewSurfel(mRays, cache, surfel);
             if (view.solidAngle <= 0.0f) continue;  // faces away or lies behind the cache
-            // Exact: w_j·Ω_j / Σ w·a and Ω_j. Drawn: Ω_j / (K·a_j) and n·Ω_j / K.
+            // Exact: w_j·Ω_j / Σ w·a and Ω_j. Drawn: Ω_j / (k·a_j) and n·Ω_j / k.
             const float share = e.exact ? float(double(mWeights[s]) * view.solidAngle / weightedArea)
                                         : view.solidAngle / (float(taken) * surfel.area);
             const float omega = e.exact ? view.solidAngle
@@ -275,7 +280,7 @@ private:
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
         // An unlucky sample set may miss the visible part of a node (e.g. a few wall surfels
         // in a node that is mostly coplanar with a light-map cache). Such nodes keep the
-        // prior that 1/(K+1) of their bounding sphere's solid angle might be visible, so
+        // prior that 1/(k+1) of their bounding sphere's solid angle might be visible, so
         // nodes near the cache are still refined until their samples are exact.
         if (e.visible > 0.0f || e.exact) {
             e.priority = e.visible;
@@ -337,6 +342,9 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
         return fail(ErrorCode::InvalidInput, "SH links need 1..{} bands, got {}", kMaxShBands, params.bands);
     if (params.samplesPerNode == 0)
         return fail(ErrorCode::InvalidInput, "samples per node must be positive, got {}", params.samplesPerNode);
+    if (params.finalSamplesPerNode == 0)
+        return fail(ErrorCode::InvalidInput, "final samples per node must be positive, got {}",
+                    params.finalSamplesPerNode);
     if (nodes.empty() || surfels.empty() || nodes.size() != 2 * surfels.size() - 1)
         return fail(ErrorCode::InvalidInput, "hierarchy has {} nodes for {} surfels", nodes.size(), surfels.size());
     if (!weights.empty() && weights.size() != surfels.size())

@@ -16,7 +16,8 @@ struct LinkParams {
     uint32_t linksPerCache = 128;  ///< nL
     LinkMode mode = LinkMode::Rtp;
     uint32_t bands = 3;            ///< SH bands per link in SH mode
-    uint32_t samplesPerNode = 16;  ///< visibility rays that estimate one node
+    uint32_t samplesPerNode = 16;  ///< visibility rays per node estimate while choosing the cut
+    uint32_t finalSamplesPerNode = 64;  ///< rays of a linked node's fresh, final estimate
     LinkReads reads = LinkReads::Visible;
     uint64_t seed = 1;
 };

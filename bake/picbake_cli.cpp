@@ -102,10 +102,11 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     fmt::print("  unique caches   {} ({} that see no surface were dropped)\n", bake->caches.size(),
                report.blindCachesDropped);
     fmt::print("  links nL        {}\n", withDefault("links", std::to_string(p.linksPerCache)));
-    fmt::print("  link mode       {}, {} samples per node, {:.1f} links used per cache, "
-               "{:.3g} sr visible per cache, {:.3g} M rays\n",
-               toString(p.linkMode), p.linkSamples, report.links.meanLinksUsed,
-               report.links.meanVisibleSolidAngle, report.links.rays / 1e6);
+    fmt::print(
+        "  link mode       {}, {} samples per node ({} final), {:.1f} links used per cache, "
+        "{:.3g} sr visible per cache, {:.3g} M rays\n",
+        toString(p.linkMode), p.linkSamples, p.linkFinalSamples, report.links.meanLinksUsed,
+        report.links.meanVisibleSolidAngle, report.links.rays / 1e6);
     fmt::print("  flux weights    {}\n", p.exposureRays > 0
                                             ? fmt::format("exposure, {} rays per surfel", p.exposureRays)
                                             : std::string("uniform (--exposure-rays 0)"));
@@ -152,11 +153,15 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     for (const auto& [name, bytes] : info->sectionBytes) out["bytes"][name] = bytes;
     out["file_bytes"] = info->fileSize;
     out["seconds"] = seconds;
-    out["params"] = {{"grid_cell", p.gridCell}, {"lightmap_texel", p.lightmapTexel},
-                     {"hierarchy", hierarchyName(p.hierarchy)}, {"link_samples", p.linkSamples},
+    out["params"] = {{"grid_cell", p.gridCell},
+                     {"lightmap_texel", p.lightmapTexel},
+                     {"hierarchy", hierarchyName(p.hierarchy)},
+                     {"link_samples", p.linkSamples},
+                     {"link_final_samples", p.linkFinalSamples},
                      {"exposure_rays", p.exposureRays},
                      {"link_reads", p.linkReads == LinkReads::Node ? "node" : "visible"},
-                     {"relax_iterations", p.relaxIterations}, {"seed", p.seed}};
+                     {"relax_iterations", p.relaxIterations},
+                     {"seed", p.seed}};
     out["defaults"] = Json::object();
     for (const auto& [key, how] : info->defaults) out["defaults"][key] = how;
     if (json) {

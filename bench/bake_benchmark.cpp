@@ -65,7 +65,8 @@ int runBakeBenchmark(const BakeBenchmarkParams& params) {
                       {"bands_c", last.params.bandsC},
                       {"grid_cell", last.params.gridCell},
                       {"lightmap_texel", last.params.lightmapTexel},
-                      {"link_samples", last.params.linkSamples}};
+                      {"link_samples", last.params.linkSamples},
+                      {"link_final_samples", last.params.linkFinalSamples}};
     json["caches"] = {{"unique", last.caches.size()}, {"grid", info->gridCaches}, {"lightmap", info->lightmapCaches}};
     json["load_seconds"] = loadSeconds;
     json["seconds_median"] = nlohmann::ordered_json::object();

@@ -13,7 +13,7 @@ LIVING="$(dirname "$0")/../../shared/scenes/living_room_sh3d.glb"
 SUN_LAMP="$(dirname "$0")/lightsets/living_room_sun_lamp.json"
 for variant in default paper; do
   X=()
-  [ "$variant" = paper ] && X=(--exposure-rays 0 --link-reads node --hierarchy agglomerative)
+  [ "$variant" = paper ] && X=(--exposure-rays 0 --link-reads node --hierarchy agglomerative --link-final-samples 16)
   A="$BUILD/bench/picbench --quiet accuracy --out-dir $OUT/$variant"
   $A --scene "$SCENES/cornell.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"
   $A --scene "$SCENES/cornell_area.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"

@@ -64,7 +64,8 @@ struct BakeParams {
     float lightmapTexel = 0.0f;      ///< metres
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Visible;
-    uint32_t linkSamples = 16;       ///< visibility rays per node estimate
+    uint32_t linkSamples = 16;       ///< visibility rays per node estimate while choosing the cut
+    uint32_t linkFinalSamples = 64;  ///< visibility rays of a linked node's final estimate
     uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
                                      ///< (bake/surfel_exposure.h); 0: uniform node radiance
     LinkReads linkReads = LinkReads::Visible;

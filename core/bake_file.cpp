@@ -336,6 +336,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["link_mode"] = linkModeName(p.linkMode);
     json["hierarchy"] = hierarchyName(p.hierarchy);
     json["link_samples"] = p.linkSamples;
+    json["link_final_samples"] = p.linkFinalSamples;
     json["exposure_rays"] = p.exposureRays;
     json["link_reads"] = linkReadsName(p.linkReads);
     json["relax_iterations"] = p.relaxIterations;
@@ -377,6 +378,11 @@ public:
         PIC_TRY_ASSIGN(const uint64_t value,
                        unsignedField(key, std::numeric_limits<uint32_t>::max()));
         return static_cast<uint32_t>(value);
+    }
+
+    /// An optional field: `fallback` where the file does not have it.
+    Result<uint32_t> u32Or(const char* key, uint32_t fallback) {
+        return mObject.contains(key) ? u32(key) : fallback;
     }
 
     Result<float> f32(const char* key) {
@@ -457,6 +463,8 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     p.linkMode = static_cast<LinkMode>(linkMode);
     p.hierarchy = static_cast<HierarchyMethod>(hierarchy);
     PIC_TRY_ASSIGN(p.linkSamples, reader.u32("link_samples"));
+    // Bakes written before the final estimate had its own count re-estimated with link_samples.
+    PIC_TRY_ASSIGN(p.linkFinalSamples, reader.u32Or("link_final_samples", p.linkSamples));
     PIC_TRY_ASSIGN(p.exposureRays, reader.u32("exposure_rays"));
     PIC_TRY_ASSIGN(const uint32_t linkReads, reader.oneOf("link_reads", {"node", "visible"}));
     p.linkReads = static_cast<LinkReads>(linkReads);

@@ -164,6 +164,44 @@ TEST(LinkGeneration, LinksOfACacheInAClosedBoxCoverTheSphere) {
     EXPECT_EQ(links->stats.blindCaches, 0u);
 }
 
+TEST(LinkGeneration, MoreFinalRaysEstimateWhatACacheSeesMoreClosely) {
+    // In the sealed thin_wall room every grid cache sees exactly 4π sr of surfels, half of the
+    // room hidden behind the partition from most, so each cache's sum of linked visible solid
+    // angle measures the error of its final node estimates. With 16 rays a node near the cache
+    // is sometimes estimated several times too high (one ray drawn by area lands on the surfel
+    // right beside the cache); 64 rays take those tails off.
+    const test::BakedScene& b = test::bakedScene("thin_wall", smallOptions());
+    ASSERT_TRUE(b.ok);
+    const BakeData& bake = b.bake;
+    auto rmsDeviation = [&](uint32_t finalSamples) {
+        LinkParams params;
+        params.linksPerCache = 96;
+        params.finalSamplesPerNode = finalSamples;
+        auto links = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
+        EXPECT_TRUE(links);
+        if (!links) return 0.0;
+        auto sums = solidAnglePerCache(*links, bake.caches.size(), params.linksPerCache);
+        double squares = 0.0;
+        int grid = 0;
+        for (size_t c = 0; c < bake.caches.size(); ++c) {
+            // tests/scenes: the room is [-3, 3] × [0, 2.5] × [-2, 2], the partition |x| ≤ 1 cm;
+            // grid vertices outside them see back faces.
+            const glm::vec3 p = bake.caches[c].position;
+            const bool inRoom = std::abs(p.x) < 3.0f && p.y > 0.0f && p.y < 2.5f &&
+                                std::abs(p.z) < 2.0f && std::abs(p.x) > 0.01f;
+            if (bake.caches[c].kind != gpu::kCacheKindGrid || !inRoom) continue;
+            const double deviation = sums[c] / (4.0 * kPi) - 1.0;
+            squares += deviation * deviation;
+            ++grid;
+        }
+        EXPECT_GT(grid, 50);
+        return std::sqrt(squares / std::max(grid, 1));
+    };
+    const double sixteen = rmsDeviation(16), sixtyFour = rmsDeviation(64);
+    EXPECT_GT(sixteen, 0.0);
+    EXPECT_LT(sixtyFour, 0.75 * sixteen) << "16 rays: " << sixteen << ", 64 rays: " << sixtyFour;
+}
+
 TEST(LinkGeneration, RtpAndShFormsAgreeOnBandZero) {
     // Band 0 of the SH form is Ω_vis·y00/(πA); the RTP form holds factor·K0(α)·y00.
     const test::BakedScene& b = test::bakedScene("cornell", smallOptions());
@@ -282,6 +320,12 @@ TEST(Bake, RejectsBadParameters) {
     options = {};
     options.gridCell = -1.0f;
     EXPECT_FALSE(resolveBakeParams(scene, options, defaults));
+    options = {};
+    options.linkFinalSamples = 0;
+    r = resolveBakeParams(scene, options, defaults);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("--link-final-samples must be in [1, 1024], got 0"),
+              std::string::npos);
 }
 
 }  // namespace

@@ -137,6 +137,12 @@ TEST(SurfelExposure, LinkFactorsFollowTheWeightsOfTheVisibleSurfels) {
                     1e-5f * uniform->links.rtp[i].factor);
     }
     // Leaves: the factor is the surfel's own, whatever its weight (Σ_visible w·Ω / (π w·a)).
+    // That holds where the leaf's estimate was exact; with more final rays than cut rays a
+    // drawn estimate whose visible samples all hit one heavy surfel also reads that leaf
+    // (bake/link_generation.cpp, localise), so both counts stay at 16 here.
+    params.finalSamplesPerNode = params.samplesPerNode;
+    uniform = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params);
+    ASSERT_TRUE(uniform);
     std::vector<float> mixed(bake.surfels.size());
     for (size_t s = 0; s < mixed.size(); ++s) mixed[s] = s % 2 ? 5.0f : 0.5f;
     auto weighted = generateLinks(*b.rays, bake.surfels, bake.nodes, bake.caches, params, mixed);

@@ -41,6 +41,7 @@ BakeData makeBake(LinkMode mode) {
                    .linkMode = mode,
                    .hierarchy = HierarchyMethod::KdTree,
                    .linkSamples = 8,
+                   .linkFinalSamples = 24,
                    .relaxIterations = 3,
                    .seed = 0x123456789ABCDEF0ull};
     bake.sceneHash = 0xFEEDFACE12345678ull;
@@ -143,6 +144,7 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     EXPECT_EQ(a.params.linkMode, b.params.linkMode);
     EXPECT_EQ(a.params.hierarchy, b.params.hierarchy);
     EXPECT_EQ(a.params.linkSamples, b.params.linkSamples);
+    EXPECT_EQ(a.params.linkFinalSamples, b.params.linkFinalSamples);
     EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
     EXPECT_EQ(a.params.seed, b.params.seed);
     EXPECT_EQ(a.sceneHash, b.sceneHash);
@@ -323,6 +325,24 @@ TEST_F(BakeFile, ParamsUseReadableNames) {
     EXPECT_TRUE(contains(text, R"("hierarchy": "kdtree")"));
     EXPECT_TRUE(contains(text, R"("grid_cell": "2 × mean surfel spacing")"));
     EXPECT_TRUE(contains(text, R"("lightmap_texel": 0.1,)"));
+}
+
+TEST_F(BakeFile, ParamsWithoutFinalLinkSamplesReadThemAsLinkSamples) {
+    // Bakes written before "link_final_samples" existed re-estimated linked nodes with
+    // link_samples rays. Blanking the field out (JSON whitespace keeps the section's size)
+    // makes such a file.
+    auto [file, bytes] = written(makeBake(LinkMode::Rtp));
+    std::string text(bytes.begin(), bytes.end());
+    const std::string field = R"("link_final_samples": 24,)";
+    const size_t at = text.find(field);
+    ASSERT_NE(at, std::string::npos);
+    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
+    resealSection(bytes, 0);
+    writeBytes(file, bytes);
+    const Result<BakeData> read = readBakeFile(file);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_EQ(read->params.linkSamples, 8u);
+    EXPECT_EQ(read->params.linkFinalSamples, 8u);
 }
 
 TEST_F(BakeFile, WritesByteIdenticalFiles) {

@@ -18,16 +18,30 @@ namespace {
 
 /// Every field of BakeOptions, and the sizes per diagonal where given: what makes two bakes
 /// the same bake.
-using BakeKey = std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
-                           std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
-                           std::optional<float>, LinkMode, HierarchyMethod, uint32_t, uint32_t,
-                           LinkReads, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
+using BakeKey =
+    std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
+               std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
+               std::optional<float>, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t,
+               LinkReads, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
 
 BakeKey keyOf(const std::string& name, const BakeOptions& o,
               std::optional<std::pair<float, float>> perDiagonal) {
-    return {name,       o.surfels,   o.links,          o.bandsY,          o.bandsC,
-            o.gridCell, o.lightmapTexel, o.linkMode, o.hierarchy, o.linkSamples,
-            o.exposureRays, o.linkReads, o.relaxIterations, o.seed, perDiagonal};
+    return {name,
+            o.surfels,
+            o.links,
+            o.bandsY,
+            o.bandsC,
+            o.gridCell,
+            o.lightmapTexel,
+            o.linkMode,
+            o.hierarchy,
+            o.linkSamples,
+            o.linkFinalSamples,
+            o.exposureRays,
+            o.linkReads,
+            o.relaxIterations,
+            o.seed,
+            perDiagonal};
 }
 
 /// bakedScene for both sizings: `perDiagonal` (grid cell, light-map texel) replaces the
