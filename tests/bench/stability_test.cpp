@@ -182,11 +182,12 @@ StabilitySettings linkedOnly(glm::uvec2 size) {
 }
 
 TEST(StabilitySuite, ThinWallLeaksLittle) {
-    // thin_wall: dark side ÷ lit side of the indirect light, measured 0.051 from the linked
+    // thin_wall: dark side ÷ lit side of the indirect light, measured 0.0023 from the linked
     // caches and 0.0022 from the ideal ones (128 directions each); path tracing gives 0, the
-    // partition being sealed. The leak is in the links' transport, not where the caches sit
-    // (the ideal caches sit at the same places); paper 000 §5.2 (c) puts it down to clusters
-    // that straddle a wall. `picbench stability` gives 0.023 at the default bake.
+    // partition being sealed. What is left sits where caches straddle the partition (the
+    // ideal caches leak as much). Paper 000 §5.2 (c)'s clusters that straddle a wall leaked
+    // 0.051 here with the paper's hierarchy and 16-ray link estimates. `picbench stability`
+    // gives 0.0029 at the default bake.
     const test::BakedScene& b = small("thin_wall");
     ASSERT_TRUE(b.ok);
     ASSERT_GE(b.scene.cameras.size(), 2u);
@@ -198,7 +199,7 @@ TEST(StabilitySuite, ThinWallLeaksLittle) {
     ASSERT_TRUE(leak) << leak.error().message;
     ASSERT_TRUE(leak->ideal);
     EXPECT_GT(meanLuminance(leak->lit.linked), 0.0);
-    EXPECT_LT(leak->linked, 0.12);
+    EXPECT_LT(leak->linked, 0.01);
     EXPECT_LT(*leak->ideal, 0.01);
 }
 
