@@ -303,14 +303,18 @@ int runRender(const Common& common, const RenderCommand& command) {
     std::string passes;
     for (const auto& [pass, ms] : timings.passMs)
         passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", pass, ms);
-    std::fprintf(stderr,
-                 "picclient render: scene %s in %.0f ms (%s); version %llu: light change to decoded "
-                 "frame %.1f ms (server update + encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
-                 "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
-                 downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(), (unsigned long long)decoder.version(), latencyMs,
-                 serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y, command.shade.component().c_str(),
-                 (*context)->deviceName().c_str(), timings.totalMs, passes.c_str(), since(start),
-                 command.output.path().c_str());
+    // Without --lights nothing changed: the time is the session's current frame arriving.
+    std::fprintf(
+        stderr,
+        "picclient render: scene %s in %.0f ms (%s); version %llu: %s %.1f ms (server update + "
+        "encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
+        "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
+        downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(),
+        (unsigned long long)decoder.version(),
+        pushed ? "light change to decoded frame" : "current frame received and decoded in",
+        latencyMs, serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y,
+        command.shade.component().c_str(), (*context)->deviceName().c_str(), timings.totalMs,
+        passes.c_str(), since(start), command.output.path().c_str());
     std::printf("%s\n", command.output.path().c_str());
     return 0;
 }

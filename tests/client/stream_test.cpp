@@ -978,6 +978,17 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
                                      " --out " + image.string() + " 2>&1",
                                  exit);
     EXPECT_EQ(exit, 2) << viewerPush;
+    // Without --lights a viewer renders the session's current frame: nothing changed, so no
+    // light change's latency is claimed.
+    std::string viewerRender =
+        run(client + " render --server " + address + " --session " + session + " --token " +
+                viewer + " --scene-camera 0 --size 8x8 --cache-dir " + cacheDir.string() +
+                " --out " + image.string() + " 2>&1",
+            exit);
+    EXPECT_EQ(exit, 0) << viewerRender;
+    EXPECT_NE(viewerRender.find("current frame received and decoded in"), std::string::npos)
+        << viewerRender;
+    EXPECT_EQ(viewerRender.find("light change"), std::string::npos) << viewerRender;
 
     std::string stats = run(client + " stats --server " + address + " --session " + session +
                                 " --token " + viewer,

@@ -22,6 +22,7 @@
 #include "core/sh.h"
 #include "rays/embree_scene.h"
 #include "tests/support/baked_scene.h"
+#include "tests/support/lights.h"
 
 namespace pic {
 namespace {
@@ -230,15 +231,7 @@ TEST_F(PathTracerTest, BounceLimitKeepsPathsOfAtMostBPlusOneReflections) {
     for (const glm::vec3& p : none.pixels) EXPECT_EQ(p, glm::vec3(0.0f));
 }
 
-Light pointLight(glm::vec3 position, float intensity, glm::vec3 color) {
-    Light light;
-    light.id = "lamp";
-    light.type = LightType::Point;
-    light.position = position;
-    light.intensity = intensity;
-    light.color = color;
-    return light;
-}
+using test::pointLight;
 
 /// A closed sphere of radius 1 about the origin (an icosahedron subdivided `levels` times,
 /// vertices pushed onto the sphere) of albedo ρ.

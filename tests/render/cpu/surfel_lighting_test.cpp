@@ -14,6 +14,7 @@
 #include "core/light_set.h"
 #include "rays/embree_scene.h"
 #include "render/cpu/surfel_lighting.h"
+#include "tests/support/lights.h"
 
 namespace pic {
 namespace {
@@ -66,15 +67,7 @@ BakeData oneSurfelBake(const glm::vec3& position) {
     return bake;
 }
 
-Light pointLight(glm::vec3 position, float intensity, glm::vec3 color) {
-    Light light;
-    light.id = "lamp";
-    light.type = LightType::Point;
-    light.position = position;
-    light.intensity = intensity;
-    light.color = color;
-    return light;
-}
+using test::pointLight;
 
 void expectVecNear(const glm::vec3& actual, const glm::dvec3& expected, double relative) {
     for (int c = 0; c < 3; ++c)
