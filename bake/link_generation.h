@@ -53,7 +53,10 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
 
 /// How a cache sees one surfel: the unit direction to it, its disc's solid angle (0 when it
 /// faces away from the cache or lies behind a light-map cache's surface) and whether an
-/// occlusion ray reaches it. The one test that link generation and its diagnostics share.
+/// occlusion ray reaches it. Within three radii of the cache, only the parts of the disc where
+/// a ray finds the surfel's surface count (one ray per part), so a disc overhanging its patch's
+/// edges or partly hidden counts what is there. The one test that link generation and its
+/// diagnostics share.
 struct SurfelView {
     glm::vec3 direction{0.0f};
     float solidAngle = 0.0f;  ///< sr, ignoring occlusion
@@ -64,5 +67,12 @@ SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel&
 /// Solid angle (sr) of a disc of radius r seen from distance d at cosine cosTheta between
 /// its normal and the direction to the viewer: the on-axis disc formula scaled by cosTheta.
 float discSolidAngle(float distance, float radius, float cosTheta);
+
+/// Solid angle (sr) of a surfel's disc seen from `from`, right off its axis and near it (within
+/// 4 % of the integral from half a radius above it): the disc formula above counts a lattice
+/// of surfels 0.74 radii below the viewer as 0.72 of their plane. With
+/// hemisphereNormal, the parts of the disc behind that plane through `from` are left out.
+float surfelSolidAngle(const glm::vec3& from, const Surfel& surfel,
+                       const glm::vec3* hemisphereNormal = nullptr);
 
 }  // namespace pic

@@ -69,6 +69,36 @@ TEST(SurfelExposure, FreeDistanceUnderAPlaneIsTwiceItsHeight) {
     for (float d : *free) EXPECT_NEAR(d, 2.0f * h, 0.1f * h);
 }
 
+TEST(SurfelView, NearACacheOnlyThePartsOfADiscOnItsSurfaceCount) {
+    // A surfel of 6.6 cm radius on a slat 2 cm wide, seen from 7 mm above the slat's plane and
+    // 4 cm beside its centre line, over empty space: most of the disc overhangs the slat, and
+    // what the cache sees of it is the slat's strip. On a wide plate the whole disc counts.
+    const float r = 0.066f;
+    Surfel surfel = surfelAt({0.0f, 0.0f, 0.0f}, {0, 1, 0});
+    surfel.radius = r;
+    surfel.area = std::numbers::pi_v<float> * r * r;
+    gpu::Cache cache{};
+    cache.position = glm::vec3(0.04f, 0.007f, 0.0f);
+    cache.kind = gpu::kCacheKindGrid;
+    const float disc = surfelSolidAngle(cache.position, surfel);
+    ASSERT_GT(disc, 1.0f);
+    for (float halfWidth : {0.01f, 0.5f}) {
+        Scene scene;
+        scene.sourcePath = "slat.gltf";
+        addRectangle(scene, 0.0f, -halfWidth, halfWidth, -0.5f, 0.5f, true);
+        auto rays = EmbreeScene::create(scene);
+        ASSERT_TRUE(rays) << rays.error().message;
+        const SurfelView view = viewSurfel(**rays, cache, surfel);
+        EXPECT_TRUE(view.visible);
+        if (halfWidth < r) {
+            EXPECT_GT(view.solidAngle, 0.0f);
+            EXPECT_LT(view.solidAngle, 0.3f * disc);
+        } else {
+            EXPECT_NEAR(view.solidAngle, disc, 1e-3f * disc);
+        }
+    }
+}
+
 TEST(SurfelExposure, HiddenSurfelsWeighLessAndWeightsAverageOne) {
     // A 2 m floor under a ceiling 2 m up, with a lid 1 cm over its x < 0 half: the surfel under
     // the lid sees about 2 cm of free space, the open one metres.
