@@ -259,6 +259,7 @@ private:
             }
             const Surfel& surfel = mSurfels[s];
             const SurfelView view = viewSurfel(mRays, cache, surfel);
+            rays += view.rays;
             if (view.solidAngle <= 0.0f) continue;  // faces away or lies behind the cache
             // Exact: w_j·Ω_j / Σ w·a and Ω_j. Drawn: Ω_j / (k·a_j) and n·Ω_j / k.
             const float share = e.exact ? float(double(mWeights[s]) * view.solidAngle / weightedArea)
@@ -266,7 +267,6 @@ private:
             const float omega = e.exact ? view.solidAngle
                                         : view.solidAngle * float(node.surfelCount) / float(taken);
             e.unoccluded += omega;
-            ++rays;
             if (!view.visible) continue;
             e.visible += omega;
             ++e.visibleCount;
@@ -403,6 +403,7 @@ SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel&
         // The ray stops just short of the surfel's own surface.
         const float tFar = d * (1.0f - 1e-4f) - 4.0f * epsilon;
         view.visible = !(tFar > epsilon && rays.occluded(cache.position, w, epsilon, tFar));
+        view.rays = 1;
         return view;
     }
     // Near the cache a disc of the surfel's area no longer stands for its patch of surface: it
@@ -417,6 +418,7 @@ SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel&
             const float omega =
                 splitDiscSolidAngle(cache.position, centre, surfel.normal, radius, hemisphere, 1);
             if (!(omega > 0.0f)) return;
+            ++view.rays;
             const glm::vec3 toPart = centre - cache.position;
             const float distance = glm::length(toPart);
             const float tolerance = 0.5f * radius + 4.0f * epsilon;

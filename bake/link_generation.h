@@ -61,6 +61,7 @@ struct SurfelView {
     glm::vec3 direction{0.0f};
     float solidAngle = 0.0f;  ///< sr, ignoring occlusion
     bool visible = false;     ///< solidAngle > 0 and nothing blocks the segment
+    uint32_t rays = 0;        ///< rays cast: one, one per part of the disc near it, or none
 };
 SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel);
 
