@@ -38,8 +38,7 @@ struct NodeEstimate {
     glm::vec3 positionSum{0.0f};   ///< Σ w·Ω·V·x over the samples, in the units of perArea
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
-    uint32_t visibleCount = 0;              ///< samples that reached a surfel
-    uint32_t taken = 0;                     ///< samples drawn (all surfels when exact)
+    double visibleArea = 0.0;  ///< estimated Σ w·a of the surfels the cache sees, m²
     uint32_t firstVisible = UINT32_MAX;     ///< leaf-order range of the visible samples' surfels
     uint32_t lastVisible = 0;
     float priority = 0.0f;     ///< refinement order: larger first
@@ -52,7 +51,13 @@ struct NodeEstimate {
 struct Scratch {
     std::vector<NodeEstimate> estimates;
     std::vector<VisibleSample> samples;
+    std::vector<uint32_t> near;  ///< the cache's near surfels (CacheLinker::findNear), ascending
+    std::vector<uint32_t> stack;
 };
+
+/// Surfels within this many of their radii of a cache are counted exactly in every estimate
+/// (CacheLinker::estimate).
+constexpr float kExactRadii = 6.0f;
 
 class CacheLinker {
 public:
@@ -68,6 +73,7 @@ public:
             mPrefix[s + 1] = mPrefix[s] + wa;
             mColourPrefix[s + 1] = mColourPrefix[s] + glm::dvec3(fluxColour(surfels[s])) * wa;
             mPositionPrefix[s + 1] = mPositionPrefix[s] + glm::dvec3(surfels[s].position) * wa;
+            mMaxRadius = std::max(mMaxRadius, surfels[s].radius);
         }
     }
 
@@ -79,10 +85,10 @@ public:
         chosen.clear();
         uint64_t rays = 0;
         Rng rng(mParams.seed, cacheIndex);
+        findNear(cache.position, scratch);
 
         auto evaluate = [&](uint32_t node) {
-            NodeEstimate e =
-                estimate(node, cache, mParams.samplesPerNode, rng, scratch.samples, rays);
+            NodeEstimate e = estimate(node, cache, mParams.samplesPerNode, rng, scratch, rays);
             scratch.estimates.push_back(e);
             return static_cast<uint32_t>(scratch.estimates.size() - 1);
         };
@@ -137,9 +143,8 @@ public:
                 chosen.push_back(e);
                 continue;
             }
-            NodeEstimate again =
-                estimate(scratch.estimates[e].node, cache, mParams.finalSamplesPerNode, fresh,
-                         scratch.samples, rays);
+            NodeEstimate again = estimate(scratch.estimates[e].node, cache,
+                                          mParams.finalSamplesPerNode, fresh, scratch, rays);
             if (again.visible <= 0.0f) continue;
             // Both sample sets bound the part the cache sees.
             again.firstVisible = std::min(again.firstVisible, scratch.estimates[e].firstVisible);
@@ -210,7 +215,7 @@ private:
         e.readScale = 1.0f;
         if (mParams.reads == LinkReads::Node) return;
         const double whole = weightedArea(e.node);
-        const double needed = e.exact ? 0.0 : whole * double(e.visibleCount) / double(e.taken);
+        const double needed = e.exact ? 0.0 : e.visibleArea;
         uint32_t n = e.node;
         for (;;) {
             const Node& node = mNodes[n];
@@ -228,55 +233,111 @@ private:
         e.readScale = float(whole / weightedArea(n));
     }
 
+    /// Fills scratch.near with the surfels within kExactRadii of their radius of `position`, in
+    /// ascending order: the hierarchy is walked from the root, skipping nodes whose bounding
+    /// sphere lies farther.
+    void findNear(const glm::vec3& position, Scratch& scratch) const {
+        std::vector<uint32_t>& near = scratch.near;
+        std::vector<uint32_t>& stack = scratch.stack;
+        near.clear();
+        stack.assign(1, static_cast<uint32_t>(mNodes.size() - 1));
+        while (!stack.empty()) {
+            const uint32_t n = stack.back();
+            stack.pop_back();
+            const Node& node = mNodes[n];
+            const float reach = node.radius + kExactRadii * mMaxRadius;
+            const glm::vec3 v = node.center - position;
+            if (glm::dot(v, v) >= reach * reach) continue;
+            if (node.left == kNoNode) {
+                const Surfel& s = mSurfels[n];
+                const glm::vec3 u = s.position - position;
+                const float r = kExactRadii * s.radius;
+                if (glm::dot(u, u) < r * r) near.push_back(n);
+                continue;
+            }
+            stack.push_back(node.right);
+            stack.push_back(node.left);
+        }
+        std::sort(near.begin(), near.end());
+    }
+
     /// Estimates a node from up to k of its surfels: all of them when it has at most k (exact),
-    /// else k drawn in proportion to w·a (stratified over the node's contiguous range of the
-    /// prefix sums), one occlusion ray each. Drawn by weight, sample j estimates
-    /// Σ w·Ω·V / Σ w·a by Ω_j·V_j / a_j with bounded variance however uneven the weights; with
-    /// uniform weights n·Ω_j is the usual estimate of the solid angle, which the drawn samples
-    /// also give for the priority and the cone (that of the node's weighted part).
+    /// else its surfels near the cache exactly (Scratch::near) and k draws in proportion to w·a
+    /// (stratified over the node's contiguous range of the prefix sums), one occlusion ray each,
+    /// a draw that lands on a near surfel counting nothing. Drawn by weight, sample j estimates
+    /// the rest of Σ w·Ω·V / Σ w·a by Ω_j·V_j / a_j with bounded variance however uneven the
+    /// weights; with uniform weights n·Ω_j is the usual estimate of the solid angle, which the
+    /// drawn samples also give for the priority and the cone (that of the node's weighted part).
+    /// Near surfels are what makes the draw heavy-tailed: one beside the cache subtends
+    /// steradians, and a draw that happens to land on it counts it n/k times. Counted exactly,
+    /// in the living room the light-map caches' read nodes follow what they see (node model
+    /// 1.07 → 0.99 of the exact gather) and the grid caches' cuts cover it (0.937 → 0.965).
     NodeEstimate estimate(uint32_t nodeIndex, const Cache& cache, uint32_t k, Rng& rng,
-                          std::vector<VisibleSample>& samples, uint64_t& rays) const {
+                          Scratch& scratch, uint64_t& rays) const {
+        std::vector<VisibleSample>& samples = scratch.samples;
         const Node& node = mNodes[nodeIndex];
         NodeEstimate e;
         e.node = nodeIndex;
         e.sampleBegin = static_cast<uint32_t>(samples.size());
-        const uint32_t taken = std::min(node.surfelCount, k);
-        e.taken = taken;
         e.exact = node.surfelCount <= k;
+        const uint32_t taken = std::min(node.surfelCount, k);
         const double begin = mPrefix[node.firstSurfel];
         const double weightedArea = mPrefix[node.firstSurfel + node.surfelCount] - begin;
-        const auto first = mPrefix.begin() + node.firstSurfel;
-        const auto last = mPrefix.begin() + node.firstSurfel + node.surfelCount;
-        for (uint32_t j = 0; j < taken; ++j) {
-            uint32_t s = node.firstSurfel + j;
-            if (!e.exact) {
-                const double target = begin + (j + rng.uniform()) / taken * weightedArea;
-                // The surfel whose [prefix[s], prefix[s + 1]) holds the target.
-                s = node.firstSurfel +
-                    static_cast<uint32_t>(std::min<ptrdiff_t>(
-                        std::upper_bound(first, last, target) - first - 1, node.surfelCount - 1));
-                s = std::max(s, node.firstSurfel);
-            }
-            const Surfel& surfel = mSurfels[s];
-            const SurfelView view = viewSurfel(mRays, cache, surfel);
-            rays += view.rays;
-            if (view.solidAngle <= 0.0f) continue;  // faces away or lies behind the cache
-            // Exact: w_j·Ω_j / Σ w·a and Ω_j. Drawn: Ω_j / (k·a_j) and n·Ω_j / k.
-            const float share = e.exact ? float(double(mWeights[s]) * view.solidAngle / weightedArea)
-                                        : view.solidAngle / (float(taken) * surfel.area);
-            const float omega = e.exact ? view.solidAngle
-                                        : view.solidAngle * float(node.surfelCount) / float(taken);
-            e.unoccluded += omega;
-            if (!view.visible) continue;
+        // One visible surfel: its exact or drawn contribution (`omega` sr of solid angle,
+        // `share` of Σ w·Ω·V / Σ w·a, `area` of the visible Σ w·a).
+        auto add = [&](uint32_t s, const SurfelView& view, float omega, float share, double area) {
             e.visible += omega;
-            ++e.visibleCount;
+            e.visibleArea += area;
             e.firstVisible = std::min(e.firstVisible, s);
             e.lastVisible = std::max(e.lastVisible, s);
             e.perArea += share;
             e.directionSum += share * view.direction;
-            e.colourSum += share * fluxColour(surfel);
-            e.positionSum += share * surfel.position;
+            e.colourSum += share * fluxColour(mSurfels[s]);
+            e.positionSum += share * mSurfels[s].position;
             samples.push_back({view.direction, share});
+        };
+        // Exact: w_j·Ω_j / Σ w·a and Ω_j.
+        auto addExact = [&](uint32_t s) {
+            const SurfelView view = viewSurfel(mRays, cache, mSurfels[s]);
+            rays += view.rays;
+            if (view.solidAngle <= 0.0f) return;  // faces away or lies behind the cache
+            e.unoccluded += view.solidAngle;
+            const double wa = double(mWeights[s]) * mSurfels[s].area;
+            if (view.visible)
+                add(s, view, view.solidAngle,
+                    float(double(mWeights[s]) * view.solidAngle / weightedArea), wa);
+        };
+        if (e.exact) {
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s)
+                addExact(s);
+        } else {
+            const auto nearBegin =
+                std::lower_bound(scratch.near.begin(), scratch.near.end(), node.firstSurfel);
+            const auto nearEnd = std::lower_bound(nearBegin, scratch.near.end(),
+                                                  node.firstSurfel + node.surfelCount);
+            for (auto it = nearBegin; it != nearEnd; ++it) addExact(*it);
+            const auto first = mPrefix.begin() + node.firstSurfel;
+            const auto last = mPrefix.begin() + node.firstSurfel + node.surfelCount;
+            for (uint32_t j = 0; j < taken; ++j) {
+                const double target = begin + (j + rng.uniform()) / taken * weightedArea;
+                // The surfel whose [prefix[s], prefix[s + 1]) holds the target.
+                uint32_t s =
+                    node.firstSurfel +
+                    static_cast<uint32_t>(std::min<ptrdiff_t>(
+                        std::upper_bound(first, last, target) - first - 1, node.surfelCount - 1));
+                s = std::max(s, node.firstSurfel);
+                if (std::binary_search(nearBegin, nearEnd, s)) continue;
+                const Surfel& surfel = mSurfels[s];
+                const SurfelView view = viewSurfel(mRays, cache, surfel);
+                rays += view.rays;
+                if (view.solidAngle <= 0.0f) continue;
+                // Drawn: Ω_j / (k·a_j) and n·Ω_j / k; each draw stands for Σ w·a / k.
+                const float omega = view.solidAngle * float(node.surfelCount) / float(taken);
+                e.unoccluded += omega;
+                if (view.visible)
+                    add(s, view, omega, view.solidAngle / (float(taken) * surfel.area),
+                        weightedArea / taken);
+            }
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
         // An unlucky sample set may miss the visible part of a node (e.g. a few wall surfels
@@ -304,6 +365,7 @@ private:
     std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
     std::vector<glm::dvec3> mColourPrefix;  ///< Σ w·κ·a over the surfels before each
     std::vector<glm::dvec3> mPositionPrefix;  ///< Σ w·a·x over the surfels before each
+    float mMaxRadius = 0.0f;                  ///< the largest surfel radius, m
 };
 
 }  // namespace
