@@ -233,10 +233,10 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     std::vector<float> weights;
     if (p.exposureRays > 0) {
         StageTimer exposureTimer(report, "exposure");
-        PIC_TRY_ASSIGN(const std::vector<float> freeDistance,
-                       surfelFreeDistance(*rays, scene.bounds, exposureReach(scene), bake.surfels,
-                                          ExposureParams{p.exposureRays, p.seed}));
-        weights = fluxWeights(bake.surfels, freeDistance);
+        PIC_TRY_ASSIGN(const SurfelExposure exposure,
+                       surfelExposure(*rays, scene.bounds, exposureReach(scene), bake.surfels,
+                                      ExposureParams{p.exposureRays, p.seed}));
+        weights = fluxWeights(bake.surfels, bouncedExposure(bake.surfels, exposure));
         exposureTimer.stop();
     }
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <unordered_map>
 
+#include "bake/surfel_grid.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -19,38 +19,6 @@ glm::vec2 squareToTriangle(float u, float v) {
     float su = std::sqrt(u);
     return {su * (1.0f - v), su * v};
 }
-
-/// A uniform hash grid over surfel positions for neighbour queries during relaxation.
-class SurfelGrid {
-public:
-    SurfelGrid(const std::vector<Surfel>& surfels, float cellSize) : mCell(cellSize) {
-        mCells.reserve(surfels.size());
-        for (uint32_t i = 0; i < surfels.size(); ++i) mCells[key(cellOf(surfels[i].position))].push_back(i);
-    }
-
-    template <class Fn>
-    void forNeighbours(const glm::vec3& p, Fn&& fn) const {
-        glm::ivec3 c = cellOf(p);
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    auto it = mCells.find(key(c + glm::ivec3(dx, dy, dz)));
-                    if (it == mCells.end()) continue;
-                    for (uint32_t j : it->second) fn(j);
-                }
-    }
-
-private:
-    glm::ivec3 cellOf(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / mCell)); }
-    static uint64_t key(const glm::ivec3& c) {
-        return (static_cast<uint64_t>(static_cast<uint32_t>(c.x) & 0x1FFFFF) << 42) |
-               (static_cast<uint64_t>(static_cast<uint32_t>(c.y) & 0x1FFFFF) << 21) |
-               (static_cast<uint64_t>(static_cast<uint32_t>(c.z) & 0x1FFFFF));
-    }
-
-    float mCell;
-    std::unordered_map<uint64_t, std::vector<uint32_t>> mCells;
-};
 
 /// One Jacobi step of tangential repulsion: each surfel moves away from neighbours closer
 /// than the ideal spacing, within its tangent plane, and stays on its own triangle.

@@ -103,14 +103,8 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     lightCaches(*bake, flux, values);
 
     // Luma radiance of every surfel, and what a link reads for it: its node's flux spread by
-    // the flux weights the bake linked with (recomputed: the bake file does not keep them).
-    std::vector<float> weights(nS, 1.0f);
-    if (bake->params.exposureRays > 0) {
-        auto free = surfelFreeDistance(**rays, scene->bounds, exposureReach(*scene), bake->surfels,
-                                       ExposureParams{bake->params.exposureRays, bake->params.seed});
-        if (!free) return reportError(free.error());
-        weights = fluxWeights(bake->surfels, *free);
-    }
+    // the flux weights the bake linked with.
+    const std::vector<float>& weights = bake->surfelWeights;
     const std::vector<double> weightedArea = weightedNodeArea(bake->surfels, bake->nodes, weights);
     std::vector<glm::dvec3> radiance(nS);
     for (size_t s = 0; s < nS; ++s) radiance[s] = glm::dvec3(flux[s]) / (kPi * bake->surfels[s].area);

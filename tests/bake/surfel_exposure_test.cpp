@@ -64,9 +64,9 @@ TEST(SurfelExposure, FreeDistanceUnderAPlaneIsTwiceItsHeight) {
     ASSERT_TRUE(rays) << rays.error().message;
     const std::vector<Surfel> surfels = {surfelAt({0.0f, 0.0f, 0.0f}, {0, 1, 0}),
                                          surfelAt({3.0f * h, 0.0f, -h}, {0, 1, 0})};
-    auto free = surfelFreeDistance(**rays, scene.bounds, 1e3f, surfels, ExposureParams{256, 1});
-    ASSERT_TRUE(free) << free.error().message;
-    for (float d : *free) EXPECT_NEAR(d, 2.0f * h, 0.1f * h);
+    auto exposure = surfelExposure(**rays, scene.bounds, 1e3f, surfels, ExposureParams{256, 1});
+    ASSERT_TRUE(exposure) << exposure.error().message;
+    for (float d : exposure->freeDistance) EXPECT_NEAR(d, 2.0f * h, 0.1f * h);
 }
 
 TEST(SurfelView, NearACacheOnlyThePartsOfADiscOnItsSurfaceCount) {
@@ -114,15 +114,16 @@ TEST(SurfelExposure, HiddenSurfelsWeighLessAndWeightsAverageOne) {
     Surfel emitter = surfelAt({0.0f, 1.99f, 0.0f}, {0, -1, 0});
     emitter.emission = glm::vec3(3.0f);
     surfels.push_back(emitter);
-    auto free = surfelFreeDistance(**rays, scene.bounds, 1e3f, surfels, ExposureParams{64, 1});
-    ASSERT_TRUE(free);
-    EXPECT_NEAR((*free)[0], 0.02f, 0.005f);  // 2h under the lid
-    EXPECT_GT((*free)[1], 1.0f);
-    EXPECT_LT((*free)[1], 4.0f);
-    const std::vector<float> w = fluxWeights(surfels, *free);
+    auto exposure = surfelExposure(**rays, scene.bounds, 1e3f, surfels, ExposureParams{64, 1});
+    ASSERT_TRUE(exposure);
+    const std::vector<float>& free = exposure->freeDistance;
+    EXPECT_NEAR(free[0], 0.02f, 0.005f);  // 2h under the lid
+    EXPECT_GT(free[1], 1.0f);
+    EXPECT_LT(free[1], 4.0f);
+    const std::vector<float> w = fluxWeights(surfels, free);
     // Reflectors: E_cos[min(t, R)], scaled to an area-weighted mean of 1; the emitter alone is 1.
     EXPECT_NEAR(w[0] + w[1], 2.0f, 1e-5f);
-    EXPECT_NEAR(w[0] / w[1], (*free)[0] / (*free)[1], 1e-4f);
+    EXPECT_NEAR(w[0] / w[1], free[0] / free[1], 1e-4f);
     EXPECT_LT(w[0], 0.05f * w[1]);
     EXPECT_NEAR(w[2], 1.0f, 1e-6f);
 }
@@ -144,6 +145,144 @@ TEST(SurfelExposure, WeightsHaveAFloorAndNodeAreasSumThem) {
     const std::vector<float> dark = fluxWeights(surfels, {0.0f, 0.0f});
     EXPECT_FLOAT_EQ(dark[0], 1.0f);
     EXPECT_FLOAT_EQ(dark[1], 1.0f);
+}
+
+/// Adds the parallelogram o, o + u, o + u + v, o + v, facing u × v.
+void addQuad(Scene& scene, glm::vec3 o, glm::vec3 u, glm::vec3 v) {
+    const glm::vec3 corners[4] = {o, o + u, o + u + v, o + v};
+    const uint32_t first = uint32_t(scene.vertices.size());
+    for (const glm::vec3& p : corners) {
+        Vertex vertex;
+        vertex.position = p;
+        scene.vertices.push_back(vertex);
+        scene.bounds.extend(p);
+    }
+    for (const uint32_t c : {1u, 2u}) {
+        Triangle t;
+        t.v[0] = first;
+        t.v[1] = first + c;
+        t.v[2] = first + c + 1;
+        scene.triangles.push_back(t);
+    }
+}
+
+/// n × n surfels of grey albedo ρ at the centres of the parallelogram's cells, facing u × v.
+void addLattice(std::vector<Surfel>& surfels, glm::vec3 o, glm::vec3 u, glm::vec3 v, int n, float rho) {
+    const glm::vec3 normal = glm::normalize(glm::cross(u, v));
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            Surfel s = surfelAt(o + (i + 0.5f) / n * u + (j + 0.5f) / n * v, normal);
+            s.area = glm::length(glm::cross(u, v)) / float(n * n);
+            s.radius = std::sqrt(s.area / std::numbers::pi_v<float>);
+            s.albedo = glm::vec3(rho);
+            surfels.push_back(s);
+        }
+}
+
+/// The six inner faces of the unit cube: origin and edges, each facing into the cube.
+struct Face {
+    glm::vec3 o, u, v;
+};
+constexpr Face kCubeFaces[6] = {
+    {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}},  // floor, +y
+    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},  // ceiling, −y
+    {{0, 0, 0}, {0, 1, 0}, {0, 0, 1}},  // x = 0, +x
+    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},  // x = 1, −x
+    {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}},  // z = 0, +z
+    {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}},  // z = 1, −z
+};
+
+TEST(SurfelExposure, BouncesSolveTheTransportBetweenSurfels) {
+    // Surfel 0 sees surfel 1 along two of its four rays, the sky along one, and along the last
+    // a surface with no surfel (left out); surfel 1 sees surfel 0 all round. E/c = d + bounces:
+    // E₀ = d₀ + (2/3)·ρ₁·E₁ and E₁ = d₁ + ρ₀·E₀, so E₀ = (d₀ + (2/3)·ρ₁·d₁) / (1 − (2/3)·ρ₀·ρ₁).
+    std::vector<Surfel> surfels = {surfelAt({0, 0, 0}, {0, 1, 0}), surfelAt({0, 1, 0}, {0, -1, 0})};
+    surfels[0].albedo = glm::vec3(0.8f);
+    surfels[1].albedo = glm::vec3(0.6f);
+    SurfelExposure exposure;
+    exposure.raysPerSurfel = 4;
+    exposure.freeDistance = {1.0f, 2.0f};
+    exposure.seen = {1, 1, kRayEscaped, kRayUnresolved, 0, 0, 0, 0};
+    const std::vector<float> e = bouncedExposure(surfels, exposure);
+    const double e0 = (1.0 + 2.0 / 3.0 * 0.6 * 2.0) / (1.0 - 2.0 / 3.0 * 0.8 * 0.6);
+    EXPECT_NEAR(e[0], e0, 1e-4 * e0);
+    EXPECT_NEAR(e[1], 2.0 + 0.8 * e0, 1e-4 * e0);
+    // Black surfels, or rays that all escape: no bounce.
+    surfels[0].albedo = surfels[1].albedo = glm::vec3(0.0f);
+    EXPECT_EQ(bouncedExposure(surfels, exposure), std::vector<float>({1.0f, 2.0f}));
+}
+
+TEST(SurfelExposure, BouncesKeepTheEnergyOfAClosedBox) {
+    // Inside a closed box of albedo ρ every ray hits a wall, and reciprocity (a_s·F_sh =
+    // a_h·F_hs) makes each bounce carry ρ times the last over the box's area: the area mean of
+    // E/c is 1/(1 − ρ) times that of d. The bounces also even the light out: a floor surfel in
+    // a corner, which sees little free space but lit walls all round, gains on one at the
+    // centre.
+    Scene scene;
+    scene.sourcePath = "box.gltf";
+    std::vector<Surfel> surfels;
+    const int n = 8;
+    const float rho = 0.5f;
+    for (const Face& f : kCubeFaces) {
+        addQuad(scene, f.o, f.u, f.v);
+        addLattice(surfels, f.o, f.u, f.v, n, rho);
+    }
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    auto exposure = surfelExposure(**rays, scene.bounds, 1e3f, surfels, ExposureParams{256, 1});
+    ASSERT_TRUE(exposure) << exposure.error().message;
+    size_t escaped = 0, unresolved = 0;
+    for (uint32_t h : exposure->seen) {
+        escaped += h == kRayEscaped;
+        unresolved += h == kRayUnresolved;
+    }
+    EXPECT_LT(escaped, exposure->seen.size() / 1000);
+    EXPECT_LT(unresolved, exposure->seen.size() / 1000);
+    const std::vector<float> e = bouncedExposure(surfels, *exposure);
+    double direct = 0.0, total = 0.0;
+    for (size_t i = 0; i < surfels.size(); ++i) {
+        direct += exposure->freeDistance[i];
+        total += e[i];
+    }
+    EXPECT_NEAR(total / direct, 1.0 / (1.0 - rho), 0.03 / (1.0 - rho));
+    const size_t corner = 0, centre = (n / 2) * n + n / 2;  // floor surfels (0.06, 0, 0.06), (0.56, 0, 0.56)
+    const std::vector<float>& d = exposure->freeDistance;
+    EXPECT_LT(d[corner], 0.8f * d[centre]);
+    EXPECT_GT(e[corner] / e[centre], 1.1f * d[corner] / d[centre]);
+}
+
+TEST(SurfelExposure, UnderASlabBouncesStayLow) {
+    // A slab 2 cm above the floor of a closed white box (ρ 0.8), its top and underside lined with
+    // surfels: the floor under it sees only the underside, which sees only that floor, so with
+    // its bounces it stays below a tenth of the open floor, as without them, while the open
+    // floor gains from the walls.
+    Scene scene;
+    scene.sourcePath = "slab_box.gltf";
+    std::vector<Surfel> surfels;
+    const float rho = 0.8f;
+    for (const Face& f : kCubeFaces) {
+        addQuad(scene, f.o, f.u, f.v);
+        addLattice(surfels, f.o, f.u, f.v, 16, rho);
+    }
+    const glm::vec3 x(0.5f, 0, 0), z(0, 0, 0.5f);
+    addQuad(scene, {0.25f, 0.02f, 0.25f}, x, z);  // underside, −y
+    addLattice(surfels, {0.25f, 0.02f, 0.25f}, x, z, 8, rho);
+    addQuad(scene, {0.25f, 0.04f, 0.25f}, z, x);  // top, +y
+    addLattice(surfels, {0.25f, 0.04f, 0.25f}, z, x, 8, rho);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    auto exposure = surfelExposure(**rays, scene.bounds, 1e3f, surfels, ExposureParams{128, 1});
+    ASSERT_TRUE(exposure) << exposure.error().message;
+    const std::vector<float> e = bouncedExposure(surfels, *exposure);
+    const std::vector<float>& d = exposure->freeDistance;
+    // Floor surfel (i, j) of 16 × 16 sits at x = (j + 0.5)/16, z = (i + 0.5)/16.
+    const size_t under = 7 * 16 + 7, open = 14 * 16 + 2;
+    const size_t top = 6 * 256 + 64 + 3 * 8 + 4;  // on the slab
+    EXPECT_LT(d[under], 0.1f * d[open]);
+    EXPECT_LT(e[under], 0.1f * e[open]);
+    EXPECT_GT(e[open], 2.0f * d[open]);
+    // The slab's top reads as lit as the open floor, not as the floor under it.
+    EXPECT_GT(e[top], 0.7f * e[open]);
 }
 
 TEST(SurfelExposure, LinkFactorsFollowTheWeightsOfTheVisibleSurfels) {
