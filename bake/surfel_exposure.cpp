@@ -67,21 +67,21 @@ Result<SurfelExposure> surfelExposure(const EmbreeScene& rays, const Aabb& bound
     // than the floor's just under it.
     float radius = 0.0f;
     for (const Surfel& s : surfels) radius = std::max(radius, s.radius);
-    const float cell = 2.0f * std::max(radius, 1e-6f);
-    const SurfelGrid grid(surfels, cell);
+    const float reachOfHit = 2.0f * std::max(radius, 1e-6f);
+    const SurfelGrid grid(surfels, 2.0f * reachOfHit, reachOfHit);
     auto surfelAt = [&](const glm::vec3& p, const glm::vec3& side) {
         uint32_t nearest = kRayUnresolved;
-        float best = cell * cell;
-        grid.forNeighbours(p, [&](uint32_t j) {
-            if (glm::dot(surfels[j].normal, side) < 0.5f) return;
-            const glm::vec3 d = surfels[j].position - p;
+        float best = reachOfHit * reachOfHit;
+        for (const SurfelGrid::Entry& e : grid.halo(p)) {
+            if (glm::dot(e.normal, side) < 0.5f) continue;
+            const glm::vec3 d = e.position - p;
             const float off = glm::dot(d, side);
             const float d2 = glm::dot(d, d) + 15.0f * off * off;
             if (d2 < best) {
                 best = d2;
-                nearest = j;
+                nearest = e.index;
             }
-        });
+        }
         return nearest;
     };
     const float epsilon = rays.epsilon();

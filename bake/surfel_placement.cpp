@@ -28,9 +28,8 @@ void relaxOnce(const Scene& scene, std::vector<Surfel>& surfels, float spacing) 
     parallelFor(0, surfels.size(), [&](size_t i) {
         const Surfel& s = surfels[i];
         glm::vec3 push(0.0f);
-        grid.forNeighbours(s.position, [&](uint32_t j) {
-            if (j == i) return;
-            const Surfel& o = surfels[j];
+        grid.forNeighbours(s.position, [&](const SurfelGrid::Entry& o) {
+            if (o.index == i) return;
             // Surfels on the other side of a thin wall do not repel each other; those across
             // a crease do, so that edges push surfels away as much as neighbours in the plane
             // (without it, surfels pile up on the edges of their triangles).

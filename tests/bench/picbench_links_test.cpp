@@ -23,8 +23,11 @@ protected:
 
 TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
     // The four factors multiply to linked/traced by construction of their estimates; each is
-    // a ratio of two estimates of the same radiance, so on cornell every one of them is near 1
-    // (a wrong π, area or y00 in any of the five estimates would put one far off).
+    // a ratio of two estimates of the same radiance, so on cornell every one of them is within
+    // a factor 1.5 of 1, where a wrong π, area or y00 in any of the five estimates would put
+    // one. Not closer: the sample holds 12 grid caches, and one beside a wall, where surfels'
+    // discs stand for the surface, moved the grid caches' representation to 1.33 on one of
+    // this project's machines.
     const fs::path json = mDir / "links.json";
     std::string err;
     ASSERT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --caches 40 "
@@ -44,8 +47,8 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
                                    "visibility_estimate"}) {
             const double value = r.at(factor).get<double>();
             EXPECT_TRUE(std::isfinite(value)) << factor;
-            EXPECT_GT(value, 0.8) << factor;
-            EXPECT_LT(value, 1.25) << factor;
+            EXPECT_GT(value, 1.0 / 1.5) << factor;
+            EXPECT_LT(value, 1.5) << factor;
         }
     }
     EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);

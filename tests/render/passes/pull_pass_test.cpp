@@ -116,7 +116,9 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
             ASSERT_NEAR(gotRadiance[c], radiance[c], top * (1.0f / 256.0f + 1e-4f))
                 << "node " << n << " channel " << c;
     }
-    EXPECT_GT(sloped, (nodes.size() - nS) / 2);
+    // Slopes of 0.1 and more in a good share of the nodes (about half with the bake's flux
+    // weights today; the limiter cuts the rest): the comparison above is not of zeros.
+    EXPECT_GT(sloped, (nodes.size() - nS) / 4);
 }
 
 }  // namespace
