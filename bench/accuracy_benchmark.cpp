@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -280,31 +279,6 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     auto blotch = blotchIndex(oursIndirect, idealIndirect);
     if (!blotch) return reportError(blotch.error());
 
-    // The caches themselves, per kind: band 0 of luma (their mean incident luma radiance),
-    // linked against ideal. The ratio of the sums says whether one kind reads dark or bright
-    // (grid caches light dynamic objects and the triangles too small for the light map, which
-    // an image may barely show); the relative RMS of the differences is their scatter, ideal
-    // caches' own noise included.
-    Json cacheKinds;
-    const size_t strideY = size_t{bake->params.bandsY} * bake->params.bandsY;
-    for (const auto& [kind, name] : {std::pair{gpu::kCacheKindGrid, "grid"},
-                                     std::pair{gpu::kCacheKindLightmap, "lightmap"}}) {
-        double linkedSum = 0.0, idealSum = 0.0, squared = 0.0;
-        size_t count = 0;
-        for (size_t c = 0; c < bake->caches.size(); ++c) {
-            if (bake->caches[c].kind != kind) continue;
-            const double l = (*values)->y[c * strideY], i = ideal->y[c * strideY];
-            linkedSum += l;
-            idealSum += i;
-            squared += (l - i) * (l - i);
-            ++count;
-        }
-        if (count == 0 || !(idealSum > 0.0)) continue;
-        cacheKinds[name] = {{"caches", count},
-                            {"linked_over_ideal", linkedSum / idealSum},
-                            {"relative_rms", std::sqrt(squared / double(count)) / (idealSum / double(count))}};
-    }
-
     std::error_code ec;
     std::filesystem::create_directories(params.outDir, ec);
     const std::string stem = std::filesystem::path(params.scenePath).stem().string();
@@ -338,7 +312,6 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     json["ideal_indirect"] = errorJson(*eIdealIndirect);
     json["ideal_full"] = errorJson(*eIdealFull);
     json["blotch_index"] = *blotch;
-    json["caches"] = cacheKinds;
     json["seconds"] = seconds;
     json["images"] = {base + "_indirect_side.png", base + "_full_side.png"};
     const std::string jsonPath = params.jsonPath.empty() ? base + "_accuracy.json" : params.jsonPath;
@@ -355,10 +328,6 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
                     e->channelRatio.r, e->channelRatio.g, e->channelRatio.b);
     std::printf("  blotch index (linked against ideal caches, indirect, 4x4 blocks, mean-matched): %.4f\n",
                 *blotch);
-    for (const auto& [name, kind] : cacheKinds.items())
-        std::printf("  %s caches (%zu), band-0 luma, linked against ideal: ratio of sums %.4f, relative RMS %.4f\n",
-                    name.c_str(), kind["caches"].get<size_t>(), kind["linked_over_ideal"].get<double>(),
-                    kind["relative_rms"].get<double>());
     std::printf("  seconds: %s\n", seconds.dump().c_str());
     std::printf("  wrote %s, %s_indirect_side.png, %s_full_side.png (ours | ideal caches | path traced | error)\n",
                 jsonPath.c_str(), base.c_str(), base.c_str());

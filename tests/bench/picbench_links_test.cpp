@@ -81,40 +81,6 @@ TEST_F(PicbenchLinks, SweepChartsUpdateTimeAgainstError) {
     EXPECT_TRUE(fs::exists(mDir / "sweep.png"));
 }
 
-TEST_F(PicbenchLinks, AccuracyHoldsEachKindOfCacheAgainstTheIdealOnes) {
-    // `accuracy` compares the converged caches with the ideal ones per kind: every cache is
-    // counted once, in its kind, and on cornell both kinds read within a factor 1.5 of the
-    // ideal caches (a cache of one kind counted in the other, or a band other than 0, would
-    // not); the blotch index is a finite, positive figure beside them.
-    const fs::path json = mDir / "accuracy.json";
-    std::string err;
-    ASSERT_EQ(run(std::string("accuracy --scene ") + PIC_TEST_SCENE_DIR +
-                      "/cornell.gltf --surfels 4096 --links 32 --size 24x24 --spp 16 "
-                      "--probe-samples 64 --out-dir " + (mDir / "accuracy").string() + " --json " + json.string(),
-                  err),
-              0)
-        << err;
-    std::ifstream in(json);
-    const nlohmann::json report = nlohmann::json::parse(in);
-    const nlohmann::json& caches = report.at("caches");
-    size_t counted = 0;
-    for (const char* kind : {"grid", "lightmap"}) {
-        SCOPED_TRACE(kind);
-        const nlohmann::json& k = caches.at(kind);
-        counted += k.at("caches").get<size_t>();
-        const double ratio = k.at("linked_over_ideal").get<double>();
-        EXPECT_GT(ratio, 1.0 / 1.5);
-        EXPECT_LT(ratio, 1.5);
-        const double rms = k.at("relative_rms").get<double>();
-        EXPECT_TRUE(std::isfinite(rms));
-        EXPECT_GT(rms, 0.0);
-    }
-    EXPECT_EQ(counted, report.at("bake").at("unique_caches").get<size_t>());
-    const double blotch = report.at("blotch_index").get<double>();
-    EXPECT_TRUE(std::isfinite(blotch));
-    EXPECT_GT(blotch, 0.0);
-}
-
 TEST_F(PicbenchLinks, MissingSceneIsBadInputNamingThePath) {
     std::string err;
     EXPECT_EQ(run("links --scene /nonexistent/scene.gltf", err), 2);
