@@ -53,6 +53,8 @@ struct Scratch {
     std::vector<VisibleSample> samples;
     std::vector<uint32_t> near;  ///< the cache's near surfels (CacheLinker::findNear), ascending
     std::vector<uint32_t> stack;
+    std::vector<double> targets;  ///< CacheLinker::estimate's draws
+    std::vector<uint32_t> drawn;
 };
 
 /// Surfels within this many of their radii of a cache are counted exactly in every estimate
@@ -316,16 +318,25 @@ private:
             const auto nearEnd = std::lower_bound(nearBegin, scratch.near.end(),
                                                   node.firstSurfel + node.surfelCount);
             for (auto it = nearBegin; it != nearEnd; ++it) addExact(*it);
-            const auto first = mPrefix.begin() + node.firstSurfel;
-            const auto last = mPrefix.begin() + node.firstSurfel + node.surfelCount;
-            for (uint32_t j = 0; j < taken; ++j) {
-                const double target = begin + (j + rng.uniform()) / taken * weightedArea;
-                // The surfel whose [prefix[s], prefix[s + 1]) holds the target.
-                uint32_t s =
-                    node.firstSurfel +
-                    static_cast<uint32_t>(std::min<ptrdiff_t>(
-                        std::upper_bound(first, last, target) - first - 1, node.surfelCount - 1));
-                s = std::max(s, node.firstSurfel);
+            // Draw j is the surfel s whose [prefix[s], prefix[s + 1]) holds its target (the
+            // last one for a target at the end). The draws' binary searches over the node's
+            // prefix sums run in lockstep, branch-free, so that their cache misses overlap,
+            // and the surfels they find are prefetched before any is viewed: drawn from a
+            // large node they lie far apart in memory, and the bake waited on them.
+            std::vector<double>& targets = scratch.targets;
+            std::vector<uint32_t>& drawn = scratch.drawn;
+            targets.resize(taken);
+            drawn.assign(taken, node.firstSurfel);
+            for (uint32_t j = 0; j < taken; ++j)
+                targets[j] = begin + (j + rng.uniform()) / taken * weightedArea;
+            for (uint32_t n = node.surfelCount; n > 1;) {
+                const uint32_t half = n / 2;
+                for (uint32_t j = 0; j < taken; ++j)
+                    drawn[j] += mPrefix[drawn[j] + half] <= targets[j] ? half : 0u;
+                n -= half;
+            }
+            for (uint32_t s : drawn) __builtin_prefetch(&mSurfels[s]);
+            for (uint32_t s : drawn) {
                 if (std::binary_search(nearBegin, nearEnd, s)) continue;
                 const Surfel& surfel = mSurfels[s];
                 const SurfelView view = viewSurfel(mRays, cache, surfel);
