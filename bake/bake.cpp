@@ -171,6 +171,7 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     if (p.exposureRays > 1024)
         return fail(ErrorCode::InvalidInput, "--exposure-rays must be in [0, 1024], got {}", p.exposureRays);
     p.linkReads = options.linkReads;
+    p.linkCut = options.linkCut;
     p.relaxIterations = options.relaxIterations;
     p.seed = options.seed;
     return p;
@@ -249,6 +250,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.finalSamplesPerNode = p.linkFinalSamples;
     linkParams.seed = p.seed;
     linkParams.reads = p.linkReads;
+    linkParams.cut = p.linkCut;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
     bake.links = std::move(links.links);
     bake.surfelWeights = weights.empty() ? std::vector<float>(bake.surfels.size(), 1.0f) : weights;

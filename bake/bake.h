@@ -28,6 +28,7 @@ struct BakeOptions {
     uint32_t linkFinalSamples = 64;
     uint32_t exposureRays = 64;
     LinkReads linkReads = LinkReads::Visible;
+    LinkCut linkCut = LinkCut::ErrorBound;
     uint32_t relaxIterations = 4;
     uint64_t seed = 1;
 };

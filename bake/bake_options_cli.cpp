@@ -27,6 +27,11 @@ void BakeOptionFlags::addTo(CLI::App& command) {
                        "whose flux a link reads: visible (the smallest part of the linked node "
                        "holding what the cache sees) or node (the paper's; default visible)")
         ->check(CLI::IsMember({"visible", "node"}));
+    command.add_option("--link-cut", mLinkCut,
+                       "how a cache's links are chosen: error (refine the node with the largest "
+                       "visible solid angle times radius, the bound on its model's error) or "
+                       "solid-angle (the paper's; default error)")
+        ->check(CLI::IsMember({"error", "solid-angle"}));
     command.add_option("--relax", mOptions.relaxIterations, "surfel relaxation iterations (default 4)");
     command.add_option("--seed", mOptions.seed, "random seed (default 1)");
 }
@@ -44,6 +49,7 @@ BakeOptions BakeOptionFlags::toOptions() const {
                         : mHierarchy == "agglomerative" ? HierarchyMethod::Agglomerative
                                                         : HierarchyMethod::Visible;
     options.linkReads = mLinkReads == "node" ? LinkReads::Node : LinkReads::Visible;
+    options.linkCut = mLinkCut == "solid-angle" ? LinkCut::SolidAngle : LinkCut::ErrorBound;
     return options;
 }
 

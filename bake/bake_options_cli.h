@@ -14,8 +14,8 @@ namespace pic {
 class BakeOptionFlags {
 public:
     /// Adds --surfels, --links, --bands, --chroma-bands, --grid-cell, --lightmap-texel,
-    /// --link-mode, --hierarchy, --link-samples, --exposure-rays, --link-reads, --relax and
-    /// --seed to `command`.
+    /// --link-mode, --hierarchy, --link-samples, --exposure-rays, --link-reads, --link-cut,
+    /// --relax and --seed to `command`.
     void addTo(CLI::App& command);
     /// The options the user set; unset ones stay empty so the bake picks defaults.
     BakeOptions toOptions() const;
@@ -24,7 +24,8 @@ private:
     BakeOptions mOptions;
     uint32_t mSurfels = 0, mLinks = 0, mBands = 0, mChromaBands = 0;
     float mGridCell = 0.0f, mLightmapTexel = 0.0f;
-    std::string mLinkMode = "rtp", mHierarchy = "visible", mLinkReads = "visible";
+    std::string mLinkMode = "rtp", mHierarchy = "visible", mLinkReads = "visible",
+                mLinkCut = "error";
     CLI::Option* mSurfelsOption = nullptr;
     CLI::Option* mLinksOption = nullptr;
     CLI::Option* mBandsOption = nullptr;

@@ -41,7 +41,7 @@ struct NodeEstimate {
     double visibleArea = 0.0;  ///< estimated Σ w·a of the surfels the cache sees, m²
     uint32_t firstVisible = UINT32_MAX;     ///< leaf-order range of the visible samples' surfels
     uint32_t lastVisible = 0;
-    float priority = 0.0f;     ///< refinement order: larger first
+    float priority = 0.0f;     ///< refinement order, larger first: Ω·r, or Ω (LinkCut)
     bool exact = false;        ///< every surfel of the node was tested
     uint32_t readNode = 0;     ///< the node whose flux the link reads (see CacheLinker::localise)
     float readScale = 1.0f;    ///< Σ w·a of the node over that of readNode
@@ -351,20 +351,28 @@ private:
             }
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
+        // The refinement order is a bound on the error of the node's model: a link reads its
+        // node's flux as spread by the weights and a linear spread (render/cpu/pull.h), which
+        // light varying over the node at a rate g beyond the model (a sunlit patch, a shadow's
+        // edge) misses by up to g·r at a distance r from where the model is right, so the link
+        // is off by up to Ω·g·r over the Ω it sees. g depends on the lights, unknown here, so
+        // it is the same for every node, and the node with the largest Ω·r (its bounding
+        // radius) is refined first. Paper 000's order, Ω alone, refines a small node beside
+        // the cache, which its model already matches, before a large one across the room.
         // An unlucky sample set may miss the visible part of a node (e.g. a few wall surfels
         // in a node that is mostly coplanar with a light-map cache). Such nodes keep the
         // prior that 1/(k+1) of their bounding sphere's solid angle might be visible, so
         // nodes near the cache are still refined until their samples are exact.
-        if (e.visible > 0.0f || e.exact) {
-            e.priority = e.visible;
-        } else {
+        float omega = e.visible;
+        if (!(e.visible > 0.0f || e.exact)) {
             glm::vec3 toCentre = node.center - cache.position;
             float d2 = glm::dot(toCentre, toCentre);
             float r2 = node.radius * node.radius;
             float bound = d2 <= r2 ? 4.0f * kPi
                                    : 2.0f * kPi * r2 / (d2 * (1.0f + std::sqrt(1.0f - r2 / d2)));
-            e.priority = bound / static_cast<float>(k + 1);
+            omega = bound / static_cast<float>(k + 1);
         }
+        e.priority = mParams.cut == LinkCut::ErrorBound ? omega * node.radius : omega;
         return e;
     }
 

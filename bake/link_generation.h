@@ -1,7 +1,9 @@
 #pragma once
-/// Link generation (paper 000 §4.5-4.6): for every cache, a cut of nL hierarchy nodes
-/// refined top-down by visible solid angle (Embree occlusion rays), stored SH-projected
-/// (eq. 2) or runtime-projected (direction, cone, scalar factor), each with a colour tint.
+/// Link generation (paper 000 §4.5-4.6): for every cache, a cut of nL hierarchy nodes refined
+/// top-down by visible solid angle times node radius, a bound on the error of a node's model
+/// (paper 000 refines by visible solid angle alone), with Embree occlusion rays; stored
+/// SH-projected (eq. 2) or runtime-projected (direction, cone, scalar factor), each with a
+/// colour tint.
 
 #include <cstdint>
 #include <vector>
@@ -19,6 +21,7 @@ struct LinkParams {
     uint32_t samplesPerNode = 16;  ///< visibility rays per node estimate while choosing the cut
     uint32_t finalSamplesPerNode = 64;  ///< rays of a linked node's fresh, final estimate
     LinkReads reads = LinkReads::Visible;
+    LinkCut cut = LinkCut::ErrorBound;
     uint64_t seed = 1;
 };
 

@@ -113,6 +113,9 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     fmt::print("  links read      {}\n", p.linkReads == LinkReads::Node
                                             ? "the linked node's flux (--link-reads node)"
                                             : "the part of the node the cache sees");
+    fmt::print("  links chosen by {}\n", p.linkCut == LinkCut::SolidAngle
+                                             ? "visible solid angle (--link-cut solid-angle)"
+                                             : "the bound on their error, solid angle × radius");
     fmt::print("  bands           y {}, c {}{}\n", p.bandsY, p.bandsC,
                bake->defaults.count("bands") ? "  (default)" : "");
     fmt::print("  seed            {}\n", p.seed);
@@ -160,6 +163,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
                      {"link_final_samples", p.linkFinalSamples},
                      {"exposure_rays", p.exposureRays},
                      {"link_reads", p.linkReads == LinkReads::Node ? "node" : "visible"},
+                     {"link_cut", linkCutName(p.linkCut)},
                      {"relax_iterations", p.relaxIterations},
                      {"seed", p.seed}};
     out["defaults"] = Json::object();

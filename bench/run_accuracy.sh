@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Accuracy of the cache term against the path-traced reference on the test scenes and the
 # living room, with the default bake (exposure flux weights, links that read the part they
-# see, the visible hierarchy) and with paper 000's (--exposure-rays 0 --link-reads node
-# --hierarchy agglomerative), the nL sweep on cornell and the one-bounce decomposition of the
-# linked caches' error: the commands of docs/accuracy.md. Writes JSON and side-by-side PNGs into ${OUT:-accuracy}/<default|paper>/.
+# see, the visible hierarchy, the error-bound cut) and with paper 000's (--exposure-rays 0
+# --link-reads node --link-cut solid-angle --hierarchy agglomerative), the nL sweep on cornell
+# and the one-bounce decomposition of the linked caches' error: the commands of
+# docs/accuracy.md. Writes JSON and side-by-side PNGs into ${OUT:-accuracy}/<default|paper>/.
 # Usage: bash bench/run_accuracy.sh [build-dir]
 set -euo pipefail
 BUILD=${1:-build}
@@ -13,7 +14,7 @@ LIVING="$(dirname "$0")/../../shared/scenes/living_room_sh3d.glb"
 SUN_LAMP="$(dirname "$0")/lightsets/living_room_sun_lamp.json"
 for variant in default paper; do
   X=()
-  [ "$variant" = paper ] && X=(--exposure-rays 0 --link-reads node --hierarchy agglomerative --link-final-samples 16)
+  [ "$variant" = paper ] && X=(--exposure-rays 0 --link-reads node --link-cut solid-angle --hierarchy agglomerative --link-final-samples 16)
   A="$BUILD/bench/picbench --quiet accuracy --out-dir $OUT/$variant"
   $A --scene "$SCENES/cornell.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"
   $A --scene "$SCENES/cornell_area.gltf" --size 96x96 --spp 512 --probe-samples 512 "${X[@]}"

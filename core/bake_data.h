@@ -54,6 +54,17 @@ enum class LinkReads : uint32_t {
                   ///< colour of that part (the link's tint)
 };
 
+/// How a cache's cut is refined (bake/link_generation.h).
+enum class LinkCut : uint32_t {
+    SolidAngle = 0,  ///< the node with the largest visible solid angle Ω first (paper 000)
+    ErrorBound = 1,  ///< the node with the largest Ω·r (r its radius) first: the bound on the
+                     ///< error of its model
+};
+
+inline const char* linkCutName(LinkCut cut) {
+    return cut == LinkCut::SolidAngle ? "solid-angle" : "error";
+}
+
 /// The parameters a bake was made with, after defaults were resolved.
 struct BakeParams {
     uint32_t surfels = 0;            ///< nS
@@ -69,6 +80,7 @@ struct BakeParams {
     uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
                                      ///< (bake/surfel_exposure.h); 0: uniform node radiance
     LinkReads linkReads = LinkReads::Visible;
+    LinkCut linkCut = LinkCut::ErrorBound;
     uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
     uint64_t seed = 1;
 };

@@ -339,6 +339,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["link_final_samples"] = p.linkFinalSamples;
     json["exposure_rays"] = p.exposureRays;
     json["link_reads"] = linkReadsName(p.linkReads);
+    json["link_cut"] = linkCutName(p.linkCut);
     json["relax_iterations"] = p.relaxIterations;
     json["seed"] = p.seed;
     json["defaults"] = defaults;
@@ -379,6 +380,8 @@ public:
                        unsignedField(key, std::numeric_limits<uint32_t>::max()));
         return static_cast<uint32_t>(value);
     }
+
+    bool contains(const char* key) const { return mObject.contains(key); }
 
     /// An optional field: `fallback` where the file does not have it.
     Result<uint32_t> u32Or(const char* key, uint32_t fallback) {
@@ -468,6 +471,11 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     PIC_TRY_ASSIGN(p.exposureRays, reader.u32("exposure_rays"));
     PIC_TRY_ASSIGN(const uint32_t linkReads, reader.oneOf("link_reads", {"node", "visible"}));
     p.linkReads = static_cast<LinkReads>(linkReads);
+    // Bakes written before the error-bound cut refined by solid angle.
+    PIC_TRY_ASSIGN(const uint32_t linkCut, reader.contains("link_cut")
+                                               ? reader.oneOf("link_cut", {"solid-angle", "error"})
+                                               : Result<uint32_t>(0u));
+    p.linkCut = static_cast<LinkCut>(linkCut);
     PIC_TRY_ASSIGN(p.relaxIterations, reader.u32("relax_iterations"));
     PIC_TRY_ASSIGN(p.seed, reader.unsignedField("seed", std::numeric_limits<uint64_t>::max()));
     PIC_TRY_ASSIGN(parsed.defaults, reader.stringMap("defaults"));

@@ -452,5 +452,72 @@ TEST(LinkReads, ALinkTakesTheColourOfThePartItSees) {
     EXPECT_NEAR(rootFlux.g / rootFlux.r, rootAlbedo.g / rootAlbedo.r, 1e-6f);
 }
 
+TEST(LinkCut, RefinesALargeFarPatchBeforeASmallNearOne) {
+    // A cache between two patches of 4 × 4 surfels that subtend about the same solid angle,
+    // 0.16 sr: a 0.2 m square 0.5 m above it and a 2 m square 5 m below. The cut refines by
+    // Ω·r, the bound on its nodes' model error (bake/link_generation.cpp), so with 8 links
+    // the far patch, ten times the radius, takes all but one of them; by Ω alone, paper
+    // 000's order, the two would split them about evenly.
+    Scene scene;
+    scene.sourcePath = "patches.gltf";
+    addSquare(scene, 0.5f, 0.1f, false);
+    addSquare(scene, -5.0f, 1.0f, true);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    std::vector<Surfel> surfels;
+    for (const bool near : {true, false})
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j) {
+                const float side = near ? 0.05f : 0.5f;  // surfel spacing, m
+                const glm::vec3 at(side * (i - 1.5f), near ? 0.5f : -5.0f, side * (j - 1.5f));
+                Surfel s = surfelAt(at, {0.0f, near ? -1.0f : 1.0f, 0.0f});
+                s.area = side * side;
+                s.radius = std::sqrt(s.area / std::numbers::pi_v<float>);
+                surfels.push_back(s);
+            }
+    auto hierarchy = buildHierarchy(surfels, HierarchyParams{.sceneExtent = 6.0f});
+    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+    const std::vector<Surfel>& leaves = hierarchy->surfels;
+    const std::vector<Node>& nodes = hierarchy->nodes;
+    Cache cache{};
+    cache.kind = gpu::kCacheKindGrid;
+
+    // Links of each patch for a cut, and the solid angles they see.
+    struct Split {
+        int nearLinks = 0, farLinks = 0;
+        double nearSolidAngle = 0.0, farSolidAngle = 0.0;
+    };
+    auto split = [&](LinkCut cut) {
+        LinkParams params;
+        params.linksPerCache = 8;
+        params.cut = cut;
+        auto links = generateLinks(**rays, leaves, nodes, {cache}, params);
+        EXPECT_TRUE(links) << links.error().message;
+        Split result;
+        for (uint32_t l = 0; links && l < params.linksPerCache; ++l) {
+            const RtpLink& link = links->links.rtp[l];
+            EXPECT_GT(link.factor, 0.0f) << "link " << l << " is padding";
+            const Node& node = nodes[link.node];
+            bool nearNode = true, farNode = true;
+            for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
+                nearNode = nearNode && leaves[s].position.y > 0.0f;
+                farNode = farNode && leaves[s].position.y < 0.0f;
+            }
+            EXPECT_TRUE(nearNode || farNode) << "link " << l << " reads both patches";
+            (nearNode ? result.nearLinks : result.farLinks) += 1;
+            (nearNode ? result.nearSolidAngle : result.farSolidAngle) +=
+                links->visibleSolidAngle[l];
+        }
+        return result;
+    };
+    const Split error = split(LinkCut::ErrorBound);
+    EXPECT_NEAR(error.nearSolidAngle / error.farSolidAngle, 1.0, 0.1);
+    EXPECT_EQ(error.nearLinks, 1);
+    EXPECT_EQ(error.farLinks, 7);
+    const Split paper = split(LinkCut::SolidAngle);
+    EXPECT_EQ(paper.nearLinks, 4);
+    EXPECT_EQ(paper.farLinks, 4);
+}
+
 }  // namespace
 }  // namespace pic

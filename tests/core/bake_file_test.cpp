@@ -345,6 +345,30 @@ TEST_F(BakeFile, ParamsWithoutFinalLinkSamplesReadThemAsLinkSamples) {
     EXPECT_EQ(read->params.linkFinalSamples, 8u);
 }
 
+TEST_F(BakeFile, ParamsWithoutALinkCutReadAsTheSolidAngleCut) {
+    // The link cut round-trips by name, and bakes written before "link_cut" existed refined
+    // their cuts by solid angle: a file without the field (blanked out as above) reads so.
+    BakeData bake = makeBake(LinkMode::Rtp);
+    for (const LinkCut cut : {LinkCut::SolidAngle, LinkCut::ErrorBound}) {
+        bake.params.linkCut = cut;
+        const auto [file, bytes] = written(bake);
+        const Result<BakeData> read = readBakeFile(file);
+        ASSERT_TRUE(read) << read.error().message;
+        EXPECT_EQ(read->params.linkCut, cut);
+    }
+    auto [file, bytes] = written(bake);
+    std::string text(bytes.begin(), bytes.end());
+    const std::string field = R"("link_cut": "error",)";
+    const size_t at = text.find(field);
+    ASSERT_NE(at, std::string::npos);
+    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
+    resealSection(bytes, 0);
+    writeBytes(file, bytes);
+    const Result<BakeData> read = readBakeFile(file);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_EQ(read->params.linkCut, LinkCut::SolidAngle);
+}
+
 TEST_F(BakeFile, WritesByteIdenticalFiles) {
     const BakeData bake = makeBake(LinkMode::Sh);
     const auto [first, firstBytes] = written(bake, "a.pic");

@@ -22,7 +22,7 @@ using BakeKey =
     std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
                std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
                std::optional<float>, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t,
-               LinkReads, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
+               LinkReads, LinkCut, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
 
 BakeKey keyOf(const std::string& name, const BakeOptions& o,
               std::optional<std::pair<float, float>> perDiagonal) {
@@ -39,6 +39,7 @@ BakeKey keyOf(const std::string& name, const BakeOptions& o,
             o.linkFinalSamples,
             o.exposureRays,
             o.linkReads,
+            o.linkCut,
             o.relaxIterations,
             o.seed,
             perDiagonal};
