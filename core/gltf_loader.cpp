@@ -356,6 +356,11 @@ public:
         if (!mModel.skins.empty())
             fmt::print(stderr, "note: '{}': skins are ignored (meshes loaded in bind pose)\n",
                        mPath);
+        if (mScene.rewound)
+            fmt::print(stderr,
+                       "note: '{}': {} triangles wound clockwise about their vertex normals were "
+                       "turned to face them\n",
+                       mPath, mScene.rewound);
         finish();
         return std::move(mScene);
     }
@@ -538,10 +543,14 @@ private:
                 t.v[k] = uint32_t(base + (hasNormals ? corners[c + size_t(k)] : c + size_t(k)));
             t.primitive = primitiveId;
             mScene.triangles.push_back(t);
-            float area = mScene.triangleArea(uint32_t(mScene.triangles.size() - 1));
+            const uint32_t index = uint32_t(mScene.triangles.size() - 1);
+            float area = mScene.triangleArea(index);
             if (!(area > 0.0f) || !std::isfinite(area)) {
                 mScene.triangles.pop_back();
                 ++mScene.droppedDegenerate;
+            } else if (hasNormals && windsAgainstItsNormals(index)) {
+                std::swap(mScene.triangles.back().v[1], mScene.triangles.back().v[2]);
+                ++mScene.rewound;
             }
         }
         uint32_t triangleCount = uint32_t(mScene.triangles.size()) - firstTriangle;
@@ -613,6 +622,18 @@ private:
             }
         }
         return corners;
+    }
+
+    /// Whether triangle t winds clockwise about its vertex normals: the front face of glTF is
+    /// the counter-clockwise one, but files from other tools often disagree with their own
+    /// normals, and the normals are what their authors saw shaded. Surfels, light-map caches
+    /// and the inside tests all face the geometric normal, so a triangle wound against its
+    /// normals would be lit, and would light, from behind. Non-finite normals have no say.
+    bool windsAgainstItsNormals(uint32_t t) const {
+        glm::vec3 sum(0.0f);
+        for (uint32_t v : mScene.triangles[t].v)
+            if (isFinite(mScene.vertices[v].normal)) sum += mScene.vertices[v].normal;
+        return glm::dot(sum, mScene.triangleNormal(t)) < 0.0f;
     }
 
     /// Gives flat-shaded vertices their triangle's normal, and shared vertices whose NORMAL was

@@ -112,6 +112,7 @@ struct Scene {
     double totalArea = 0.0;        ///< sum of triangle areas, m²
     uint64_t hash = 0;             ///< content hash of geometry and materials
     uint32_t droppedDegenerate = 0;  ///< zero-area triangles skipped at load
+    uint32_t rewound = 0;  ///< triangles turned at load to wind counter-clockwise about their normals
 
     /// Area of triangle t in m².
     float triangleArea(uint32_t t) const;

@@ -799,6 +799,40 @@ TEST_F(GltfLoader, MirroringNodeKeepsNormalsOutward) {
     EXPECT_NEAR(scene->totalArea, 1.5 + std::sqrt(3.0) / 2.0 + 1.0, 1e-5);
 }
 
+TEST_F(GltfLoader, TrianglesWoundAgainstTheirNormalsAreTurned) {
+    // The same quad three times: wound counter-clockwise about its +z normals, wound clockwise
+    // about them (one triangle), and without normals wound clockwise (flat normals follow the
+    // winding, so nothing disagrees).
+    GltfBuilder b;
+    int positions = b.floats({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, "VEC3");
+    int normals = b.floats({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
+    auto quad = [&](std::vector<uint16_t> indices, bool withNormals) {
+        json attributes = {{"POSITION", positions}};
+        if (withNormals) attributes["NORMAL"] = normals;
+        return b.append(
+            "meshes",
+            {{"primitives",
+              json::array({{{"attributes", attributes},
+                            {"indices", b.data(indices, kUnsignedShort, "SCALAR")}}})}});
+    };
+    int agreeing = quad({0, 1, 2, 0, 2, 3}, true);
+    int halfTurned = quad({0, 2, 1, 0, 2, 3}, true);
+    int flat = quad({0, 2, 1, 0, 3, 2}, false);
+    b.scene({b.append("nodes", {{"mesh", agreeing}}), b.append("nodes", {{"mesh", halfTurned}}),
+             b.append("nodes", {{"mesh", flat}})});
+    Result<Scene> scene = writeAndLoad(b);
+    ASSERT_TRUE(scene) << scene.error().message;
+    ASSERT_EQ(scene->triangles.size(), 6u);
+    EXPECT_EQ(scene->rewound, 1u);
+    for (uint32_t t = 0; t < 4; ++t) {
+        expectVecNear(scene->triangleNormal(t), {0, 0, 1}, 1e-6f);
+        for (uint32_t v : scene->triangles[t].v)
+            expectVecNear(scene->vertices[v].normal, {0, 0, 1}, 1e-6f);
+    }
+    for (uint32_t t = 4; t < 6; ++t) expectVecNear(scene->triangleNormal(t), {0, 0, -1}, 1e-6f);
+    EXPECT_NEAR(scene->totalArea, 3.0, 1e-6);
+}
+
 TEST_F(GltfLoader, DegenerateTrianglesAreDroppedAndCounted) {
     GltfBuilder b;
     int positions = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0}, "VEC3");
