@@ -158,7 +158,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     const float epsilon = (*rays)->epsilon();
     auto firstBounce = [&](const glm::vec3& origin, const glm::vec3& direction) {
         const auto hit = (*rays)->intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
-        if (!hit) return glm::vec3(0.0f);
+        if (!hit || (hit->backFace && params.oneSidedTruth)) return glm::vec3(0.0f);
         const uint32_t t = hit->triangle;
         glm::vec3 radiance(0.0f);
         if (!hit->backFace)
@@ -232,6 +232,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                     {"link_mode", bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp"},
                     {"unique_caches", nC}};
     json["directions"] = params.directions;
+    json["one_sided_truth"] = params.oneSidedTruth;
     json["all"] = ratiosJson(all, uint32_t(examined));
     json["grid"] = ratiosJson(grid, gridCount);
     json["lightmap"] = ratiosJson(lightmap, lightmapCount);

@@ -32,6 +32,8 @@ struct LinkErrorParams {
     BakeOptions bake;
     uint32_t caches = 400;         ///< caches to examine, evenly spread over the cache list
     uint32_t directions = 1024;    ///< path-traced directions per examined cache
+    bool oneSidedTruth = false;    ///< the traced bounce takes no light off a surface's back,
+                                   ///< as the surfels (front faces only) do
     std::string jsonPath;          ///< empty: print only
     uint64_t seed = 1;
 };

@@ -54,6 +54,33 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
     EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);
 }
 
+TEST_F(PicbenchLinks, OneSidedTruthTakesTheBackFacesLightOut) {
+    // The furnished room's window lets grid caches sit outside it, where they see its walls
+    // from behind: the path-traced truth reflects light off those backs, the surfels (front
+    // faces only) cannot, so with --one-sided-truth the grid caches' representation rises. The
+    // light-map caches, all inside, see no back face: theirs stays.
+    auto factors = [&](const std::string& extra, const char* name) {
+        const fs::path json = mDir / name;
+        std::string err;
+        EXPECT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR +
+                          "/furnished_room.gltf --surfels 4096 --links 64 --caches 60 --directions 128 " + extra +
+                          " --json " + json.string(),
+                      err),
+                  0)
+            << err;
+        std::ifstream in(json);
+        return nlohmann::json::parse(in);
+    };
+    const nlohmann::json both = factors("", "both.json");
+    const nlohmann::json front = factors("--one-sided-truth", "front.json");
+    EXPECT_FALSE(both.at("one_sided_truth").get<bool>());
+    EXPECT_TRUE(front.at("one_sided_truth").get<bool>());
+    EXPECT_GT(front.at("grid").at("representation").get<double>(),
+              both.at("grid").at("representation").get<double>() + 0.03);
+    EXPECT_NEAR(front.at("lightmap").at("representation").get<double>(),
+                both.at("lightmap").at("representation").get<double>(), 0.01);
+}
+
 TEST_F(PicbenchLinks, SweepChartsUpdateTimeAgainstError) {
     // `accuracy --links-sweep`: one bake per nL (given unsorted, with a repeat), one reference.
     const fs::path json = mDir / "sweep.json";
