@@ -32,7 +32,7 @@ for variant in default paper; do
   for view in "a -5,8.2,-30,-5,7,-10,0,1,0,70" "b 10,7.9,-22,-2,7,-12,0,1,0,70"; do
     $BUILD/bench/picbench --quiet accuracy --out-dir "$OUT/$variant/openarena_${view%% *}" \
       --scene "$OPENARENA" --lights "$SUN" --camera "${view#* }" --size 160x120 --spp 128 \
-      --probe-samples 128 "${X[@]}"
+      --probe-samples 1024 "${X[@]}"
   done
 done
 # The speed/accuracy trade-off over nL (JSON and a PNG chart).
