@@ -64,6 +64,43 @@ Json channelRatios(const glm::dvec3& a, const glm::dvec3& b) {
     return out;
 }
 
+/// How much the caches of `cache` disagree in one factor a/b beyond its ratio over them all:
+/// the RMS over caches of (their luma ratio / the aggregate's − 1), each cache weighted by
+/// the luma of b. A factor that is right on average but differs from cache to cache shows
+/// here and as blotches, not in the ratio.
+template <typename A, typename B>
+double scatter(const std::vector<Estimates>& estimates, const std::vector<size_t>& cache, A a, B b) {
+    glm::dvec3 sumA(0.0), sumB(0.0);
+    for (size_t k : cache) sumA += a(estimates[k]), sumB += b(estimates[k]);
+    const double overall = lumaRatio(sumA, sumB);
+    if (!(overall > 0.0)) return 0.0;
+    double weighted = 0.0, weight = 0.0;
+    for (size_t k : cache) {
+        const double w = luma(b(estimates[k]));
+        if (!(w > 0.0)) continue;
+        const double d = luma(a(estimates[k])) / w / overall - 1.0;
+        weighted += w * d * d;
+        weight += w;
+    }
+    return weight > 0.0 ? std::sqrt(weighted / weight) : 0.0;
+}
+
+/// The scatter of every factor over the caches `cache`.
+Json scatterJson(const std::vector<Estimates>& e, const std::vector<size_t>& cache) {
+    auto traced = [](const Estimates& x) { return x.traced; };
+    auto gather = [](const Estimates& x) { return x.gather; };
+    auto cut = [](const Estimates& x) { return x.cut; };
+    auto mean = [](const Estimates& x) { return x.mean; };
+    auto spread = [](const Estimates& x) { return x.spread; };
+    auto linked = [](const Estimates& x) { return x.linked; };
+    return {{"linked_over_traced", scatter(e, cache, linked, traced)},
+            {"representation", scatter(e, cache, gather, traced)},
+            {"cut_coverage", scatter(e, cache, cut, gather)},
+            {"node_mean_radiance", scatter(e, cache, mean, cut)},
+            {"node_spread_radiance", scatter(e, cache, spread, cut)},
+            {"visibility_estimate", scatter(e, cache, linked, spread)}};
+}
+
 Json ratiosJson(const Estimates& e, uint32_t caches) {
     return {{"caches", caches},
             {"linked_over_traced", lumaRatio(e.linked, e.traced)},
@@ -214,15 +251,16 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     progress.finish();
 
     Estimates all, grid, lightmap;
-    uint32_t gridCount = 0, lightmapCount = 0;
+    std::vector<size_t> allCaches, gridCaches, lightmapCaches;
     for (size_t k = 0; k < examined; ++k) {
         all += estimates[k];
+        allCaches.push_back(k);
         if (bake->caches[k * nC / examined].kind == gpu::kCacheKindLightmap) {
             lightmap += estimates[k];
-            ++lightmapCount;
+            lightmapCaches.push_back(k);
         } else {
             grid += estimates[k];
-            ++gridCount;
+            gridCaches.push_back(k);
         }
     }
     Json json;
@@ -234,8 +272,11 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     json["directions"] = params.directions;
     json["one_sided_truth"] = params.oneSidedTruth;
     json["all"] = ratiosJson(all, uint32_t(examined));
-    json["grid"] = ratiosJson(grid, gridCount);
-    json["lightmap"] = ratiosJson(lightmap, lightmapCount);
+    json["grid"] = ratiosJson(grid, uint32_t(gridCaches.size()));
+    json["lightmap"] = ratiosJson(lightmap, uint32_t(lightmapCaches.size()));
+    json["all"]["scatter"] = scatterJson(estimates, allCaches);
+    json["grid"]["scatter"] = scatterJson(estimates, gridCaches);
+    json["lightmap"]["scatter"] = scatterJson(estimates, lightmapCaches);
 
     std::printf("%s: one bounce, %zu of %zu caches, nL %u (%s)\n", params.scenePath.c_str(), examined,
                 nC, nL, bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");
@@ -259,6 +300,10 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                           c[2].get<double>());
             std::printf(" %*s", widths[f], text);
         }
+        std::printf("\n");
+        const Json& scattered = r["scatter"];
+        std::printf("  %-9s %7s", "", "scatter");
+        for (int f = 0; f < 6; ++f) std::printf(" %*.4f", widths[f], scattered[factors[f]].get<double>());
         std::printf("\n");
     }
     if (!params.jsonPath.empty()) {

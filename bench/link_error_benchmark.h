@@ -18,7 +18,11 @@
 /// Their ratios factor linked/traced into the surfel representation (gather/traced), the
 /// coverage of the cut (cut/gather), the node radiance model with the spread (spread/cut) and
 /// the visibility estimate (linked/spread); mean/cut, the model without the spread, is printed
-/// beside them. Writes JSON; never asserts.
+/// beside them. Under each ratio, its scatter: the RMS over the caches of their own ratio's
+/// relative deviation from it (weighted by the denominator's luma), how much neighbouring
+/// caches disagree in that factor, which shows as blotches rather than bias. The traced
+/// estimate's Monte Carlo noise adds to the scatter of the first two (about 0.2 at 1,024
+/// directions in a sunlit room; use ≥ 16,384 to read them). Writes JSON; never asserts.
 
 #include <string>
 

@@ -49,7 +49,14 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
             EXPECT_TRUE(std::isfinite(value)) << factor;
             EXPECT_GT(value, 1.0 / 1.5) << factor;
             EXPECT_LT(value, 1.5) << factor;
+            // How much the caches disagree in the factor: an RMS of relative deviations.
+            const double scatter = r.at("scatter").at(factor).get<double>();
+            EXPECT_TRUE(std::isfinite(scatter)) << factor;
+            EXPECT_GE(scatter, 0.0) << factor;
+            EXPECT_LT(scatter, 1.0) << factor;
         }
+        // Every cache's cut covers nearly all it sees, so that factor cannot scatter.
+        EXPECT_LT(r.at("scatter").at("cut_coverage").get<double>(), 0.05);
     }
     EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);
 }
