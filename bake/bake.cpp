@@ -41,6 +41,7 @@ private:
 constexpr double kSurfelSpacingDivisor = 64.0;
 constexpr uint32_t kMinDefaultSurfels = 8192;
 constexpr uint32_t kMaxDefaultSurfels = 131072;
+
 constexpr float kGridCellsAlongExtent = 16.0f;
 constexpr double kDefaultLightmapTexels = 8192.0;
 constexpr uint32_t kDefaultLinks = 128;
@@ -177,10 +178,31 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     return p;
 }
 
+Result<std::vector<Surfel>> placeBakeSurfels(const Scene& scene, const EmbreeScene& rays,
+                                             BakeParams& params, bool raise,
+                                             std::map<std::string, std::string>& defaults,
+                                             BakeReport& report) {
+    const uint32_t first = params.surfels;
+    for (;;) {
+        PIC_TRY_ASSIGN(std::vector<Surfel> surfels,
+                       placeSurfels(scene, SurfelParams{params.surfels, params.relaxIterations, 16, params.seed}));
+        report.discShareOnSurface = discShareOnSurface(rays, surfels);
+        if (!raise || report.discShareOnSurface >= kMinDiscShareOnSurface ||
+            params.surfels > kMaxDefaultSurfels / 2) {
+            if (params.surfels != first)
+                defaults["surfels"] += fmt::format("; raised from {} until at least {} of the discs' area "
+                                                   "lay on their surfaces ({:.3f})",
+                                                   first, kMinDiscShareOnSurface, report.discShareOnSurface);
+            return surfels;
+        }
+        params.surfels *= 2;
+    }
+}
+
 Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report) {
     BakeData bake;
     PIC_TRY_ASSIGN(bake.params, resolveBakeParams(scene, options, bake.defaults));
-    const BakeParams& p = bake.params;
+    BakeParams& p = bake.params;
     bake.sceneHash = scene.hash;
 
     StageTimer raysTimer(report, "rays");
@@ -189,7 +211,7 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
 
     StageTimer surfelTimer(report, "surfels");
     PIC_TRY_ASSIGN(std::vector<Surfel> surfels,
-                   placeSurfels(scene, SurfelParams{p.surfels, p.relaxIterations, 16, p.seed}));
+                   placeBakeSurfels(scene, *rays, p, !options.surfels, bake.defaults, report));
     surfelTimer.stop();
 
     StageTimer hierarchyTimer(report, "hierarchy");

@@ -44,12 +44,30 @@ struct BakeReport {
     uint32_t lightmapRejected = 0;
     uint32_t lightmapGridShaded = 0;  ///< triangles too small for the light map (grid-shaded)
     uint32_t blindCachesDropped = 0;  ///< caches that saw no surfel, removed after linking
+    double discShareOnSurface = 0.0;  ///< of the surfels' disc area (link_generation.h)
     uint64_t peakMemoryBytes = 0;
 };
 
 /// Resolves unset options from the scene's extent and area; `defaults` says how.
 Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& options,
                                      std::map<std::string, std::string>& defaults);
+
+/// The least share of the surfels' disc area on their own surfaces (discShareOnSurface) that
+/// a default surfel count keeps: open rooms hold 0.86–0.98 at a spacing of 1/64 of their
+/// extent, the OpenArena level 0.75, where caches found a quarter of the light short within
+/// four surfel radii of them.
+inline constexpr double kMinDiscShareOnSurface = 0.85;
+
+/// Places `params.surfels` surfels. With `raise` (the count is a default) the count doubles
+/// until the share of their discs on their surfaces reaches kMinDiscShareOnSurface or the
+/// next would pass the default's ceiling, 131,072: surfaces narrower than a disc (a level's
+/// steps, ledges and bars) are otherwise drawn by discs that overhang them, and caches near
+/// them find part of their light missing. Says so in `defaults`; the share placed is in
+/// `report`.
+Result<std::vector<Surfel>> placeBakeSurfels(const Scene& scene, const EmbreeScene& rays,
+                                             BakeParams& params, bool raise,
+                                             std::map<std::string, std::string>& defaults,
+                                             BakeReport& report);
 
 /// Runs every bake stage on a loaded scene.
 Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report);

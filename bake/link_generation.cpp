@@ -428,7 +428,7 @@ constexpr float kNearRadii = 3.0f;
 /// radius r): discs of radius r/√32 centred on a sunflower spiral.
 template <class Fn>
 void forDiscParts(const glm::vec3& c, const glm::vec3& n, float r, Fn&& fn) {
-    constexpr uint32_t kParts = 32;
+    constexpr uint32_t kParts = kDiscParts;
     glm::vec3 t, b;
     orthonormalBasis(n, t, b);
     const float partRadius = r / std::sqrt(float(kParts));
@@ -512,6 +512,36 @@ SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel&
             view.visible = true;
         });
     return view;
+}
+
+uint32_t surfelPartsOnSurface(const EmbreeScene& rays, const Surfel& surfel) {
+    const float epsilon = rays.epsilon();
+    uint32_t on = 0;
+    forDiscParts(surfel.position, surfel.normal, surfel.radius, [&](const glm::vec3& centre, float radius) {
+        // Lifted as far as viewSurfel's rays tolerate a surface off a part's centre.
+        const float lift = 0.5f * radius + 4.0f * epsilon;
+        const glm::vec3 from = surfel.position + lift * surfel.normal;
+        const glm::vec3 to = centre + lift * surfel.normal;
+        const glm::vec3 across = to - from;
+        const float length = glm::length(across);
+        if (length > epsilon && rays.occluded(from, across / length, 0.0f, length)) return;
+        const auto hit = rays.intersect(to, -surfel.normal, 0.0f, 2.0f * lift);
+        if (hit && glm::dot(hit->geometricNormal, surfel.normal) >= 0.7f) ++on;
+    });
+    return on;
+}
+
+double discShareOnSurface(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
+                          size_t sample) {
+    if (surfels.empty()) return 1.0;
+    const size_t count = std::min(std::max<size_t>(sample, 1), surfels.size());
+    std::vector<uint32_t> on(count);
+    parallelFor(0, count, [&](size_t k) {
+        on[k] = surfelPartsOnSurface(rays, surfels[k * surfels.size() / count]);
+    }, 64);
+    uint64_t sum = 0;
+    for (uint32_t n : on) sum += n;
+    return double(sum) / (double(kDiscParts) * double(count));
 }
 
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,

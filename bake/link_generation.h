@@ -54,6 +54,9 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params, const std::vector<float>& weights = {});
 
+/// The parts a surfel's disc is split into near a viewer (viewSurfel).
+inline constexpr uint32_t kDiscParts = 32;
+
 /// How a cache sees one surfel: the unit direction to it, its disc's solid angle (0 when it
 /// faces away from the cache or lies behind a light-map cache's surface) and whether an
 /// occlusion ray reaches it. Within three radii of the cache, only the parts of the disc where
@@ -67,6 +70,19 @@ struct SurfelView {
     uint32_t rays = 0;        ///< rays cast: one, one per part of the disc near it, or none
 };
 SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel);
+
+/// How many of the kDiscParts parts of a surfel's disc lie on its own surface: a ray from
+/// above its centre to above the part passes nothing, and one down from there meets a surface
+/// facing the surfel's way. The rest overhangs an edge, a wall standing on the surface or a
+/// hole, where near caches (viewSurfel) find nothing of the surfel.
+uint32_t surfelPartsOnSurface(const EmbreeScene& rays, const Surfel& surfel);
+
+/// The share of the surfels' disc area that lies on their own surfaces (surfelPartsOnSurface),
+/// over `sample` surfels spread evenly over the list (all when there are fewer): how well
+/// discs of their radius stand for the scene's surfaces. 1 for open floors and walls; it
+/// falls as surfaces narrower than a disc (steps, slats, pillars) take a larger share.
+double discShareOnSurface(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
+                          size_t sample = 8192);
 
 /// Solid angle (sr) of a disc of radius r seen from distance d at cosine cosTheta between
 /// its normal and the direction to the viewer: the on-axis disc formula scaled by cosTheta.

@@ -86,6 +86,13 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                scene.triangles.size(), scene.materials.size(), scene.lights.size(), scene.cameras.size(),
                scene.totalArea, scene.bounds.extent().x, scene.bounds.extent().y, scene.bounds.extent().z);
     fmt::print("  surfels nS      {}\n", withDefault("surfels", std::to_string(p.surfels)));
+    fmt::print("  surfel discs    {:.3f} of their area on their own surfaces\n", report.discShareOnSurface);
+    if (report.discShareOnSurface < kMinDiscShareOnSurface)
+        std::fprintf(stderr,
+                     "picbake: note: only %.2f of the surfels' disc area lies on their surfaces (a default "
+                     "count keeps %.2f): caches near surfaces narrower than a disc will read too little "
+                     "light; a larger --surfels draws them better\n",
+                     report.discShareOnSurface, kMinDiscShareOnSurface);
     fmt::print("  hierarchy       {}, {} nodes, {} levels\n", hierarchyName(p.hierarchy), bake->nodes.size(),
                bake->levelOffsets.size() - 1);
     fmt::print("  grid cell       {}\n", withDefault("grid_cell", fmt::format("{:.4g} m", p.gridCell)));

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -409,6 +410,40 @@ TEST(Bake, DefaultsFollowTheSceneSize) {
     EXPECT_GT(p2->gridCell / p1->gridCell, 10.0f);
     EXPECT_GT(p2->lightmapTexel / p1->lightmapTexel, 10.0f);
     EXPECT_TRUE(d1.count("surfels") && d1.count("grid_cell") && d1.count("lightmap_texel"));
+}
+
+TEST(Bake, ADefaultSurfelCountDoublesUntilTheDiscsLieOnTheirSurfaces) {
+    // Cornell's boxes and corners with 64 surfels of 18 cm radius: discs overhang the boxes'
+    // edges and the room's corners. A default count doubles until 0.85 of the discs' area lies
+    // on their surfaces; a count the user gave stays, whatever the share.
+    const Scene scene = test::loadTestScene("cornell");
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    BakeParams params;
+    params.surfels = 64;
+    params.relaxIterations = 1;
+    std::map<std::string, std::string> defaults{{"surfels", "from the extent"}};
+    BakeReport report;
+    auto kept = placeBakeSurfels(scene, **rays, params, false, defaults, report);
+    ASSERT_TRUE(kept) << kept.error().message;
+    EXPECT_EQ(kept->size(), 64u);
+    const double coarse = report.discShareOnSurface;
+    EXPECT_GT(coarse, 0.5);
+    EXPECT_LT(coarse, 0.85);
+    EXPECT_EQ(defaults["surfels"], "from the extent");
+
+    auto raised = placeBakeSurfels(scene, **rays, params, true, defaults, report);
+    ASSERT_TRUE(raised) << raised.error().message;
+    EXPECT_EQ(raised->size(), params.surfels);
+    EXPECT_GT(params.surfels, 64u);
+    EXPECT_EQ(params.surfels % 64u, 0u);
+    EXPECT_TRUE(std::has_single_bit(params.surfels / 64u));
+    EXPECT_GE(report.discShareOnSurface, 0.85);
+    EXPECT_NE(defaults["surfels"].find("raised from 64"), std::string::npos) << defaults["surfels"];
+    // Half as many would not have reached it: the count is the first that does.
+    params.surfels /= 2;
+    ASSERT_TRUE(placeBakeSurfels(scene, **rays, params, false, defaults, report));
+    EXPECT_LT(report.discShareOnSurface, 0.85);
 }
 
 TEST(Bake, RejectsBadParameters) {

@@ -56,6 +56,20 @@ TEST_F(PicbakeCli, BakeThenInfoJsonHasTheContractKeys) {
     EXPECT_TRUE(json["bytes"].contains("surfels"));
 }
 
+TEST_F(PicbakeCli, TooFewSurfelsForTheSurfacesIsANote) {
+    // 64 surfels of 18 cm radius overhang cornell's boxes: the bake keeps the count it was
+    // given, prints the share of the discs on their surfaces and says what it costs.
+    const std::string bake = (mDir / "coarse.pic").string();
+    test::CommandResult coarse =
+        run("bake " + scene("cornell") + " -o " + bake + " --surfels 64 --links 8");
+    ASSERT_EQ(coarse.exitCode, 0) << coarse.err;
+    EXPECT_NE(coarse.out.find("surfel discs"), std::string::npos) << coarse.out;
+    EXPECT_NE(coarse.err.find("note: only 0."), std::string::npos) << coarse.err;
+    test::CommandResult fine = run(smallBake("cornell", bake));
+    ASSERT_EQ(fine.exitCode, 0) << fine.err;
+    EXPECT_EQ(fine.err.find("note: only"), std::string::npos) << fine.err;
+}
+
 TEST_F(PicbakeCli, SameSceneFlagsAndSeedGiveAByteIdenticalFile) {
     std::string a = (mDir / "a.pic").string(), b = (mDir / "b.pic").string();
     ASSERT_EQ(run(smallBake("cornell", a) + " --seed 5").exitCode, 0);

@@ -519,5 +519,36 @@ TEST(LinkCut, RefinesALargeFarPatchBeforeASmallNearOne) {
     EXPECT_EQ(paper.farLinks, 4);
 }
 
+TEST(SurfelView, PartsOnSurfaceLeaveOutTheOverhang) {
+    // A surfel of 10 cm radius in the middle of a 2 m floor lies wholly on it; at the floor's
+    // edge half its disc overhangs; on a strip 4 cm wide about a quarter of it lies on the
+    // strip (the band's area 2r·w over πr²: 0.25).
+    const float r = 0.1f;
+    Surfel surfel = surfelAt({0.0f, 0.0f, 0.0f}, {0, 1, 0});
+    surfel.radius = r;
+    surfel.area = std::numbers::pi_v<float> * r * r;
+    Scene floor;
+    floor.sourcePath = "floor.gltf";
+    addSquare(floor, 0.0f, 1.0f, true);
+    auto rays = EmbreeScene::create(floor);
+    ASSERT_TRUE(rays) << rays.error().message;
+    EXPECT_EQ(surfelPartsOnSurface(**rays, surfel), kDiscParts);
+    Surfel atEdge = surfel;
+    atEdge.position.x = 1.0f;
+    EXPECT_NEAR(float(surfelPartsOnSurface(**rays, atEdge)), 16.0f, 3.0f);
+    EXPECT_NEAR(discShareOnSurface(**rays, {surfel, atEdge}), 0.75, 0.05);
+
+    Scene strip;
+    strip.sourcePath = "strip.gltf";
+    addRectangle(strip, 0.0f, -1.0f, 1.0f, -0.02f, 0.02f, true);
+    rays = EmbreeScene::create(strip);
+    ASSERT_TRUE(rays) << rays.error().message;
+    EXPECT_NEAR(float(surfelPartsOnSurface(**rays, surfel)), 8.0f, 3.0f);
+    // Facing down, the surfel finds no surface under it (its floor faces up).
+    Surfel flipped = surfel;
+    flipped.normal = glm::vec3(0, -1, 0);
+    EXPECT_EQ(surfelPartsOnSurface(**rays, flipped), 0u);
+}
+
 }  // namespace
 }  // namespace pic
