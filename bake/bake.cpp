@@ -41,7 +41,6 @@ private:
 constexpr double kSurfelSpacingDivisor = 64.0;
 constexpr uint32_t kMinDefaultSurfels = 8192;
 constexpr uint32_t kMaxDefaultSurfels = 131072;
-
 constexpr float kGridCellsAlongExtent = 16.0f;
 constexpr double kDefaultLightmapTexels = 8192.0;
 constexpr uint32_t kDefaultLinks = 128;
