@@ -277,6 +277,26 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     json["all"]["scatter"] = scatterJson(estimates, allCaches);
     json["grid"]["scatter"] = scatterJson(estimates, gridCaches);
     json["lightmap"]["scatter"] = scatterJson(estimates, lightmapCaches);
+    // Each examined cache, to find where a factor scatters: its place, its kind, the traced
+    // luma and its own ratios.
+    Json perCache = Json::array();
+    for (size_t k = 0; k < examined; ++k) {
+        const Cache& cache = bake->caches[k * nC / examined];
+        const Estimates& e = estimates[k];
+        perCache.push_back(
+            {{"cache", k * nC / examined},
+             {"kind", cache.kind == gpu::kCacheKindLightmap ? "lightmap" : "grid"},
+             {"position", {cache.position.x, cache.position.y, cache.position.z}},
+             {"normal", {cache.normal.x, cache.normal.y, cache.normal.z}},
+             {"traced_luma", luma(e.traced)},
+             {"linked_over_traced", lumaRatio(e.linked, e.traced)},
+             {"representation", lumaRatio(e.gather, e.traced)},
+             {"cut_coverage", lumaRatio(e.cut, e.gather)},
+             {"node_mean_radiance", lumaRatio(e.mean, e.cut)},
+             {"node_spread_radiance", lumaRatio(e.spread, e.cut)},
+             {"visibility_estimate", lumaRatio(e.linked, e.spread)}});
+    }
+    json["caches"] = std::move(perCache);
 
     std::printf("%s: one bounce, %zu of %zu caches, nL %u (%s)\n", params.scenePath.c_str(), examined,
                 nC, nL, bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");

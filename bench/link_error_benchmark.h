@@ -22,7 +22,8 @@
 /// relative deviation from it (weighted by the denominator's luma), how much neighbouring
 /// caches disagree in that factor, which shows as blotches rather than bias. The traced
 /// estimate's Monte Carlo noise adds to the scatter of the first two (about 0.2 at 1,024
-/// directions in a sunlit room; use ≥ 16,384 to read them). Writes JSON; never asserts.
+/// directions in a sunlit room; use ≥ 16,384 to read them). Writes JSON, with every examined
+/// cache's place, kind and ratios under `caches`; never asserts.
 
 #include <string>
 

@@ -59,6 +59,14 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
         EXPECT_LT(r.at("scatter").at("cut_coverage").get<double>(), 0.05);
     }
     EXPECT_EQ(report.at("all").at("caches").get<int>(), 40);
+    // Every examined cache, with its place, its kind and its own ratios.
+    const nlohmann::json& caches = report.at("caches");
+    ASSERT_EQ(caches.size(), 40u);
+    for (const nlohmann::json& c : caches) {
+        EXPECT_EQ(c.at("position").size(), 3u);
+        EXPECT_TRUE(c.at("kind") == "grid" || c.at("kind") == "lightmap");
+        EXPECT_GE(c.at("traced_luma").get<double>(), 0.0);
+    }
 }
 
 TEST_F(PicbenchLinks, OneSidedTruthTakesTheBackFacesLightOut) {
