@@ -96,6 +96,25 @@ Json errorJson(const ImageError& e) {
             {"channel_ratio", {e.channelRatio.r, e.channelRatio.g, e.channelRatio.b}}};
 }
 
+/// `base` with the SH band 0 (`band0`) or the bands above it (otherwise) of `from`, in luma
+/// and chroma: which bands of the linked caches the blotches are in.
+CacheValues withBands(const CacheValues& base, const CacheValues& from, bool band0) {
+    PIC_CHECK(base.bandsY == from.bandsY && base.bandsC == from.bandsC &&
+              base.cacheCount() == from.cacheCount());
+    CacheValues out = base;
+    const size_t strideY = size_t{base.bandsY} * base.bandsY, strideC = size_t{base.bandsC} * base.bandsC;
+    for (size_t c = 0; c < base.cacheCount(); ++c) {
+        for (size_t i = 0; i < strideY; ++i)
+            if ((i == 0) == band0) out.y[c * strideY + i] = from.y[c * strideY + i];
+        for (size_t i = 0; i < strideC; ++i)
+            if ((i == 0) == band0) {
+                out.co[c * strideC + i] = from.co[c * strideC + i];
+                out.cg[c * strideC + i] = from.cg[c * strideC + i];
+            }
+    }
+    return out;
+}
+
 /// The speed/accuracy trade-off over nL: one reference and one set of ideal caches, one bake
 /// per nL, each with its CPU twin's update time (median of three) and its indirect error.
 int runLinksSweep(const AccuracyParams& params, const Scene& scene, const EmbreeScene& rays,
@@ -278,6 +297,17 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     // Blotches: where the linked caches disagree with the ideal ones beyond a global scale.
     auto blotch = blotchIndex(oursIndirect, idealIndirect);
     if (!blotch) return reportError(blotch.error());
+    // Which SH bands the blotches are in: the ideal caches with the linked caches' band 0 put
+    // in, and with their bands above 0 put in, each shaded and held against the ideal image.
+    double blotchBand0 = 0.0, blotchAbove = 0.0;
+    for (const bool band0 : {true, false}) {
+        Image full, indirect;
+        if (auto ok = shadeBoth(withBands(*ideal, **values, band0), full, indirect); !ok)
+            return reportError(ok.error());
+        auto b = blotchIndex(indirect, idealIndirect);
+        if (!b) return reportError(b.error());
+        (band0 ? blotchBand0 : blotchAbove) = *b;
+    }
 
     std::error_code ec;
     std::filesystem::create_directories(params.outDir, ec);
@@ -312,6 +342,7 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
     json["ideal_indirect"] = errorJson(*eIdealIndirect);
     json["ideal_full"] = errorJson(*eIdealFull);
     json["blotch_index"] = *blotch;
+    json["blotch_index_by_band"] = {{"band_0", blotchBand0}, {"bands_above_0", blotchAbove}};
     json["seconds"] = seconds;
     json["images"] = {base + "_indirect_side.png", base + "_full_side.png"};
     const std::string jsonPath = params.jsonPath.empty() ? base + "_accuracy.json" : params.jsonPath;
@@ -328,6 +359,9 @@ int runAccuracyBenchmark(const AccuracyParams& params) {
                     e->channelRatio.r, e->channelRatio.g, e->channelRatio.b);
     std::printf("  blotch index (linked against ideal caches, indirect, 4x4 blocks, mean-matched): %.4f\n",
                 *blotch);
+    std::printf("  the same with only the linked caches' band 0 (ideal above it): %.4f; with only their "
+                "bands above 0 (ideal band 0): %.4f\n",
+                blotchBand0, blotchAbove);
     std::printf("  seconds: %s\n", seconds.dump().c_str());
     std::printf("  wrote %s, %s_indirect_side.png, %s_full_side.png (ours | ideal caches | path traced | error)\n",
                 jsonPath.c_str(), base.c_str(), base.c_str());

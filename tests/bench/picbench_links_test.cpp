@@ -123,6 +123,31 @@ TEST_F(PicbenchLinks, SweepChartsUpdateTimeAgainstError) {
     EXPECT_TRUE(fs::exists(mDir / "sweep.png"));
 }
 
+TEST_F(PicbenchLinks, AccuracySplitsTheBlotchIndexBySHBand) {
+    // The blotch index of the linked caches, and of the ideal caches with only the linked
+    // band 0 put in or only the linked bands above it: each a relative RMSE, finite and ≥ 0,
+    // and the linked caches differ from the ideal ones in both parts.
+    const fs::path json = mDir / "accuracy.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("accuracy --scene ") + PIC_TEST_SCENE_DIR +
+                      "/cornell.gltf --size 24x24 --spp 16 --probe-samples 16 --out-dir " +
+                      (mDir / "accuracy").string() + " --json " + json.string(),
+                  err),
+              0)
+        << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    const double whole = report.at("blotch_index").get<double>();
+    EXPECT_TRUE(std::isfinite(whole));
+    EXPECT_GT(whole, 0.0);
+    for (const char* part : {"band_0", "bands_above_0"}) {
+        const double value = report.at("blotch_index_by_band").at(part).get<double>();
+        EXPECT_TRUE(std::isfinite(value)) << part;
+        EXPECT_GT(value, 0.0) << part;
+        EXPECT_LT(value, 1.0) << part;
+    }
+}
+
 TEST_F(PicbenchLinks, MissingSceneIsBadInputNamingThePath) {
     std::string err;
     EXPECT_EQ(run("links --scene /nonexistent/scene.gltf", err), 2);
