@@ -69,6 +69,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
         bake.caches[to] = bake.caches[c];
         std::copy_n(links.tint.begin() + c * nL, nL, links.tint.begin() + to * nL);
         std::copy_n(links.offset.begin() + c * nL * 3, nL * 3, links.offset.begin() + to * nL * 3);
+        std::copy_n(links.spreadShare.begin() + c * nL, nL, links.spreadShare.begin() + to * nL);
         if (links.mode == LinkMode::Rtp) {
             std::copy_n(links.rtp.begin() + c * nL, nL, links.rtp.begin() + to * nL);
         } else {
@@ -80,6 +81,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidA
     bake.caches.resize(kept);
     links.tint.resize(size_t{kept} * nL);
     links.offset.resize(size_t{kept} * nL * 3);
+    links.spreadShare.resize(size_t{kept} * nL);
     if (links.mode == LinkMode::Rtp) {
         links.rtp.resize(size_t{kept} * nL);
     } else {

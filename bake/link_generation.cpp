@@ -36,6 +36,10 @@ struct NodeEstimate {
     glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
     glm::vec3 colourSum{0.0f};     ///< Σ w·Ω·V·κ over the samples, in the units of perArea
     glm::vec3 positionSum{0.0f};   ///< Σ w·Ω·V·x over the samples, in the units of perArea
+    glm::vec3 reference{0.0f};     ///< a point of the node, which the next three are about
+    double shareSum = 0.0;         ///< perArea in double
+    glm::dvec3 localSum{0.0};      ///< Σ w·Ω·V·(x − reference)
+    double localSquareSum = 0.0;   ///< Σ w·Ω·V·|x − reference|²
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
     double visibleArea = 0.0;  ///< estimated Σ w·a of the surfels the cache sees, m²
@@ -69,12 +73,15 @@ public:
                 const std::vector<float>& weights)
         : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params), mWeights(weights),
           mPrefix(surfels.size() + 1, 0.0), mColourPrefix(surfels.size() + 1, glm::dvec3(0.0)),
-          mPositionPrefix(surfels.size() + 1, glm::dvec3(0.0)) {
+          mPositionPrefix(surfels.size() + 1, glm::dvec3(0.0)),
+          mSquarePrefix(surfels.size() + 1, 0.0) {
         for (size_t s = 0; s < surfels.size(); ++s) {
             const double wa = double(weights[s]) * surfels[s].area;
             mPrefix[s + 1] = mPrefix[s] + wa;
             mColourPrefix[s + 1] = mColourPrefix[s] + glm::dvec3(fluxColour(surfels[s])) * wa;
             mPositionPrefix[s + 1] = mPositionPrefix[s] + glm::dvec3(surfels[s].position) * wa;
+            const glm::dvec3 x(surfels[s].position);
+            mSquarePrefix[s + 1] = mSquarePrefix[s] + glm::dot(x, x) * wa;
             mMaxRadius = std::max(mMaxRadius, surfels[s].radius);
         }
     }
@@ -200,6 +207,27 @@ public:
         return glm::vec3(glm::dvec3(e.positionSum) / double(e.perArea) - centroid);
     }
 
+    /// The spread share ρ of a link: the trace of the covariance of the part the cache sees
+    /// (its visible samples, weights w·Ω·V) over that of its read node (weights w·a), ≤ 1. The
+    /// runtime's exponential spread reads a link of ρ = 1 at the node's mean and one of ρ = 0
+    /// at the spread's value at the part's centroid (render/cpu/pull.h). 1 under
+    /// LinkReads::Node, whose links read the node's mean.
+    float spreadShareOf(const NodeEstimate& e) const {
+        if (mParams.reads == LinkReads::Node) return 1.0f;
+        if (!(e.shareSum > 0.0)) return 0.0f;
+        const glm::dvec3 mean = e.localSum / e.shareSum;
+        const double part = e.localSquareSum / e.shareSum - glm::dot(mean, mean);
+        const Node& read = mNodes[e.readNode];
+        const size_t first = read.firstSurfel, last = read.firstSurfel + read.surfelCount;
+        const double weight = mPrefix[last] - mPrefix[first];
+        if (!(weight > 0.0)) return 0.0f;
+        const glm::dvec3 centroid = (mPositionPrefix[last] - mPositionPrefix[first]) / weight;
+        const double node = (mSquarePrefix[last] - mSquarePrefix[first]) / weight -
+                            glm::dot(centroid, centroid);
+        if (!(node > 0.0)) return 1.0f;  // a point: every part spreads as the node
+        return float(std::clamp(part / node, 0.0, 1.0));
+    }
+
 private:
     double weightedArea(uint32_t node) const {
         const Node& n = mNodes[node];
@@ -280,6 +308,7 @@ private:
         const Node& node = mNodes[nodeIndex];
         NodeEstimate e;
         e.node = nodeIndex;
+        e.reference = mSurfels[node.firstSurfel].position;
         e.sampleBegin = static_cast<uint32_t>(samples.size());
         e.exact = node.surfelCount <= k;
         const uint32_t taken = std::min(node.surfelCount, k);
@@ -296,6 +325,10 @@ private:
             e.directionSum += share * view.direction;
             e.colourSum += share * fluxColour(mSurfels[s]);
             e.positionSum += share * mSurfels[s].position;
+            const glm::dvec3 local = glm::dvec3(mSurfels[s].position) - glm::dvec3(e.reference);
+            e.shareSum += share;
+            e.localSum += double(share) * local;
+            e.localSquareSum += double(share) * glm::dot(local, local);
             samples.push_back({view.direction, share});
         };
         // Exact: w_j·Ω_j / Σ w·a and Ω_j.
@@ -384,6 +417,7 @@ private:
     std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
     std::vector<glm::dvec3> mColourPrefix;  ///< Σ w·κ·a over the surfels before each
     std::vector<glm::dvec3> mPositionPrefix;  ///< Σ w·a·x over the surfels before each
+    std::vector<double> mSquarePrefix;        ///< Σ w·a·|x|² over the surfels before each
     float mMaxRadius = 0.0f;                  ///< the largest surfel radius, m
 };
 
@@ -579,6 +613,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     links.bands = params.mode == LinkMode::Sh ? params.bands : 0;
     links.tint.assign(nC * nL, 0u);  // padding: no light
     links.offset.assign(nC * nL * 3, 0u);
+    links.spreadShare.assign(nC * nL, 0u);
     if (params.mode == LinkMode::Rtp) {
         links.rtp.assign(nC * nL, RtpLink{0, 0.0f, 0, 0.0f});
     } else {
@@ -615,6 +650,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                 links.tint[slot] = tint.code;
                 const glm::vec3 offset = linker.offsetOf(e);
                 for (int i = 0; i < 3; ++i) links.offset[slot * 3 + i] = floatToHalfClamped(offset[i]);
+                links.spreadShare[slot] = encodeSpreadShare(linker.spreadShareOf(e));
                 const float toRadiance = tint.scale / kPi;
                 if (params.mode == LinkMode::Rtp) {
                     // The cone spans the node's unoccluded solid angle; the factor scales it to

@@ -164,25 +164,39 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 read[c] *= colour[c] * weightedArea[node] / colouredArea[node][c];
         return read;
     };
-    // What a link reads for surfel s with the node's flux spread (render/cpu/pull.h): the
-    // modelled radiance times the limited spread at the surfel's box point over the flux.
+    // What a link reads with the node's flux spread (render/cpu/pull.h), relative to the
+    // node's flux: the spread at the box point of the visible part's centroid (Σ w·Ω·x /
+    // Σ w·Ω, as the bake's offset), with the part's spread share.
     const NodeSpread spread = nodeSpread(*bake);
     std::vector<glm::mat3> moment(bake->nodes.size()), slopes(bake->nodes.size());
-    std::vector<glm::vec3> centreFlux(bake->nodes.size());
-    pullFluxSpread(*bake, spread, flux, moment, centreFlux, slopes);
-    auto spreadModelled = [&](uint32_t node, uint32_t s) {
-        glm::dvec3 read = modelled(node, s);
-        if (node < nS) return read;
-        const glm::vec3 u = decodeBoxPoint(
-            encodeBoxPoint(spread, node, bake->surfels[s].position - spread.centroid[node]));
-        for (int c = 0; c < 3; ++c)
-            read[c] *=
-                flux[node][c] > 0.0f
-                    ? centreFlux[node][c] * (1.0f + glm::dot(slopes[node][c], u)) / flux[node][c]
-                    : 0.0f;
-        return read;
+    std::vector<glm::vec3> centreFlux(bake->nodes.size()), concentration(bake->nodes.size());
+    std::vector<uint8_t> exponential(bake->nodes.size());
+    pullFluxSpread(*bake, spread, flux, moment, centreFlux, slopes, concentration, exponential);
+    auto spreadRead = [&](uint32_t node, const glm::vec3& centroid, float spreadShare) {
+        glm::dvec3 ratio(1.0);
+        if (node < nS) return ratio;
+        const glm::vec3 u =
+            decodeBoxPoint(encodeBoxPoint(spread, node, centroid - spread.centroid[node]));
+        for (int c = 0; c < 3; ++c) {
+            const float read =
+                exponential[node]
+                    ? centreFlux[node][c] * std::exp(glm::dot(slopes[node][c], u) -
+                                                     (1.0f - spreadShare) * concentration[node][c])
+                    : centreFlux[node][c] * (1.0f + glm::dot(slopes[node][c], u));
+            ratio[c] = flux[node][c] > 0.0f ? read / flux[node][c] : 0.0;
+        }
+        return ratio;
     };
 
+    // A part's spread share (bake/link_generation.cpp): the trace of its covariance over its
+    // node's, from the part's centroid and mean |x|².
+    auto spreadShare = [&](uint32_t n, const glm::dvec3& centroid, double meanSquare) {
+        double node = 0.0;
+        for (int k = 0; k < 3; ++k)
+            if (spread.inverseVariance[n][k] > 0.0f) node += 1.0 / spread.inverseVariance[n][k];
+        const double part = std::max(0.0, meanSquare - glm::dot(centroid, centroid));
+        return float(node > 0.0 ? std::min(1.0, part / node) : 1.0);
+    };
     const size_t nC = bake->caches.size();
     const size_t examined = std::min<size_t>(std::max(params.caches, 1u), nC);
     const uint32_t nL = bake->links.linksPerCache;
@@ -229,13 +243,24 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
             const uint32_t n = linkedNode(bake->links, c * nL + j);
             if (n == kNoNode) continue;
             const Node& node = bake->nodes[n];
+            glm::dvec3 mean(0.0), centroid(0.0);
+            double centroidWeight = 0.0, second = 0.0;
             for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
                 const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
                 if (!view.visible) continue;
                 e.cut += radiance[s] * (double(view.solidAngle) * y00);
-                e.mean += modelled(n, s) * (double(view.solidAngle) * y00);
-                e.spread += spreadModelled(n, s) * (double(view.solidAngle) * y00);
+                mean += modelled(n, s) * (double(view.solidAngle) * y00);
+                const double w = weights.empty() ? 1.0 : double(weights[s]);
+                centroid += w * double(view.solidAngle) * glm::dvec3(bake->surfels[s].position);
+                centroidWeight += w * double(view.solidAngle);
+                const glm::dvec3 x(bake->surfels[s].position);
+                second += w * double(view.solidAngle) * glm::dot(x, x);
             }
+            e.mean += mean;
+            if (centroidWeight > 0.0)
+                e.spread += mean * spreadRead(n, glm::vec3(centroid / centroidWeight),
+                                              spreadShare(n, centroid / centroidWeight,
+                                                          second / centroidWeight));
         }
         // Uniform directions over the cache's sphere (hemisphere for light-map caches).
         Rng rng(params.seed, c);

@@ -11,8 +11,9 @@
 ///             spread by the bake's flux weights, Φ·w/(π·Σ w·a) (Φ/(πA) with uniform
 ///             weights), per channel in the surfels' colours κ, Φ·w·κ/(π·Σ w·κ·a), with
 ///             visible-part reads (the links' tints), exact visibility,
-///   spread    the same with the node's limited linear flux spread (render/cpu/pull.h)
-///             evaluated at each surfel: what the runtime's links read, with exact visibility,
+///   spread    the same with the node's flux spread (render/cpu/pull.h) read as the runtime
+///             reads it, at the centroid of the part the cache sees (Σ w·Ω·x / Σ w·Ω) with
+///             that part's spread share: what the runtime's links read, exact visibility,
 ///   linked    the runtime's cache (estimated visibility, the spread read at each link's box
 ///             point).
 /// Their ratios factor linked/traced into the surfel representation (gather/traced), the

@@ -16,6 +16,7 @@ namespace pic {
 using gpu::Cache;
 using gpu::kNoCache;
 using gpu::kNoNode;
+using gpu::kSpreadShareSteps;
 using gpu::Node;
 using gpu::RtpLink;
 using gpu::Surfel;
@@ -119,7 +120,19 @@ struct LinkSet {
     std::vector<uint32_t> tint;            ///< both modes: nC·nL tints (core/color.h encodeLinkTint)
     std::vector<uint16_t> offset;          ///< both modes: nC·nL·3 binary16, metres: the centroid of
                                            ///< the part the link sees from its node's flux centroid
+    std::vector<uint8_t> spreadShare;      ///< both modes: nC·nL codes (encodeSpreadShare): the
+                                           ///< spread of the part the link sees over its node's
+                                           ///< (render/cpu/pull.h)
 };
+
+/// The code of a spread share ρ ∈ [0, 1] (clamped; NaN → 0), ρ·63 rounded.
+inline uint8_t encodeSpreadShare(float share) {
+    const float clamped = share > 0.0f ? (share < 1.0f ? share : 1.0f) : 0.0f;
+    return static_cast<uint8_t>(clamped * float(kSpreadShareSteps) + 0.5f);
+}
+
+/// The spread share of a code from encodeSpreadShare.
+inline float decodeSpreadShare(uint8_t code) { return float(code) / float(kSpreadShareSteps); }
 
 /// A complete bake.
 struct BakeData {

@@ -87,11 +87,11 @@ static_assert(sizeof(LinksRecord) == 16);
 static_assert(sizeof(glm::vec2) == 8 && std::is_trivially_copyable_v<glm::vec2>);
 
 /// Section names in the order the writer emits them; a file must hold each exactly once.
-constexpr std::array<std::string_view, 17> kSectionNames = {
+constexpr std::array<std::string_view, 18> kSectionNames = {
     "params",         "surfels",         "surfel_weights", "nodes",        "levels",
     "caches",         "grid",            "grid_index",     "lightmap",     "lightmap_index",
     "lightmap_uvs",   "links",           "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
-    "links_tint",     "links_offset",
+    "links_tint",     "links_offset",    "links_spread_share",
 };
 constexpr size_t kSectionCount = kSectionNames.size();
 static_assert(std::ranges::all_of(kSectionNames,
@@ -115,6 +115,7 @@ struct BakeView {
     std::span<const uint16_t> shCoefficients;
     std::span<const uint32_t> tint;
     std::span<const uint16_t> offset;
+    std::span<const uint8_t> spreadShare;
 };
 
 std::string errnoText(int err) {
@@ -300,6 +301,13 @@ Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& wh
         if ((v.offset[i] & 0x7C00u) == 0x7C00u)
             return fail(code, "{}: offset of link {} is not finite (half bits {:#06x})", what,
                         i / 3, v.offset[i]);
+    if (v.spreadShare.size() != nLinks)
+        return fail(code, "{}: links of {} caches × {} links need {} spread shares, found {}", what,
+                    v.caches.size(), v.links.linksPerCache, nLinks, v.spreadShare.size());
+    for (size_t i = 0; i < v.spreadShare.size(); ++i)
+        if (v.spreadShare[i] > kSpreadShareSteps)
+            return fail(code, "{}: spread share code {} of link {} exceeds {}", what,
+                        v.spreadShare[i], i, kSpreadShareSteps);
     return {};
 }
 
@@ -687,6 +695,7 @@ Result<BakeView> viewSections(const SectionMap& s, const std::string& path) {
     PIC_TRY_ASSIGN(v.shCoefficients, arrayIn<uint16_t>(s, "links_sh_coeffs", path));
     PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", path));
     PIC_TRY_ASSIGN(v.offset, arrayIn<uint16_t>(s, "links_offset", path));
+    PIC_TRY_ASSIGN(v.spreadShare, arrayIn<uint8_t>(s, "links_spread_share", path));
     return v;
 }
 
@@ -739,6 +748,7 @@ BakeView viewOf(const BakeData& bake) {
     v.shCoefficients = links.shCoefficients;
     v.tint = links.tint;
     v.offset = links.offset;
+    v.spreadShare = links.spreadShare;
     return v;
 }
 
@@ -768,6 +778,7 @@ std::array<std::span<const std::byte>, kSectionCount> sectionBytesOf(const BakeV
         std::as_bytes(v.shCoefficients),
         std::as_bytes(v.tint),
         std::as_bytes(v.offset),
+        std::as_bytes(v.spreadShare),
     };
 }
 
@@ -901,6 +912,7 @@ Result<BakeData> readBakeFile(const std::string& path) {
     bake.links.shCoefficients = toVector(v.shCoefficients);
     bake.links.tint = toVector(v.tint);
     bake.links.offset = toVector(v.offset);
+    bake.links.spreadShare = toVector(v.spreadShare);
     return bake;
 }
 

@@ -41,6 +41,7 @@
 ///   links_sh_coeffs  SH mode: nC·nL·bands² × u16 half float; RTP mode: empty
 ///   links_tint       nC·nL × u32 link tint (core/color.h encodeLinkTint), both modes
 ///   links_offset     nC·nL·3 × u16 finite half float, metres (LinkSet::offset), both modes
+///   links_spread_share nC·nL × u8 code ≤ 63 (LinkSet::spreadShare, encodeSpreadShare), both modes
 ///
 /// Both directions check that the counts agree and that every node and cache index is in range
 /// (kNoNode / kNoCache aside; RTP padding links have factor 0), so the runtime can index the
@@ -58,7 +59,7 @@
 namespace pic {
 
 /// Format version written into, and required of, every bake file.
-inline constexpr uint32_t kBakeFormatVersion = 5;
+inline constexpr uint32_t kBakeFormatVersion = 6;
 /// Bytes of the header including its trailing checksum; the section table follows.
 inline constexpr uint64_t kBakeHeaderBytes = 48;
 /// Bytes of one section table entry.

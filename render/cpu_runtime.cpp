@@ -47,6 +47,8 @@ public:
           mNodeMoment(bake.nodes.size()),
           mCentreFlux(bake.nodes.size()),
           mSlopes(bake.nodes.size()),
+          mConcentration(bake.nodes.size()),
+          mExponential(bake.nodes.size()),
           mNodeLight(bake.nodes.size()),
           mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)),
           mStencils(surfelStencils(scene, rays, bake)) {
@@ -70,8 +72,10 @@ private:
     std::vector<glm::vec3> mNodeFlux;  ///< 2nS − 1: leaves hold the current bounce's surfel flux
     NodeSpread mSpread;                ///< fixed per bake
     std::vector<glm::mat3> mNodeMoment;  ///< 2nS − 1: the flux's first moments
-    std::vector<glm::vec3> mCentreFlux;  ///< 2nS − 1: the limited spreads' centre flux
+    std::vector<glm::vec3> mCentreFlux;  ///< 2nS − 1: the spreads' centre flux
     std::vector<glm::mat3> mSlopes;      ///< 2nS − 1: and their slopes
+    std::vector<glm::vec3> mConcentration;  ///< 2nS − 1: ln Z of the exponential ones
+    std::vector<uint8_t> mExponential;      ///< 2nS − 1: which are exponential
     std::vector<NodeLight> mNodeLight;   ///< 2nS − 1: both as links read them
     CacheValues mValues;
     std::vector<CacheStencil> mStencils;  ///< nS: the caches each surfel's bounce reads
@@ -110,11 +114,12 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     for (int bounce = 1;; ++bounce) {
         t = Clock::now();
         pullFlux(mBake, mNodeFlux);
-        pullFluxSpread(mBake, mSpread, mNodeFlux, mNodeMoment, mCentreFlux, mSlopes);
+        pullFluxSpread(mBake, mSpread, mNodeFlux, mNodeMoment, mCentreFlux, mSlopes,
+                       mConcentration, mExponential);
         pullMs += millisecondsSince(t);
 
         t = Clock::now();
-        nodeLight(mCentreFlux, mSlopes, mNodeLight);
+        nodeLight(mCentreFlux, mSlopes, mConcentration, mExponential, mNodeLight);
         lightCaches(mBake, mNodeLight, mLinks, mValues);
         cacheMs += millisecondsSince(t);
         s.bounces = bounce;

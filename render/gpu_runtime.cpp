@@ -350,11 +350,13 @@ Result<std::vector<glm::uvec4>> GpuRuntime::nodeLight() {
 std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux) {
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
     std::vector<glm::mat3> moment(nodeFlux.size()), slopes(nodeFlux.size());
-    std::vector<glm::vec3> centre(nodeFlux.size());
-    pullFluxSpread(bake, nodeSpread(bake), nodeFlux, moment, centre, slopes);
+    std::vector<glm::vec3> centre(nodeFlux.size()), concentration(nodeFlux.size());
+    std::vector<uint8_t> exponential(nodeFlux.size());
+    pullFluxSpread(bake, nodeSpread(bake), nodeFlux, moment, centre, slopes, concentration,
+                   exponential);
     std::vector<glm::uvec4> light(nodeFlux.size());
     for (size_t n = 0; n < nodeFlux.size(); ++n)
-        light[n] = glm::uvec4(gpu::packNodeSlopes(slopes[n]),
+        light[n] = glm::uvec4(gpu::packNodeSpread(slopes[n], concentration[n], exponential[n] != 0),
                               packRgbe8(centre[n] * gpu::radianceScale(bake.nodes[n].area)));
     return light;
 }

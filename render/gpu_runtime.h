@@ -68,8 +68,8 @@ class CacheLightingPass;
 class LightmapCopyPass;
 }  // namespace gpu
 
-/// Each node's light from its flux (pulled): its limited flux spread (render/cpu/pull.h), the
-/// slopes packed by gpu::packNodeSlopes and the radiance at the box centre as RGBE8, what
+/// Each node's light from its flux (pulled): its flux spread (render/cpu/pull.h), the slopes
+/// and ln Z packed by gpu::packNodeSpread and the radiance at the box centre as RGBE8, what
 /// surfel lighting (leaves) and the pull (inner nodes) write for cache lighting
 /// (shaders/shared/pull.h).
 std::vector<glm::uvec4> packNodeLight(const BakeData& bake, std::span<const glm::vec3> nodeFlux);

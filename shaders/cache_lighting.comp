@@ -53,17 +53,32 @@ vec3 decodeLinkTint(uint code) {
     return vec3(uvec3(code, code >> 10u, code >> 20u) & 0x3FFu) * (1.0 / 1023.0);
 }
 
-/// The YCoCg radiance a link carries: its node's spread at the link's box point u,
-/// radiance·(1 + slopes·u) per channel (shared/pull.h; ≥ 0 for u in the box), times its tint.
-vec3 linkRadiance(uint node, vec3 tint, uint point) {
+/// The YCoCg radiance a link carries: its node's spread at the link's box point u (shared/pull.h),
+/// radiance·(1 + slopes·u) per channel (≥ 0 for u in the box) for a linear node,
+/// radiance·exp(slopes·u − (1 − v)·ln Z) for an exponential one, the link seeing share v of
+/// it; times its tint.
+vec3 linkRadiance(uint node, vec3 tint, uint point, float concentrationWeight) {
     const uvec4 light = texelFetch(nodeLight, int(node));
     const vec3 u = unpackSnorm4x8(point).xyz;
     const vec4 a = unpackSnorm4x8(light.x);
     const vec4 b = unpackSnorm4x8(light.y);
-    const vec3 slopesB = vec3(b.zw, unpackSnorm4x8(light.z).x);
-    const vec3 spread =
-        vec3(1.0) + vec3(dot(a.xyz, u), dot(vec3(a.w, b.xy), u), dot(slopesB, u));
+    const vec3 slopesB = vec3(b.zw, unpackSnorm4x8(light.z & 0xFFu).x);
+    const vec3 exponent = vec3(dot(a.xyz, u), dot(vec3(a.w, b.xy), u), dot(slopesB, u));
+    vec3 spread;
+    if ((light.z & kNodeLightExponentialBit) != 0u) {
+        const vec3 concentration =
+            vec3(uvec3(light.z >> 8u, light.z >> 15u, light.z >> 22u) & 0x7Fu) *
+            (kConcentrationRange / 127.0);
+        spread = exp(kExponentialSpreadCap * exponent - concentrationWeight * concentration);
+    } else {
+        spread = vec3(1.0) + exponent;
+    }
     return rgbToYCoCg(unpackRgbe8(light[kNodeLightRadianceWord]) * tint * spread);
+}
+
+/// 1 − the spread share of its 6-bit code (core/bake_data.h decodeSpreadShare).
+float concentrationWeightOf(uint code) {
+    return 1.0 - float(code & 0x3Fu) * (1.0 / float(kSpreadShareSteps));
 }
 
 /// Adds link `slot` (within the chunk) to y, co, cg.
@@ -82,12 +97,12 @@ void addLink(uint slot) {
         const vec3 tint =
             vec3(link.nodeAndRed >> 24u, link.directionAndGreen >> 24u, link.pointAndBlue >> 24u) *
             (1.0 / 255.0);
-        const vec3 radiance =
-            linkRadiance(link.nodeAndRed & 0xFFFFFFu, tint, link.pointAndBlue);
+        const vec3 radiance = linkRadiance(link.nodeAndRed & 0xFFFFFFu, tint, link.pointAndBlue,
+                                           concentrationWeightOf(link.directionAndGreen >> 18u));
         float cone[kBandsY];
         coneZonal(visibleAndCone.y, cone);
         float basis[64];
-        shEvaluate(decodeOctahedral12(link.directionAndGreen), basis);
+        shEvaluate(decodeOctahedral9(link.directionAndGreen), basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float w = visible * cone[kShBandOf[i]] * basis[i];
             y[i] += radiance.x * w;
@@ -101,7 +116,8 @@ void addLink(uint slot) {
         // two per word, scaled by π·A at upload to take the node's radiance; chroma takes the
         // first lC².
         if (words[0] == kNoNode) return;
-        const vec3 radiance = linkRadiance(words[0], decodeLinkTint(words[1]), words[2]);
+        const vec3 radiance =
+            linkRadiance(words[0], decodeLinkTint(words[1]), words[2], concentrationWeightOf(words[2] >> 24u));
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
             const vec2 pair = unpackHalf2x16(words[3u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {

@@ -5,6 +5,7 @@
 // (§4.7) and the slopes along the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
 // levels in one workgroup. CPU twin: render/cpu/pull.cpp.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "shared/pull.h"
 #include "lib/rgbe8.glsl"
 
@@ -24,7 +25,8 @@ layout(push_constant) uniform Push { PullPush pc; };
 /// render/cpu/pull.cpp limitedSpread: the fitted spread's gradient in the node's axes, scaled
 /// so the spread stays ≥ 0 over the surfels' box; returns the flux at the box centre and sets
 /// the slopes along the axes per half extent, relative to it.
-float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes) {
+float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes,
+                    inout bool limited) {
     slopes = vec3(0.0);
     if (!(flux > 0.0)) return 0.0;
     const vec3 low = vec3(inner.low0, inner.low1, inner.low2);
@@ -35,6 +37,7 @@ float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes) {
     vec3 change = abs(g * halfExtent);
     const float swing = change.x + change.y + change.z;
     if (swing > atCentre) {
+        limited = true;
         g *= flux / (swing - dot(g, centre));
         atCentre = flux + dot(g, centre);
     }
@@ -46,18 +49,65 @@ float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes) {
     return atCentre;
 }
 
-/// snorm8 of v ∈ [−1, 1] rounded towards zero (shared/pull.h), in the low byte.
-uint snorm8TowardsZero(float v) {
-    return uint(int(trunc(clamp(v, -1.0, 1.0) * 127.0))) & 0xFFu;
+/// render/cpu/pull.cpp inverseLangevin: x with coth x − 1/x = r (Jedynak's approximation).
+float inverseLangevin(float r) {
+    const float a = min(abs(r), 0.99);
+    const float x = a * (3.0 - 2.6 * a + 0.7 * a * a) / ((1.0 - a) * (1.0 + 0.1 * a));
+    return r < 0.0 ? -x : x;
 }
 
-/// The nine slopes as shared/pull.h packs them.
-uvec3 packSlopes(vec3 r, vec3 g, vec3 b) {
-    return uvec3(snorm8TowardsZero(r.x) | snorm8TowardsZero(r.y) << 8 | snorm8TowardsZero(r.z) << 16 |
-                     snorm8TowardsZero(g.x) << 24,
-                 snorm8TowardsZero(g.y) | snorm8TowardsZero(g.z) << 8 | snorm8TowardsZero(b.x) << 16 |
-                     snorm8TowardsZero(b.y) << 24,
-                 snorm8TowardsZero(b.z));
+/// render/cpu/pull.cpp exponentialSpread: returns the flux at the box centre and sets the
+/// slopes β·halfExtent and ln Z.
+float exponentialSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes,
+                        out float concentration) {
+    slopes = vec3(0.0);
+    concentration = 0.0;
+    if (!(flux > 0.0)) return 0.0;
+    const vec3 low = vec3(inner.low0, inner.low1, inner.low2);
+    const vec3 centre = 0.5 * (low + inner.high);
+    const vec3 halfExtent = 0.5 * (inner.high - low);
+    const vec3 mean = (moment * mat3(inner.axis0, inner.axis1, inner.axis2)) * (1.0 / flux);
+    vec3 variance = vec3(0.0);
+    [[unroll]] for (int k = 0; k < 3; ++k)
+        if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
+    const float total = variance.x + variance.y + variance.z;
+    vec3 beta = vec3(0.0), a = vec3(0.0);
+    [[unroll]] for (int k = 0; k < 3; ++k) {
+        if (!(variance[k] > kFlatVariance * total)) continue;
+        a[k] = sqrt(3.0 * variance[k]);
+        beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
+    }
+    const float sum = dot(abs(beta), halfExtent);
+    if (sum > kExponentialSpreadCap) beta *= kExponentialSpreadCap / sum;
+    [[unroll]] for (int k = 0; k < 3; ++k) {
+        const float x = abs(beta[k] * a[k]);
+        concentration += x > 1e-2 ? log(sinh(x) / x) : x * x * (1.0 / 6.0);
+    }
+    slopes = beta * halfExtent;
+    return flux * exp(dot(beta, centre));
+}
+
+/// snorm8 of v ∈ [−1, 1] (shared/pull.h) in the low byte, rounded towards zero (linear
+/// spreads) or to nearest (exponential ones).
+uint snorm8(float v, bool towardsZero) {
+    const float scaled = clamp(v, -1.0, 1.0) * 127.0;
+    return uint(int(towardsZero ? trunc(scaled) : round(scaled))) & 0xFFu;
+}
+
+/// The nine slopes and, for an exponential spread, ln Z per channel as shared/pull.h packs them.
+uvec3 packSpread(vec3 r, vec3 g, vec3 b, vec3 concentration, bool exponential) {
+    const float scale = exponential ? 1.0 / kExponentialSpreadCap : 1.0;
+    const bool t = !exponential;
+    r *= scale, g *= scale, b *= scale;
+    uvec3 packed = uvec3(snorm8(r.x, t) | snorm8(r.y, t) << 8 | snorm8(r.z, t) << 16 | snorm8(g.x, t) << 24,
+                         snorm8(g.y, t) | snorm8(g.z, t) << 8 | snorm8(b.x, t) << 16 | snorm8(b.y, t) << 24,
+                         snorm8(b.z, t));
+    if (exponential) {
+        const uvec3 bits =
+            uvec3(round(clamp(concentration / kConcentrationRange, 0.0, 1.0) * 127.0));
+        packed.z |= bits.r << 8 | bits.g << 15 | bits.b << 22 | kNodeLightExponentialBit;
+    }
+    return packed;
 }
 
 /// Writes inner node `node` from its children's flux and moments.
@@ -65,16 +115,22 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
                vec3 rightMoment[3]) {
     const vec3 flux = leftFlux + rightFlux;
     nodeFlux[node] = vec4(flux, 0.0);
-    vec3 centre, slopes[3];
+    vec3 centre, slopes[3], moments[3], concentration = vec3(0.0);
+    bool limited = false;
     for (int c = 0; c < 3; ++c) {
         vec3 m = leftMoment[c] + rightMoment[c];
         m += leftFlux[c] * inner.leftOffset;
         m += rightFlux[c] * inner.rightOffset;
         nodeMoment[3u * node + uint(c)] = vec4(m, 0.0);
-        centre[c] = limitedSpread(inner, flux[c], m, slopes[c]);
+        moments[c] = m;
+        centre[c] = limitedSpread(inner, flux[c], m, slopes[c], limited);
     }
-    nodeLight[node] =
-        uvec4(packSlopes(slopes[0], slopes[1], slopes[2]), packRgbe8(centre * inner.radianceScale));
+    // Where the limiter acts in any channel, the node's spread is exponential in all three.
+    if (limited)
+        for (int c = 0; c < 3; ++c)
+            centre[c] = exponentialSpread(inner, flux[c], moments[c], slopes[c], concentration[c]);
+    nodeLight[node] = uvec4(packSpread(slopes[0], slopes[1], slopes[2], concentration, limited),
+                            packRgbe8(centre * inner.radianceScale));
 }
 
 void main() {

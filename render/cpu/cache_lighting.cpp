@@ -95,9 +95,15 @@ struct CacheSh {
 };
 
 /// The YCoCg flux a link carries: its node's spread at the link's box point times the
-/// link's tint. Neutral links (81 % of the atrium's) stay in YCoCg, where the spread is linear
-/// too; tinted ones multiply in RGB.
-inline glm::vec3 linkFlux(const NodeLight& node, uint32_t tint, const glm::vec3& point) {
+/// link's tint. Through a linear node neutral links (81 % of the atrium's) stay in YCoCg, where
+/// the spread is linear too; tinted ones multiply in RGB, as do exponential nodes.
+inline glm::vec3 linkFlux(const NodeLight& node, uint32_t tint, const glm::vec3& point,
+                          float concentrationWeight) {
+    if (node.exponential) {
+        const glm::vec3 rgb =
+            node.centre * glm::exp(node.spread * point - concentrationWeight * node.concentration);
+        return rgbToYCoCg(tint == kNeutralLinkTint ? rgb : rgb * decodeLinkTint(tint));
+    }
     const glm::vec3 flux = node.centre + node.spread * point;
     if (tint == kNeutralLinkTint) return flux;
     return rgbToYCoCg(glm::max(yCoCgToRgb(flux), glm::vec3(0.0f)) * decodeLinkTint(tint));
@@ -120,7 +126,8 @@ void lightCachesSh(const BakeData& bake, std::span<const NodeLight> light, const
                 // Padding links hold zero coefficients; the file format also allows kNoNode there.
                 const uint32_t node = links.shNodes[slot];
                 if (node == kNoNode) continue;
-                const glm::vec3 flux = linkFlux(light[node], links.tint[slot], table.points[slot]);
+                const glm::vec3 flux = linkFlux(light[node], links.tint[slot], table.points[slot],
+                                                table.concentrationWeight[slot]);
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
                 for (int i = 0; i < countY; ++i) {
@@ -158,8 +165,8 @@ void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, cons
                 const float* w = table.weights.data() + slot * BandsY;
                 // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
                 if (w[0] == 0.0f) continue;
-                const glm::vec3 flux =
-                    linkFlux(light[links.rtp[slot].node], links.tint[slot], table.points[slot]);
+                const glm::vec3 flux = linkFlux(light[links.rtp[slot].node], links.tint[slot],
+                                                table.points[slot], table.concentrationWeight[slot]);
                 shEvaluateFixed<BandsY>(table.directions[slot], basis.data());
                 for (int l = 0; l < BandsY; ++l) {
                     const float fluxY = flux.x * w[l];
@@ -185,12 +192,14 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
     const uint32_t bandsY = bake.params.bandsY;
     PIC_CHECK(bandsY >= 1 && bandsY <= uint32_t(kMaxShBands));
     PIC_CHECK_EQ(links.offset.size(), links.tint.size() * 3);
+    PIC_CHECK_EQ(links.spreadShare.size(), links.tint.size());
     PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
     LinkTable table;
     table.bands = bandsY;
     const bool rtp = links.mode == LinkMode::Rtp;
     PIC_CHECK_EQ((rtp ? links.rtp.size() : links.shNodes.size()), links.tint.size());
     table.points.resize(links.tint.size());
+    table.concentrationWeight.resize(links.tint.size());
     parallelFor(
         0, links.tint.size(),
         [&](size_t slot) {
@@ -200,6 +209,7 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
             for (int i = 0; i < 3; ++i) offset[i] = halfToFloat(links.offset[slot * 3 + i]);
             // Through the code the GPU's links carry, so both backends read the same point.
             table.points[slot] = decodeBoxPoint(encodeBoxPoint(spread, node, offset));
+            table.concentrationWeight[slot] = 1.0f - decodeSpreadShare(links.spreadShare[slot]);
         },
         4096);
     if (!rtp) return table;
@@ -220,16 +230,27 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
 }
 
 void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,
+               std::span<const glm::vec3> concentration, std::span<const uint8_t> exponential,
                std::span<NodeLight> out) {
     PIC_CHECK_EQ(slopes.size(), centreFlux.size());
+    PIC_CHECK_EQ(concentration.size(), centreFlux.size());
+    PIC_CHECK_EQ(exponential.size(), centreFlux.size());
     PIC_CHECK_EQ(out.size(), centreFlux.size());
     parallelFor(
         0, centreFlux.size(),
         [&](size_t n) {
             const glm::vec3 centre = centreFlux[n];
-            out[n].centre = rgbToYCoCg(centre);
+            NodeLight& light = out[n];
+            light.exponential = exponential[n];
+            light.concentration = concentration[n];
+            if (light.exponential) {
+                light.centre = centre;
+                light.spread = glm::transpose(slopes[n]);
+                return;
+            }
+            light.centre = rgbToYCoCg(centre);
             for (int k = 0; k < 3; ++k)
-                out[n].spread[k] = rgbToYCoCg(centre * glm::row(slopes[n], k));
+                light.spread[k] = rgbToYCoCg(centre * glm::row(slopes[n], k));
         },
         4096);
 }
@@ -265,10 +286,11 @@ void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const L
 void lightCaches(const BakeData& bake, std::span<const glm::vec3> nodeFlux, CacheValues& out) {
     const NodeSpread spread = nodeSpread(bake);
     std::vector<glm::mat3> moment(nodeFlux.size()), slopes(nodeFlux.size());
-    std::vector<glm::vec3> centre(nodeFlux.size());
-    pullFluxSpread(bake, spread, nodeFlux, moment, centre, slopes);
+    std::vector<glm::vec3> centre(nodeFlux.size()), concentration(nodeFlux.size());
+    std::vector<uint8_t> exponential(nodeFlux.size());
+    pullFluxSpread(bake, spread, nodeFlux, moment, centre, slopes, concentration, exponential);
     std::vector<NodeLight> light(nodeFlux.size());
-    nodeLight(centre, slopes, light);
+    nodeLight(centre, slopes, concentration, exponential, light);
     lightCaches(bake, light, unpackLinks(bake, spread), out);
 }
 

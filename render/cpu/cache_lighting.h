@@ -24,6 +24,8 @@ struct LinkTable {
     uint32_t bands = 0;                 ///< lY
     std::vector<glm::vec3> points;      ///< nC·nL box coordinates of LinkSet::offset in the
                                         ///< link's node (render/cpu/pull.h encodeBoxPoint)
+    std::vector<float> concentrationWeight;  ///< nC·nL: 1 − the link's spread share
+                                             ///< (LinkSet::spreadShare)
     std::vector<glm::vec3> directions;  ///< RTP: nC·nL unit directions cache → node
     std::vector<float> weights;  ///< RTP: nC·nL·lY band weights factor·K_l(α); 0 for padding
 };
@@ -32,17 +34,24 @@ struct LinkTable {
 /// (nodeSpread(bake)).
 LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread);
 
-/// A node's light as its links read it, in YCoCg: its limited flux spread's flux at the box
-/// centre and the change per box coordinate (column k: centre ∘ the slopes along axis k), so
-/// that a link at box point u reads centre + spread·u.
+/// A node's light as its links read it (render/cpu/pull.h). A linear node holds, in YCoCg, its
+/// limited flux spread's flux at the box centre and the change per box coordinate (column k:
+/// centre ∘ the slopes along axis k), so that a link at box point u reads centre + spread·u.
+/// An exponential node holds, per RGB channel, its spread's centre, slopes (column k: the RGB
+/// slopes along axis k) and ln Z, so that a link at u with spread share ρ reads
+/// centre ∘ exp(spread·u − (1 − ρ)·concentration).
 struct NodeLight {
     glm::vec3 centre{0.0f};
     glm::mat3 spread{0.0f};
+    glm::vec3 concentration{0.0f};
+    uint32_t exponential = 0;
 };
 
-/// The node light of every node from its limited flux spread (render/cpu/pull.h
-/// pullFluxSpread: `centreFlux`, W per RGB channel, and `slopes`) into `out` (same size).
+/// The node light of every node from its flux spread (render/cpu/pull.h pullFluxSpread:
+/// `centreFlux`, W per RGB channel, `slopes`, `concentration`, `exponential`) into `out`
+/// (same size).
 void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,
+               std::span<const glm::vec3> concentration, std::span<const uint8_t> exponential,
                std::span<NodeLight> out);
 
 /// Lights every cache of the bake from its nodes' light (nodeLight, 2nS − 1 nodes) into `out`

@@ -133,12 +133,13 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
     float atCentre = flux + glm::dot(g, centre);
     glm::vec3 change = glm::abs(g * half);
     const float swing = change.x + change.y + change.z;
-    if (swing > atCentre) {
+    const bool limited = swing > atCentre;
+    if (limited) {
         g *= flux / (swing - glm::dot(g, centre));
         atCentre = flux + glm::dot(g, centre);
     }
-    if (!(atCentre > 0.0f)) return {};
-    ChannelSpread out{atCentre, g * half * (1.0f / atCentre)};
+    if (!(atCentre > 0.0f)) return {0.0f, glm::vec3(0.0f), limited};
+    ChannelSpread out{atCentre, g * half * (1.0f / atCentre), limited};
     // Σ|slopes| ≤ 1 holds up to rounding; keep it exact, so no point of the box reads < 0.
     change = glm::abs(out.slopes);
     const float sum = change.x + change.y + change.z;
@@ -146,14 +147,55 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
     return out;
 }
 
+float inverseLangevin(float r) {
+    const float a = std::min(std::abs(r), 0.99f);
+    const float x = a * (3.0f - 2.6f * a + 0.7f * a * a) / ((1.0f - a) * (1.0f + 0.1f * a));
+    return r < 0.0f ? -x : x;
+}
+
+ExponentialSpread exponentialSpread(const NodeSpread& spread, size_t node, float flux,
+                                    const glm::vec3& moment) {
+    if (!(flux > 0.0f)) return {};
+    const glm::vec3 inverseVariance = spread.inverseVariance[node];
+    const glm::vec3 low = spread.low[node], high = spread.high[node];
+    const glm::vec3 centre = 0.5f * (low + high), half = 0.5f * (high - low);
+    // The flux centroid's offset along the axes, M / Φ.
+    const glm::vec3 mean = (moment * spread.axes[node]) * (1.0f / flux);
+    glm::vec3 variance(0.0f);
+    for (int k = 0; k < 3; ++k)
+        if (inverseVariance[k] > 0.0f) variance[k] = 1.0f / inverseVariance[k];
+    const float total = variance.x + variance.y + variance.z;
+    glm::vec3 beta(0.0f), a(0.0f);
+    for (int k = 0; k < 3; ++k) {
+        if (!(variance[k] > gpu::kFlatVariance * total)) continue;
+        a[k] = std::sqrt(3.0f * variance[k]);
+        beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
+    }
+    const float sum = glm::dot(glm::abs(beta), half);
+    if (sum > gpu::kExponentialSpreadCap) beta *= gpu::kExponentialSpreadCap / sum;
+    ExponentialSpread out;
+    for (int k = 0; k < 3; ++k) {
+        const float x = std::abs(beta[k] * a[k]);
+        // ln(sinh x / x), its series where x is small.
+        if (x > 1e-2f) out.concentration += std::log(std::sinh(x) / x);
+        else out.concentration += x * x * (1.0f / 6.0f);
+    }
+    out.centre = flux * std::exp(glm::dot(beta, centre));
+    out.slopes = beta * half;
+    return out;
+}
+
 void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
-                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes) {
+                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes,
+                    std::span<glm::vec3> concentration, std::span<uint8_t> exponential) {
     const size_t nS = bake.surfels.size();
     PIC_CHECK_EQ(nodeFlux.size(), bake.nodes.size());
     PIC_CHECK_EQ(moment.size(), bake.nodes.size());
     PIC_CHECK_EQ(centreFlux.size(), bake.nodes.size());
     PIC_CHECK_EQ(slopes.size(), bake.nodes.size());
+    PIC_CHECK_EQ(concentration.size(), bake.nodes.size());
+    PIC_CHECK_EQ(exponential.size(), bake.nodes.size());
     PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
     // Leaves (and any node the levels leave out) read their own flux, evenly.
     const size_t innerBegin = bake.levelOffsets.empty() ? nS : bake.levelOffsets.front();
@@ -163,6 +205,8 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
         std::fill(moment.begin() + begin, moment.begin() + end, glm::mat3(0.0f));
         std::copy(nodeFlux.begin() + begin, nodeFlux.begin() + end, centreFlux.begin() + begin);
         std::fill(slopes.begin() + begin, slopes.begin() + end, glm::mat3(0.0f));
+        std::fill(concentration.begin() + begin, concentration.begin() + end, glm::vec3(0.0f));
+        std::fill(exponential.begin() + begin, exponential.begin() + end, uint8_t{0});
     }
     for (size_t level = 1; level < bake.levelOffsets.size(); ++level) {
         parallelFor(
@@ -175,10 +219,21 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     for (int c = 0; c < 3; ++c) m[c] += nodeFlux[child][c] * offset;
                 }
                 moment[n] = m;
+                bool limited = false;
                 for (int c = 0; c < 3; ++c) {
                     const ChannelSpread channel = limitedSpread(spread, n, nodeFlux[n][c], m[c]);
                     centreFlux[n][c] = channel.centre;
                     slopes[n][c] = channel.slopes;
+                    limited = limited || channel.limited;
+                }
+                concentration[n] = glm::vec3(0.0f);
+                exponential[n] = limited ? 1 : 0;
+                if (!limited) return;
+                for (int c = 0; c < 3; ++c) {
+                    const ExponentialSpread channel = exponentialSpread(spread, n, nodeFlux[n][c], m[c]);
+                    centreFlux[n][c] = channel.centre;
+                    slopes[n][c] = channel.slopes;
+                    concentration[n][c] = channel.concentration;
                 }
             },
             1024);

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "core/bake_data.h"
+#include "shaders/shared/pull.h"
 
 namespace pic {
 
@@ -32,6 +33,22 @@ void pullFlux(const BakeData& bake, std::span<glm::vec3> nodeFlux);
 /// x̄_n + d (LinkSet::offset) reads Φ_n + g_n·d: a far wall lit at one end sends more light to
 /// a cache that sees that end. The visible part's centroid lies among the node's surfels, so
 /// within the box [low, high], and links carry it in box coordinates (encodeBoxPoint).
+///
+/// Where the limiter acts, light is concentrated in a part of the node (a sun patch, the
+/// corner next to a lamp) and a line cannot follow it: the node's spread is exponential
+/// instead (exponentialSpread), Φ_s = ω_s·Φ_n·e^{β·(x_s − x̄_n)} / Z(β), ≥ 0 everywhere and
+/// as peaked as the moment asks. Z is that of a model of the node: along each principal axis
+/// k its surfels spread evenly over ±a_k, a_k = √3·σ_k (the same variance), so that
+/// Z = Π_k sinh(β_k·a_k) / (β_k·a_k) and the moment fixes each β_k by the inverse Langevin
+/// function, a_k·L(β_k·a_k) = M_k / Φ_n. A link reads the model's mean over the part it sees,
+/// Φ_n·E_part[e^{β·y}] / E_node[e^{β·y}]: to second order in β (cumulants) that is
+/// Φ_n·e^{β·ȳ + ½βᵀ(Σ_part − Σ_node)β}, ȳ and Σ_part the centroid and covariance of the part
+/// (weights w·Ω·V, as the link's offset), and with ½βᵀΣ_node β ≈ ln Z and βᵀΣ_part β ≈
+/// ρ·βᵀΣ_node β, ρ = tr Σ_part / tr Σ_node the link's spread share (LinkSet::spreadShare),
+///   Φ_link = Φ_n·e^{β·ȳ − (1 − ρ)·ln Z}:
+/// Φ_n for a link that sees the whole node evenly, the spread's value at ȳ for one that sees a
+/// point. The exponent is capped, Σ_k |β_k|·halfExtent_k ≤ gpu::kExponentialSpreadCap, where
+/// the box model stops holding.
 struct NodeSpread {
     std::vector<glm::vec3> centroid;  ///< x̄_n per node, metres
     std::vector<glm::mat3> axes;      ///< principal axes of C_n (orthonormal columns)
@@ -54,7 +71,26 @@ NodeSpread nodeSpread(const BakeData& bake);
 struct ChannelSpread {
     float centre = 0.0f;     ///< W: Φ_n + g_n·c_n, c_n the box centre about x̄_n
     glm::vec3 slopes{0.0f};  ///< (g_n·axis_k)·halfExtent_k / centre
+    bool limited = false;    ///< the limiter scaled g_n down
 };
+
+/// An exponential spread of one channel (NodeSpread): a point of the box at box coordinates u
+/// reads centre·e^{slopes·u − (1 − ρ)·concentration} for a part of spread share ρ.
+struct ExponentialSpread {
+    float centre = 0.0f;           ///< W: Φ_n·e^{β·c_n}, c_n the box centre about x̄_n
+    glm::vec3 slopes{0.0f};        ///< β_k·halfExtent_k
+    float concentration = 0.0f;    ///< ln Z(β) ≥ 0
+};
+
+/// The exponential spread of one channel of `node` from its flux Φ and moment M (the twin of
+/// the GPU pull's): 0 where Φ ≤ 0; axes along which the node is flat (variance below 10⁻³ of
+/// the total) take no slope.
+ExponentialSpread exponentialSpread(const NodeSpread& spread, size_t node, float flux,
+                                    const glm::vec3& moment);
+
+/// x with L(x) = coth x − 1/x = r for |r| < 1 (the inverse Langevin function), by Jedynak's
+/// rational approximation (within 1.5 %); r is clamped to ±0.99.
+float inverseLangevin(float r);
 
 /// The limited spread of one channel of `node` from its flux Φ and moment M (the twin of the
 /// GPU pull's): g = axes·(axesᵀ·M ∘ inverseVariance), scaled so that Φ + g·y ≥ 0 over the
@@ -64,11 +100,14 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
 
 /// From pulled `nodeFlux`: the first moments M_n (`moment`, column c = channel c, W·m; the
 /// leaves' are 0) summed up the hierarchy like the flux, M_n = Σ_children M_k + Φ_k ⊗ (x̄_k −
-/// x̄_n), and every node's limited spread: `centreFlux` (W per channel; a leaf's own flux) and
-/// `slopes` (column c = channel c's slopes; 0 for leaves).
+/// x̄_n), and every node's spread: `centreFlux` (W per channel; a leaf's own flux) and
+/// `slopes` (column c = channel c's slopes; 0 for leaves). A node where the limiter acts in
+/// any channel is exponential in all three (`exponential` 1, its ln Z per channel in
+/// `concentration`); the others are linear (`exponential` 0, `concentration` 0).
 void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
-                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes);
+                    std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes,
+                    std::span<glm::vec3> concentration, std::span<uint8_t> exponential);
 
 /// Box coordinates of a point at `offset` from the flux centroid of `node` (a link's
 /// LinkSet::offset): u_k = (axis_k·offset − centre_k) / halfExtent_k, clamped to [−1, 1], 0

@@ -45,7 +45,8 @@ uint32_t linkTexelWords(const Context& context, uint32_t linkWords, uint32_t max
 
 }  // namespace
 
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, float nodeArea) {
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, uint8_t spreadShare,
+                       float nodeArea) {
     PIC_CHECK(link.node < (1u << kGpuLinkNodeBits));
     // V = factor·π·A: the bake's factor is V / (π·A) (bake/link_generation.cpp).
     const auto visible = float(double(link.factor) * std::numbers::pi * double(nodeArea));
@@ -53,17 +54,17 @@ GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, float
     // A real link too faint for binary16 would read as padding; it keeps the smallest step.
     if (half == 0 && link.factor > 0.0f) half = 1;
     const uint32_t cone = floatToHalf(std::clamp(link.oneMinusCosAlpha, 0.0f, 2.0f));
-    // snorm16 → snorm12 per octahedral coordinate, unorm10 → unorm8 per tint channel.
-    const auto snorm12 = [](uint32_t snorm16) {
-        return uint32_t(std::lround(float(int16_t(uint16_t(snorm16))) * (2047.0f / 32767.0f))) &
-               0xFFFu;
+    // snorm16 → snorm9 per octahedral coordinate, unorm10 → unorm8 per tint channel.
+    const auto snorm9 = [](uint32_t snorm16) {
+        return uint32_t(std::lround(float(int16_t(uint16_t(snorm16))) * (255.0f / 32767.0f))) &
+               0x1FFu;
     };
     const auto unorm8 = [&](int channel) {
         return uint32_t(std::lround(float((tint >> (10 * channel)) & 0x3FFu) * (255.0f / 1023.0f)));
     };
     return {link.node | unorm8(0) << 24,
-            snorm12(link.directionOct & 0xFFFFu) | snorm12(link.directionOct >> 16) << 12 |
-                unorm8(1) << 24,
+            snorm9(link.directionOct & 0xFFFFu) | snorm9(link.directionOct >> 16) << 9 |
+                uint32_t(std::min<uint32_t>(spreadShare, kSpreadShareSteps)) << 18 | unorm8(1) << 24,
             half | (cone << 16), (point & 0xFFFFFFu) | unorm8(2) << 24};
 }
 
@@ -148,7 +149,7 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 // Padding (factor 0) may name any node; V = 0 marks it.
                 rtp[i] = link.factor > 0.0f
                              ? packRtpLink(link, links.tint[i], boxPoint(i, link.node),
-                                           bake.nodes[link.node].area)
+                                           links.spreadShare[i], bake.nodes[link.node].area)
                              : GpuRtpLink{};
             },
             4096);
@@ -166,7 +167,9 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 uint32_t* record = sh.data() + slot * words;
                 record[0] = node;
                 record[1] = links.tint[slot];
-                record[2] = node == kNoNode ? 0u : boxPoint(slot, node);
+                record[2] = node == kNoNode
+                                ? 0u
+                                : boxPoint(slot, node) | uint32_t(links.spreadShare[slot]) << 24;
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 for (uint32_t i = 0; i < countY; ++i)
                     record[3 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))

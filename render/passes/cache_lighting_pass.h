@@ -18,11 +18,14 @@
 namespace pic::gpu {
 
 /// The GPU's 16-byte form of a runtime-projected link with tint code `tint` (core/color.h
-/// encodeLinkTint) and box point `point` (render/cpu/pull.h encodeBoxPoint) whose node has
-/// area `nodeArea` (shaders/shared/cache_lighting.h): the node index (below 2^24), V =
-/// factor·π·A as binary16 (clamped to 65504, at least the smallest subnormal for a link with
-/// factor > 0), 1 − cos α as binary16, the direction as 2 × snorm12 and the tint as 3 × unorm8.
-GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, float nodeArea);
+/// encodeLinkTint), box point `point` (render/cpu/pull.h encodeBoxPoint) and spread share code
+/// `spreadShare` (core/bake_data.h encodeSpreadShare) whose node has area `nodeArea`
+/// (shaders/shared/cache_lighting.h): the node index (below 2^24), V = factor·π·A as binary16
+/// (clamped to 65504, at least the smallest subnormal for a link with factor > 0), 1 − cos α
+/// as binary16, the direction as 2 × snorm9, the spread share in 6 bits and the tint as
+/// 3 × unorm8.
+GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, uint8_t spreadShare,
+                       float nodeArea);
 /// An SH link coefficient (binary16) rescaled to take the node's radiance instead of its flux:
 /// c·π·A, clamped to ±65504.
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);

@@ -22,25 +22,45 @@ float radianceScale(float area) {
 
 namespace {
 
-/// snorm8 of v ∈ [−1, 1] rounded towards zero, in the low byte.
-uint32_t snorm8TowardsZero(float v) {
-    return uint32_t(uint8_t(int8_t(std::trunc(std::clamp(v, -1.0f, 1.0f) * 127.0f))));
+/// snorm8 of v ∈ [−1, 1], rounded towards zero or to nearest, in the low byte.
+uint32_t snorm8(float v, bool towardsZero) {
+    const float scaled = std::clamp(v, -1.0f, 1.0f) * 127.0f;
+    return uint32_t(uint8_t(int8_t(towardsZero ? std::trunc(scaled) : std::round(scaled))));
+}
+
+/// unorm7 of ln Z over [0, kConcentrationRange], rounded to nearest.
+uint32_t concentrationBits(float concentration) {
+    return uint32_t(std::round(std::clamp(concentration / kConcentrationRange, 0.0f, 1.0f) * 127.0f));
 }
 
 }  // namespace
 
-glm::uvec3 packNodeSlopes(const glm::mat3& slopes) {
+glm::uvec3 packNodeSpread(const glm::mat3& slopes, const glm::vec3& concentration,
+                          bool exponential) {
+    const float scale = exponential ? 1.0f / kExponentialSpreadCap : 1.0f;
     std::array<uint32_t, 9> bytes;
     for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 3; ++k) bytes[3 * c + k] = snorm8TowardsZero(slopes[c][k]);
-    return {bytes[0] | bytes[1] << 8 | bytes[2] << 16 | bytes[3] << 24,
-            bytes[4] | bytes[5] << 8 | bytes[6] << 16 | bytes[7] << 24, bytes[8]};
+        for (int k = 0; k < 3; ++k) bytes[3 * c + k] = snorm8(slopes[c][k] * scale, !exponential);
+    glm::uvec3 packed(bytes[0] | bytes[1] << 8 | bytes[2] << 16 | bytes[3] << 24,
+                      bytes[4] | bytes[5] << 8 | bytes[6] << 16 | bytes[7] << 24, bytes[8]);
+    if (exponential)
+        packed.z |= concentrationBits(concentration.r) << 8 |
+                    concentrationBits(concentration.g) << 15 |
+                    concentrationBits(concentration.b) << 22 | kNodeLightExponentialBit;
+    return packed;
 }
 
-glm::mat3 unpackNodeSlopes(const glm::uvec3& packed) {
+bool unpackNodeSpread(const glm::uvec3& packed, glm::mat3& slopes, glm::vec3& concentration) {
     const glm::vec4 a = glm::unpackSnorm4x8(packed.x), b = glm::unpackSnorm4x8(packed.y);
-    const float z = glm::unpackSnorm4x8(packed.z).x;
-    return glm::mat3(glm::vec3(a), glm::vec3(a.w, b.x, b.y), glm::vec3(b.z, b.w, z));
+    const float z = glm::unpackSnorm4x8(packed.z & 0xFFu).x;
+    slopes = glm::mat3(glm::vec3(a), glm::vec3(a.w, b.x, b.y), glm::vec3(b.z, b.w, z));
+    const bool exponential = (packed.z & kNodeLightExponentialBit) != 0;
+    concentration = glm::vec3(0.0f);
+    if (!exponential) return false;
+    slopes *= kExponentialSpreadCap;
+    for (int c = 0; c < 3; ++c)
+        concentration[c] = float((packed.z >> (8 + 7 * c)) & 0x7Fu) / 127.0f * kConcentrationRange;
+    return true;
 }
 
 Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake,

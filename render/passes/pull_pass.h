@@ -20,10 +20,14 @@ namespace pic::gpu {
 /// §4.1), as the pull scales it.
 float radianceScale(float area);
 
-/// A node's nine spread slopes (columns: the R, G, B slopes of render/cpu/pull.h ChannelSpread)
-/// as the pull packs them, snorm8 rounded towards zero (shaders/shared/pull.h), and back.
-glm::uvec3 packNodeSlopes(const glm::mat3& slopes);
-glm::mat3 unpackNodeSlopes(const glm::uvec3& packed);
+/// Words 0-2 of a node's light as the pull packs them (shaders/shared/pull.h): its nine spread
+/// slopes (columns: the R, G, B slopes of render/cpu/pull.h ChannelSpread or
+/// ExponentialSpread) and, for an exponential spread, ln Z per channel.
+glm::uvec3 packNodeSpread(const glm::mat3& slopes, const glm::vec3& concentration,
+                          bool exponential);
+
+/// A node's spread from words 0-2 of its light; returns whether it is exponential.
+bool unpackNodeSpread(const glm::uvec3& packed, glm::mat3& slopes, glm::vec3& concentration);
 
 class PullPass {
 public:

@@ -53,11 +53,11 @@ vec2 chromaPerLuma(vec3 ycocg) {
     return clamp(ycocg.yz / ycocg.x, vec2(-2.0, -1.0), vec2(2.0, 1.0));
 }
 
-/// core/color.h decodeOctahedral for the GPU links' 2 × snorm12 form (shared/cache_lighting.h
-/// GpuRtpLink): x in bits 0-11, y in bits 12-23.
-vec3 decodeOctahedral12(uint code) {
-    const float u = max(float(int(code << 20u) >> 20) * (1.0 / 2047.0), -1.0);
-    const float v = max(float(int(code << 8u) >> 20) * (1.0 / 2047.0), -1.0);
+/// core/color.h decodeOctahedral for the GPU links' 2 × snorm9 form (shared/cache_lighting.h
+/// GpuRtpLink): x in bits 0-8, y in bits 9-17.
+vec3 decodeOctahedral9(uint code) {
+    const float u = max(float(int(code << 23u) >> 23) * (1.0 / 255.0), -1.0);
+    const float v = max(float(int(code << 14u) >> 23) * (1.0 / 255.0), -1.0);
     vec3 dir = vec3(u, v, 1.0 - abs(u) - abs(v));
     if (dir.z < 0.0) {
         dir.x = (1.0 - abs(v)) * (u >= 0.0 ? 1.0 : -1.0);

@@ -8,6 +8,9 @@ PIC_NAMESPACE_BEGIN
 
 PIC_CONST(uint, kNoNode, 0xFFFFFFFFu);
 PIC_CONST(uint, kNoCache, 0xFFFFFFFFu);
+// Steps of a link's spread share (core/bake_data.h encodeSpreadShare): the GPU's links carry it in
+// 6 bits (shared/cache_lighting.h).
+PIC_CONST(uint, kSpreadShareSteps, 63u);
 PIC_CONST(uint, kCacheKindGrid, 0u);
 PIC_CONST(uint, kCacheKindLightmap, 1u);
 

@@ -33,10 +33,12 @@ PIC_CONST(float, kHalfMax, 65504.0f);
 // the uniform model and may exceed 1 where the flux weights favour the part the cache sees
 // (binary16 holds it). The tint (core/color.h encodeLinkTint, there 3 × unorm10) is three
 // unorm8 in the words' top bytes, within 1/510 of its largest channel; the direction
-// (core/color.h encodeOctahedral, there 2 × snorm16) is 2 × snorm12, within 0.05°.
+// (core/color.h encodeOctahedral, there 2 × snorm16) is 2 × snorm9, within 0.4°; the seen
+// share (core/bake_data.h encodeSpreadShare) is its 6-bit code.
 struct GpuRtpLink {
     uint nodeAndRed;         // node index (bits 0-23) | tint R << 24
-    uint directionAndGreen;  // unit direction cache → node, octahedral x | y << 12 | tint G << 24
+    uint directionAndGreen;  // unit direction cache → node, octahedral x | y << 9
+                             // | spread share << 18 | tint G << 24
     uint visibleAndCone;     // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
     uint pointAndBlue;       // box point (render/cpu/pull.h encodeBoxPoint) | tint B << 24
 };
@@ -44,7 +46,7 @@ PIC_STRUCT_CHECK(GpuRtpLink, 16);
 PIC_CONST(uint, kGpuLinkNodeBits, 24u);
 
 // An SH-projected link as the GPU reads it: the node index, its tint (unorm10 as in the bake),
-// its box point, then its lY² binary16 coefficients (rescaled by π·A to take the node's
+// its box point | its spread share's code << 24, then its lY² binary16 coefficients (rescaled by π·A to take the node's
 // radiance) two per 32-bit word, the last word's high half zero when lY² is odd, and zero
 // words up to a multiple of 4, so that 2- or 4-word texels divide it: 8, 8, 12 words for
 // lY = 2, 3, 4.

@@ -62,13 +62,27 @@ PullNode fetchPullNode(usamplerBuffer records, uint i) {
 }
 #endif
 
-// A node as cache lighting reads it: one RGBA32UI texel (render/cpu/pull.h ChannelSpread).
-// Words 0-2 hold the slopes of its limited flux spread per channel along its box's axes, nine
-// snorm8 rounded towards zero so that each channel's Σ|slope| stays ≤ 1: word 0 R.xyz G.x,
-// word 1 G.yz B.xy, word 2 B.z in bits 0-7; word 3 the spread's radiance at the box centre,
-// centre / (π·A), as RGBE8. A link at box point u reads radiance·(1 + slopes·u) per channel.
+// A node as cache lighting reads it: one RGBA32UI texel (render/cpu/pull.h ChannelSpread and
+// ExponentialSpread). Words 0-2 hold the slopes of its flux spread per channel along its
+// box's axes, nine snorm8: word 0 R.xyz G.x, word 1 G.yz B.xy, word 2 B.z in bits 0-7; word 3
+// the spread's radiance at the box centre, centre / (π·A), as RGBE8. A linear node's slopes
+// are rounded towards zero, so that each channel's Σ|slope| stays ≤ 1, and a link at box
+// point u reads radiance·(1 + slopes·u) per channel. An exponential node (bit 31 of word 2)
+// holds its slopes over kExponentialSpreadCap, rounded to nearest, and ln Z per channel as
+// unorm7 over [0, kConcentrationRange] in bits 8-14 (R), 15-21 (G), 22-28 (B) of word 2; a
+// link at u that sees share v of it reads radiance·exp(slopes·u − (1 − v)·ln Z).
 // Leaves have no slopes (words 0-2 zero).
 PIC_CONST(uint, kNodeLightRadianceWord, 3u);
+PIC_CONST(uint, kNodeLightExponentialBit, 0x80000000u);
+// The largest Σ_k |slope_k| of an exponential spread: its reads span at most e^{±3} about the
+// box centre (render/cpu/pull.h).
+PIC_CONST(float, kExponentialSpreadCap, 3.0f);
+// ln Z of an exponential spread lies in [0, kConcentrationRange]: with Σ|slope| ≤ 3 and
+// a_k ≤ √3·halfExtent_k it is at most ln(sinh(3√3) / (3√3)) < 2.9.
+PIC_CONST(float, kConcentrationRange, 4.0f);
+// An axis along which a node's variance is below this share of its total is flat: an
+// exponential spread takes no slope along it.
+PIC_CONST(float, kFlatVariance, 1e-3f);
 
 struct PullPush {
     uint first;        // level mode: the level is nodes [first, end); tail mode: levels

@@ -25,7 +25,7 @@ constexpr std::string_view kAllSections[] = {
     "params",       "surfels",      "surfel_weights", "nodes",          "levels",
     "caches",       "grid",         "grid_index",     "lightmap",       "lightmap_index",
     "lightmap_uvs", "links",        "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
-    "links_tint",   "links_offset",
+    "links_tint",   "links_offset", "links_spread_share",
 };
 
 /// A hand-made bake: 4 surfels under a balanced hierarchy of 7 nodes, 2 grid caches and 1
@@ -120,6 +120,7 @@ BakeData makeBake(LinkMode mode) {
     for (uint32_t i = 0; i < nLinks; ++i) bake.links.tint.push_back(kNeutralLinkTint - 1025 * i);
     for (uint32_t i = 0; i < nLinks * 3; ++i)
         bake.links.offset.push_back(floatToHalf(0.125f * float(i) - 1.0f));
+    for (uint32_t i = 0; i < nLinks; ++i) bake.links.spreadShare.push_back(encodeSpreadShare(0.2f * float(i)));
     bake.surfelWeights = {0.5f, 1.0f, 2.0f, 1.25f};
     return bake;
 }
@@ -171,6 +172,7 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     EXPECT_EQ(a.links.shCoefficients, b.links.shCoefficients);
     EXPECT_EQ(a.links.tint, b.links.tint);
     EXPECT_EQ(a.links.offset, b.links.offset);
+    EXPECT_EQ(a.links.spreadShare, b.links.spreadShare);
     EXPECT_EQ(a.surfelWeights, b.surfelWeights);
 }
 
@@ -614,6 +616,10 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     shortOffsets.links.offset.pop_back();
     BakeData nanOffset = makeBake(LinkMode::Sh);
     nanOffset.links.offset[7] = 0x7E00u;
+    BakeData shortShares = makeBake(LinkMode::Sh);
+    shortShares.links.spreadShare.pop_back();
+    BakeData badShare = makeBake(LinkMode::Rtp);
+    badShare.links.spreadShare[3] = 64;
     BakeData zeroWeight = makeBake(LinkMode::Rtp);
     zeroWeight.surfelWeights[2] = 0.0f;
     BakeData missingWeights = makeBake(LinkMode::Sh);
@@ -633,6 +639,8 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
         {&badTint, "tint 1073741824 of link 4"},
         {&shortOffsets, "need 18 offset components, found 17"},
         {&nanOffset, "offset of link 2 is not finite"},
+        {&shortShares, "need 6 spread shares, found 5"},
+        {&badShare, "spread share code 64 of link 3 exceeds 63"},
         {&zeroWeight, "flux weight of surfel 2 is 0"},
         {&missingWeights, "0 surfel flux weights for nS = 4"},
     };

@@ -37,6 +37,7 @@ BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t 
     bake.links.linksPerCache = nL;
     bake.links.tint.assign(nL, kNeutralLinkTint);
     bake.links.offset.assign(size_t{nL} * 3, 0);
+    bake.links.spreadShare.assign(nL, encodeSpreadShare(1.0f));
     if (mode == LinkMode::Sh) {
         bake.links.bands = bandsY;
         bake.links.shNodes.assign(nL, 0u);
@@ -152,6 +153,53 @@ TEST(CacheLighting, ALinksTintMultipliesItsNodesFluxPerChannel) {
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(b[c], a[c] * decoded[c], 1e-5f * std::abs(a[c]) + 1e-7f)
                     << (mode == LinkMode::Rtp ? "rtp" : "sh") << " coefficient " << i << " channel " << c;
+        }
+    }
+}
+
+TEST(CacheLighting, AnExponentialNodeIsReadAtTheLinksPointAndSpreadShare) {
+    // Through an exponential node (render/cpu/pull.h) a link at box point u with spread share
+    // ρ carries centre ∘ exp(slopes·u − (1 − ρ)·ln Z) per channel: the same cache as a linear
+    // node holding that flux evenly, in both link forms, tinted or not.
+    const glm::vec3 u(0.5f, -0.25f, 1.0f);
+    const glm::vec3 centre(2.0f, 1.0f, 0.5f), concentration(0.3f, 0.8f, 0.1f);
+    glm::mat3 slopes;  // column c: channel c's slopes along the three axes
+    slopes[0] = {1.5f, -0.5f, 0.2f};
+    slopes[1] = {-2.0f, 0.5f, 0.0f};
+    slopes[2] = {0.0f, 0.0f, 3.0f};
+    for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
+        for (const uint32_t tint : {kNeutralLinkTint, encodeLinkTint({0.25f, 1.0f, 0.5f}).code}) {
+            BakeData bake = oneCacheBake(mode, 2, 2, 1, 1);
+            if (mode == LinkMode::Rtp) {
+                bake.links.rtp[0] = RtpLink{0, 0.5f, encodeOctahedral(glm::vec3(0, 1, 0)), 0.2f};
+            } else {
+                const float c[4] = {0.5f, 0.25f, -0.125f, 0.75f};
+                for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
+            }
+            bake.links.tint[0] = tint;
+            bake.links.spreadShare[0] = encodeSpreadShare(0.25f);
+            LinkTable table = unpackLinks(bake, nodeSpread(bake));
+            EXPECT_FLOAT_EQ(table.concentrationWeight[0],
+                            1.0f - decodeSpreadShare(encodeSpreadShare(0.25f)));
+            table.points[0] = u;  // a leaf has no box: put the link inside one
+            const float rho = decodeSpreadShare(bake.links.spreadShare[0]);
+            std::vector<NodeLight> exponential(1), even(1);
+            nodeLight(std::vector<glm::vec3>{centre}, std::vector<glm::mat3>{slopes},
+                      std::vector<glm::vec3>{concentration}, std::vector<uint8_t>{1}, exponential);
+            glm::vec3 read;
+            for (int c = 0; c < 3; ++c)
+                read[c] = centre[c] * std::exp(glm::dot(slopes[c], u) - (1.0f - rho) * concentration[c]);
+            nodeLight(std::vector<glm::vec3>{read}, std::vector<glm::mat3>{glm::mat3(0.0f)},
+                      std::vector<glm::vec3>{glm::vec3(0.0f)}, std::vector<uint8_t>{0}, even);
+            CacheValues a, b;
+            lightCaches(bake, exponential, table, a);
+            lightCaches(bake, even, table, b);
+            for (int i = 0; i < 4; ++i) {
+                EXPECT_NEAR(a.y[i], b.y[i], 1e-5f * std::abs(b.y[i]) + 1e-7f) << "coefficient " << i;
+                EXPECT_NEAR(a.co[i], b.co[i], 1e-5f * std::abs(b.y[i]) + 1e-7f) << "coefficient " << i;
+                EXPECT_NEAR(a.cg[i], b.cg[i], 1e-5f * std::abs(b.y[i]) + 1e-7f) << "coefficient " << i;
+            }
+            EXPECT_GT(std::abs(b.y[0]), 0.0f);
         }
     }
 }

@@ -1,5 +1,6 @@
 // The pull's CPU twin (render/cpu/pull.h): inner nodes of a three-level hierarchy hold the
-// exact sums of their leaves; the limited flux spread and the box points links read it at.
+// exact sums of their leaves; the limited linear and the exponential flux spreads and the box
+// points links read them at.
 
 #include <gtest/gtest.h>
 
@@ -67,17 +68,20 @@ BakeData lineBake() {
     return bake;
 }
 
-/// A node's limited spreads as pullFluxSpread writes them.
+/// The nodes' spreads as pullFluxSpread writes them.
 struct Spreads {
     std::vector<glm::mat3> moment, slopes;
-    std::vector<glm::vec3> centre;
+    std::vector<glm::vec3> centre, concentration;
+    std::vector<uint8_t> exponential;
 };
 
 Spreads pulledSpreads(const BakeData& bake, const NodeSpread& spread,
                       const std::vector<glm::vec3>& flux) {
-    Spreads out{std::vector<glm::mat3>(flux.size()), std::vector<glm::mat3>(flux.size()),
-                std::vector<glm::vec3>(flux.size())};
-    pullFluxSpread(bake, spread, flux, out.moment, out.centre, out.slopes);
+    const size_t n = flux.size();
+    Spreads out{std::vector<glm::mat3>(n), std::vector<glm::mat3>(n), std::vector<glm::vec3>(n),
+                std::vector<glm::vec3>(n), std::vector<uint8_t>(n)};
+    pullFluxSpread(bake, spread, flux, out.moment, out.centre, out.slopes, out.concentration,
+                   out.exponential);
     return out;
 }
 
@@ -93,12 +97,15 @@ glm::vec3 boxPoint(const NodeSpread& spread, uint32_t node, float x) {
     return u;
 }
 
-/// The flux the limited spread of `node` gives the part of it centred at `x` with share `share`
-/// of its weight, in channel `c`.
+/// The flux the spread of `node` gives the part of it centred at `x` with share `share` of its
+/// weight and spread share `rho`, in channel `c`, as a link reads it
+/// (render/cpu/cache_lighting.h NodeLight).
 float spreadFlux(const NodeSpread& spread, const Spreads& s, uint32_t node, float x, float share,
-                 int c) {
-    return share * s.centre[node][c] *
-           (1.0f + glm::dot(s.slopes[node][c], boxPoint(spread, node, x)));
+                 int c, float rho = 0.0f) {
+    const float along = glm::dot(s.slopes[node][c], boxPoint(spread, node, x));
+    if (s.exponential[node])
+        return share * s.centre[node][c] * std::exp(along - (1.0f - rho) * s.concentration[node][c]);
+    return share * s.centre[node][c] * (1.0f + along);
 }
 
 TEST(Pull, LinearFluxIsSpreadExactly) {
@@ -131,33 +138,137 @@ TEST(Pull, LinearFluxIsSpreadExactly) {
     }
 }
 
-TEST(Pull, SpreadOfConcentratedFluxStaysNonNegativeAndKeepsTheTotal) {
-    // All flux on the last surfel: the fit would go negative at x = 0 (1 − 1.2·1.5 < 0), so the
-    // limiter scales the gradient until the spread there is exactly 0.
+TEST(Pull, LimitedLinearSpreadStaysNonNegativeAndKeepsTheTotal) {
+    // All flux on the last surfel, seen by the limiter alone: the fit would go negative at
+    // x = 0 (1 − 1.2·1.5 < 0), so it scales the gradient until the spread there is exactly 0.
+    const BakeData bake = lineBake();
+    const NodeSpread spread = nodeSpread(bake);
+    const glm::vec3 moment(1.5f, 0.0f, 0.0f);  // Σ Φ_s (x_s − 1.5), all of Φ = 1 at x = 3
+    const ChannelSpread s = limitedSpread(spread, 6, 1.0f, moment);
+    EXPECT_TRUE(s.limited);
+    const auto part = [&](float x) {
+        return 0.25f * s.centre * (1.0f + glm::dot(s.slopes, boxPoint(spread, 6, x)));
+    };
+    float total = 0.0f;
+    for (uint32_t x = 0; x < 4; ++x) {
+        EXPECT_GE(part(float(x)), -1e-6f) << "surfel " << x;
+        total += part(float(x));
+    }
+    EXPECT_NEAR(part(0.0f), 0.0f, 1e-6f);
+    EXPECT_NEAR(total, 1.0f, 1e-5f);
+    // Brighter towards the light, but only 0, 1/6, 1/3, 1/2: a line cannot hold the peak.
+    EXPECT_NEAR(part(3.0f), 0.5f, 1e-5f);
+    EXPECT_NEAR(std::abs(s.slopes.x) + std::abs(s.slopes.y) + std::abs(s.slopes.z), 1.0f, 1e-5f);
+}
+
+TEST(Pull, ConcentratedFluxSpreadsExponentially) {
+    // The same flux through pullFluxSpread: the root's limiter acts, so the root is
+    // exponential, and its reads follow the peak the line could not.
     const BakeData bake = lineBake();
     std::vector<glm::vec3> flux(7, glm::vec3(0.0f));
-    flux[3] = glm::vec3(1.0f);
+    flux[3] = glm::vec3(1.0f, 0.0f, 1.0f);  // nothing in green
     pullFlux(bake, flux);
     const NodeSpread spread = nodeSpread(bake);
     const Spreads s = pulledSpreads(bake, spread, flux);
-    float total = 0.0f;
+    ASSERT_EQ(s.exponential[6], 1);
+    EXPECT_EQ(s.exponential[4], 0);  // no flux: nothing to limit
+    // Green holds no flux and reads none.
+    EXPECT_EQ(s.centre[6].g, 0.0f);
+    EXPECT_EQ(spreadFlux(spread, s, 6, 3.0f, 0.25f, 1), 0.0f);
+    // A link that sees the whole node evenly (spread share 1, centroid at x̄ = 1.5) reads Φ.
+    EXPECT_NEAR(spreadFlux(spread, s, 6, 1.5f, 1.0f, 0, 1.0f), 1.0f, 1e-5f);
+    // Each surfel seen alone (spread share 0): positive, rising towards the light, the lit one
+    // close to its whole flux (the limited line gave it 0.5) and the parts' sum close to Φ.
+    float total = 0.0f, previous = 0.0f;
     for (uint32_t x = 0; x < 4; ++x) {
         const float part = spreadFlux(spread, s, 6, float(x), 0.25f, 0);
-        EXPECT_GE(part, -1e-6f) << "surfel " << x;
+        EXPECT_GT(part, previous) << "surfel " << x;
+        previous = part;
         total += part;
     }
-    EXPECT_NEAR(spreadFlux(spread, s, 6, 0.0f, 0.25f, 0), 0.0f, 1e-6f);
-    EXPECT_NEAR(total, 1.0f, 1e-5f);
-    // Still brighter towards the light: 0, 1/6, 1/3, 1/2.
-    EXPECT_NEAR(spreadFlux(spread, s, 6, 3.0f, 0.25f, 0), 0.5f, 1e-5f);
-    // Non-negative over the whole box is Σ|slopes| ≤ 1; here the far end reads exactly 0.
+    EXPECT_GT(spreadFlux(spread, s, 6, 3.0f, 0.25f, 0), 0.75f);
+    EXPECT_NEAR(total, 1.0f, 0.1f);
+    // The cap: Σ|slopes| ≤ 3, so the far end reads at least e^−6 of the near end.
     const glm::vec3 slopes = s.slopes[6][0];
-    EXPECT_NEAR(std::abs(slopes.x) + std::abs(slopes.y) + std::abs(slopes.z), 1.0f, 1e-5f);
+    EXPECT_LE(std::abs(slopes.x) + std::abs(slopes.y) + std::abs(slopes.z),
+              gpu::kExponentialSpreadCap + 1e-5f);
 }
 
-TEST(Pull, SlopesStayWithinTheUnitBallForAnyFlux) {
-    // Random non-negative flux on a 3-D cloud of surfels: every node's every channel keeps
-    // Σ|slopes| ≤ 1, so no point of its box reads negative flux.
+TEST(Pull, InverseLangevinInvertsTheMeanOfATiltedInterval) {
+    // L(x), the mean of u ∈ [−1, 1] under density ∝ e^{x·u}, by midpoint quadrature (an oracle
+    // independent of the closed form coth x − 1/x): inverseLangevin(L(x)) is x within 2 %.
+    const auto mean = [](double x) {
+        double sum = 0.0, weight = 0.0;
+        const int n = 20000;
+        for (int i = 0; i < n; ++i) {
+            const double u = -1.0 + (i + 0.5) * 2.0 / n, w = std::exp(x * u);
+            sum += w * u;
+            weight += w;
+        }
+        return sum / weight;
+    };
+    for (double x : {-20.0, -6.0, -2.5, -1.0, -0.3, 0.05, 0.4, 1.5, 3.0, 8.0, 30.0}) {
+        const double r = mean(x);
+        if (std::abs(r) > 0.99) continue;  // beyond the clamp
+        EXPECT_NEAR(inverseLangevin(float(r)), x, 0.02 * std::abs(x) + 1e-4) << "r " << r;
+    }
+    EXPECT_EQ(inverseLangevin(0.0f), 0.0f);
+    // Clamped: a centroid at the edge of the support stays finite.
+    EXPECT_TRUE(std::isfinite(inverseLangevin(1.0f)));
+    EXPECT_EQ(inverseLangevin(1.0f), -inverseLangevin(-1.0f));
+}
+
+TEST(Pull, ExponentialSpreadMatchesTheMomentOfAnEvenlySpreadNode) {
+    // A node spread evenly over the square [−1, 1]² (variance 1/3 per axis, a = 1) whose flux
+    // is Φ·e^{β₀·y} / Z: the fit finds β₀ from the moment alone (within the inverse Langevin
+    // approximation's 1.5 %), ln Z = Σ ln(sinh β / β), and a point's read is its density.
+    NodeSpread spread;
+    spread.centroid = {glm::vec3(0.0f)};
+    spread.axes = {glm::mat3(1.0f)};
+    spread.inverseVariance = {glm::vec3(3.0f, 3.0f, 0.0f)};
+    spread.low = {glm::vec3(-1.0f, -1.0f, 0.0f)};
+    spread.high = {glm::vec3(1.0f, 1.0f, 0.0f)};
+    for (const glm::vec2 beta0 : {glm::vec2(0.5f, 0.0f), glm::vec2(1.2f, -0.8f), glm::vec2(-2.0f, 0.7f)}) {
+        // Σ Φ_s·y_s over a fine grid of the square, Φ = 2.
+        const int n = 200;
+        double z = 0.0;
+        glm::dvec2 first(0.0);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const glm::dvec2 y(-1.0 + (i + 0.5) * 2.0 / n, -1.0 + (j + 0.5) * 2.0 / n);
+                const double w = std::exp(glm::dot(glm::dvec2(beta0), y));
+                z += w;
+                first += w * y;
+            }
+        const float flux = 2.0f;
+        const glm::vec3 moment(glm::vec2(first / z) * flux, 0.0f);
+        const ExponentialSpread e = exponentialSpread(spread, 0, flux, moment);
+        for (int k = 0; k < 2; ++k)
+            EXPECT_NEAR(e.slopes[k], beta0[k], 0.02f * std::abs(beta0[k]) + 1e-3f) << "axis " << k;
+        EXPECT_EQ(e.slopes.z, 0.0f);  // flat
+        const double lnZ = std::log(z / (n * n));
+        EXPECT_NEAR(e.concentration, lnZ, 0.03 * lnZ + 1e-4);
+        // A point's read, spread share 0: Φ·e^{β₀·y} / Z.
+        const glm::vec3 u(0.5f, -0.25f, 0.0f);
+        const float read = e.centre * std::exp(glm::dot(e.slopes, u) - e.concentration);
+        const float density = flux * std::exp(glm::dot(beta0, glm::vec2(u))) / float(z / (n * n));
+        EXPECT_NEAR(read, density, 0.03f * density);
+        // The whole node at its centroid, spread share 1: Φ.
+        EXPECT_NEAR(e.centre, flux, 1e-5f);
+    }
+    // Beyond the cap the exponent is scaled to Σ|slopes| = 3; no flux reads nothing.
+    const ExponentialSpread capped = exponentialSpread(spread, 0, 1.0f, glm::vec3(0.9f, 0.5f, 0.0f));
+    EXPECT_NEAR(std::abs(capped.slopes.x) + std::abs(capped.slopes.y), gpu::kExponentialSpreadCap, 1e-4f);
+    EXPECT_GT(capped.slopes.x, capped.slopes.y);
+    const ExponentialSpread dark = exponentialSpread(spread, 0, 0.0f, glm::vec3(0.0f));
+    EXPECT_EQ(dark.centre, 0.0f);
+    EXPECT_EQ(dark.concentration, 0.0f);
+}
+
+TEST(Pull, SlopesStayBoundedForAnyFlux) {
+    // Random non-negative flux on a 3-D cloud of surfels: every linear node's every channel
+    // keeps Σ|slopes| ≤ 1, so no point of its box reads negative flux, and every exponential
+    // one Σ|slopes| ≤ 3.
     BakeData bake = lineBake();
     uint32_t state = 12345u;
     const auto next = [&] {
@@ -176,9 +287,17 @@ TEST(Pull, SlopesStayWithinTheUnitBallForAnyFlux) {
         const Spreads s = pulledSpreads(bake, spread, flux);
         for (uint32_t n = 4; n < 7; ++n)
             for (int c = 0; c < 3; ++c) {
+                // Linear spreads keep Σ|slopes| ≤ 1; exponential ones ≤ 3 with ln Z in range.
                 const glm::vec3 k = s.slopes[n][c];
-                EXPECT_LE(std::abs(k.x) + std::abs(k.y) + std::abs(k.z), 1.0f + 1e-6f);
+                const float bound = s.exponential[n] ? gpu::kExponentialSpreadCap : 1.0f;
+                EXPECT_LE(std::abs(k.x) + std::abs(k.y) + std::abs(k.z), bound + 1e-5f);
                 EXPECT_GE(s.centre[n][c], 0.0f);
+                EXPECT_TRUE(std::isfinite(s.centre[n][c]));
+                EXPECT_GE(s.concentration[n][c], 0.0f);
+                EXPECT_LE(s.concentration[n][c], gpu::kConcentrationRange);
+                if (!s.exponential[n]) {
+                    EXPECT_EQ(s.concentration[n][c], 0.0f);
+                }
             }
     }
 }

@@ -30,7 +30,7 @@ TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
     const auto pack = [&](float visible, float oneMinusCos, uint32_t node = 42) {
         const gpu::RtpLink link{node, visible / (kPi * area), encodeOctahedral(direction),
                                 oneMinusCos};
-        return gpu::packRtpLink(link, tint, point, area);
+        return gpu::packRtpLink(link, tint, point, encodeSpreadShare(0.5f), area);
     };
     const auto visibleOf = [](const gpu::GpuRtpLink& l) {
         return halfToFloat(uint16_t(l.visibleAndCone & 0xFFFFu));
@@ -56,19 +56,24 @@ TEST(GpuCacheLighting, RtpLinksPackIntoSixteenBytes) {
         glm::vec3(l.nodeAndRed >> 24, l.directionAndGreen >> 24, l.pointAndBlue >> 24) / 255.0f;
     const glm::vec3 expected = decodeLinkTint(tint);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(tint8[c], expected[c], 0.5f / 255.0f + 1e-6f);
-    EXPECT_EQ(gpu::packRtpLink({1, 1.0f, 0, 0.1f}, kNeutralLinkTint, 0, 1.0f).nodeAndRed >> 24,
+    EXPECT_EQ(gpu::packRtpLink({1, 1.0f, 0, 0.1f}, kNeutralLinkTint, 0, 0, 1.0f).nodeAndRed >> 24,
               255u);
-    // The direction as 2 × snorm12, decoded as shaders/lib/sh.glsl decodeOctahedral12 does.
-    const auto snorm12 = [](uint32_t bits) {
-        return std::max(float(int32_t(bits << 20) >> 20) / 2047.0f, -1.0f);
+    // The spread share's 6-bit code in bits 18-23.
+    EXPECT_EQ((l.directionAndGreen >> 18) & 0x3Fu, encodeSpreadShare(0.5f));
+    EXPECT_EQ((gpu::packRtpLink({1, 1.0f, 0, 0.1f}, 0, 0, encodeSpreadShare(1.0f), 1.0f)
+                   .directionAndGreen >> 18) & 0x3Fu,
+              kSpreadShareSteps);
+    // The direction as 2 × snorm9, decoded as shaders/lib/sh.glsl decodeOctahedral9 does.
+    const auto snorm9 = [](uint32_t bits) {
+        return std::max(float(int32_t(bits << 23) >> 23) / 255.0f, -1.0f);
     };
     const uint32_t oct = l.directionAndGreen;
-    const float u = snorm12(oct & 0xFFFu), v = snorm12((oct >> 12) & 0xFFFu);
+    const float u = snorm9(oct & 0x1FFu), v = snorm9((oct >> 9) & 0x1FFu);
     glm::vec3 decoded(u, v, 1.0f - std::abs(u) - std::abs(v));
     if (decoded.z < 0.0f)
         decoded = {(1.0f - std::abs(v)) * (u >= 0.0f ? 1.0f : -1.0f),
                    (1.0f - std::abs(u)) * (v >= 0.0f ? 1.0f : -1.0f), decoded.z};
-    EXPECT_GT(glm::dot(glm::normalize(decoded), direction), std::cos(0.05f * kPi / 180.0f));
+    EXPECT_GT(glm::dot(glm::normalize(decoded), direction), std::cos(0.4f * kPi / 180.0f));
     // A link too faint for binary16 keeps its smallest step instead of reading as padding;
     // padding (factor 0) stays 0; V saturates at 65504.
     EXPECT_EQ(pack(1e-9f, 0.1f).visibleAndCone & 0xFFFFu, 1u);

@@ -91,21 +91,43 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
     ASSERT_TRUE(light) << light.error().message;
     pullFlux(b.bake, nodes);
     std::vector<glm::mat3> moment(nodes.size()), slopes(nodes.size());
-    std::vector<glm::vec3> centre(nodes.size());
-    pullFluxSpread(b.bake, nodeSpread(b.bake), nodes, moment, centre, slopes);
-    size_t sloped = 0;
+    std::vector<glm::vec3> centre(nodes.size()), concentration(nodes.size());
+    std::vector<uint8_t> exponential(nodes.size());
+    pullFluxSpread(b.bake, nodeSpread(b.bake), nodes, moment, centre, slopes, concentration,
+                   exponential);
+    size_t sloped = 0, exponentials = 0;
     for (size_t n = nS; n < nodes.size(); ++n) {
-        const glm::mat3 got = gpu::unpackNodeSlopes(glm::uvec3((*light)[n]));
+        glm::mat3 got;
+        glm::vec3 gotConcentration;
+        const bool gotExponential =
+            gpu::unpackNodeSpread(glm::uvec3((*light)[n]), got, gotConcentration);
+        ASSERT_EQ(gotExponential, exponential[n] != 0) << "node " << n;
+        exponentials += exponential[n];
         float largest = 0.0f;
         for (int c = 0; c < 3; ++c) {
             for (int k = 0; k < 3; ++k) {
                 largest = std::max(largest, std::abs(slopes[n][c][k]));
+                if (gotExponential) {
+                    // snorm8 of slope / 3 to nearest: within half a step, and float rounding.
+                    ASSERT_NEAR(got[c][k], slopes[n][c][k],
+                                0.5f * gpu::kExponentialSpreadCap / 127.0f + 1e-4f)
+                        << "node " << n << " channel " << c << " axis " << k;
+                    continue;
+                }
                 // snorm8 towards zero: less than a step of 1/127 smaller in magnitude.
                 ASSERT_LE(std::abs(got[c][k]), std::abs(slopes[n][c][k]) + 1e-5f);
                 ASSERT_NEAR(got[c][k], slopes[n][c][k], 1.0f / 127.0f + 1e-5f)
                     << "node " << n << " channel " << c << " axis " << k;
             }
-            ASSERT_LE(std::abs(got[c].x) + std::abs(got[c].y) + std::abs(got[c].z), 1.0f + 1e-6f);
+            const float sum = std::abs(got[c].x) + std::abs(got[c].y) + std::abs(got[c].z);
+            if (gotExponential) {
+                ASSERT_LE(sum, gpu::kExponentialSpreadCap + 0.05f);
+                // unorm7 over [0, 4]: within half a step.
+                ASSERT_NEAR(gotConcentration[c], concentration[n][c],
+                            0.5f * gpu::kConcentrationRange / 127.0f + 1e-4f);
+            } else {
+                ASSERT_LE(sum, 1.0f + 1e-6f);
+            }
         }
         if (largest > 0.1f) ++sloped;
         // RGBE8: within 2^-8 of the largest channel, and float rounding besides.
@@ -119,6 +141,8 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
     // Slopes of 0.1 and more in a good share of the nodes (about half with the bake's flux
     // weights today; the limiter cuts the rest): the comparison above is not of zeros.
     EXPECT_GT(sloped, (nodes.size() - nS) / 4);
+    // The noise makes some small nodes' fits go negative: exponential nodes are compared too.
+    EXPECT_GT(exponentials, 0u);
 }
 
 }  // namespace
