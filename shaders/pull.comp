@@ -125,7 +125,13 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
         moments[c] = m;
         centre[c] = limitedSpread(inner, flux[c], m, slopes[c], limited);
     }
-    // Where the limiter acts in any channel, the node's spread is exponential in all three.
+    // Where the limiter acts in any channel of a flat node, its spread is exponential in all
+    // three (render/cpu/pull.cpp isFlat).
+    vec3 variance = vec3(0.0);
+    [[unroll]] for (int k = 0; k < 3; ++k)
+        if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
+    limited = limited && min(variance.x, min(variance.y, variance.z)) <=
+                             kFlatVariance * (variance.x + variance.y + variance.z);
     if (limited)
         for (int c = 0; c < 3; ++c)
             centre[c] = exponentialSpread(inner, flux[c], moments[c], slopes[c], concentration[c]);

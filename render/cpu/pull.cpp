@@ -147,6 +147,14 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
     return out;
 }
 
+bool isFlat(const NodeSpread& spread, size_t node) {
+    glm::vec3 variance(0.0f);
+    for (int k = 0; k < 3; ++k)
+        if (spread.inverseVariance[node][k] > 0.0f) variance[k] = 1.0f / spread.inverseVariance[node][k];
+    const float total = variance.x + variance.y + variance.z;
+    return std::min({variance.x, variance.y, variance.z}) <= gpu::kFlatVariance * total;
+}
+
 float inverseLangevin(float r) {
     const float a = std::min(std::abs(r), 0.99f);
     const float x = a * (3.0f - 2.6f * a + 0.7f * a * a) / ((1.0f - a) * (1.0f + 0.1f * a));
@@ -227,8 +235,8 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     limited = limited || channel.limited;
                 }
                 concentration[n] = glm::vec3(0.0f);
-                exponential[n] = limited ? 1 : 0;
-                if (!limited) return;
+                exponential[n] = limited && isFlat(spread, n) ? 1 : 0;
+                if (!exponential[n]) return;
                 for (int c = 0; c < 3; ++c) {
                     const ExponentialSpread channel = exponentialSpread(spread, n, nodeFlux[n][c], m[c]);
                     centreFlux[n][c] = channel.centre;

@@ -266,18 +266,25 @@ TEST(Pull, ExponentialSpreadMatchesTheMomentOfAnEvenlySpreadNode) {
 }
 
 TEST(Pull, SlopesStayBoundedForAnyFlux) {
-    // Random non-negative flux on a 3-D cloud of surfels: every linear node's every channel
-    // keeps Σ|slopes| ≤ 1, so no point of its box reads negative flux, and every exponential
-    // one Σ|slopes| ≤ 3.
+    // Random non-negative flux on a 3-D cloud of surfels and on the same cloud flattened:
+    // every linear node's every channel keeps Σ|slopes| ≤ 1, so no point of its box reads
+    // negative flux, and every exponential one (flat nodes only) Σ|slopes| ≤ 3.
     BakeData bake = lineBake();
     uint32_t state = 12345u;
     const auto next = [&] {
         state = state * 1664525u + 1013904223u;
         return float(state >> 8) / float(1u << 24);
     };
-    for (Surfel& s : bake.surfels) s.position = {3.0f * next(), next(), 0.2f * next()};
-    const NodeSpread spread = nodeSpread(bake);
+    for (Surfel& s : bake.surfels) s.position = {3.0f * next(), next(), next()};
+    const NodeSpread cloud = nodeSpread(bake);
+    // And the same cloud flattened, whose limited nodes spread exponentially.
+    for (Surfel& s : bake.surfels) s.position.z = 0.0f;
+    const NodeSpread flat = nodeSpread(bake);
+    EXPECT_FALSE(isFlat(cloud, 6));
+    EXPECT_TRUE(isFlat(flat, 6));
+    size_t exponentials = 0;
     for (int trial = 0; trial < 200; ++trial) {
+        const NodeSpread& spread = trial % 2 ? flat : cloud;
         std::vector<glm::vec3> flux(7);
         for (uint32_t x = 0; x < 4; ++x) {
             const float bright = next() < 0.3f ? 100.0f : 1.0f;
@@ -298,8 +305,13 @@ TEST(Pull, SlopesStayBoundedForAnyFlux) {
                 if (!s.exponential[n]) {
                     EXPECT_EQ(s.concentration[n][c], 0.0f);
                 }
+                if (trial % 2 == 0 && n == 6) {
+                    EXPECT_EQ(s.exponential[n], 0);  // four points off a plane: not flat
+                }
+                exponentials += s.exponential[n];
             }
     }
+    EXPECT_GT(exponentials, 0u);
 }
 
 TEST(Pull, BoxPointsRoundTripWithinOneStep) {

@@ -75,8 +75,9 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
     ASSERT_TRUE(b.ok);
     auto gpu = test::gpuFor(b);
     ASSERT_TRUE(gpu);
-    // Flux that grows along x, with a different slope per channel, plus noise: every inner
-    // node has a spread to find.
+    // Flux that grows along x, with a different slope per channel, plus noise, and one surfel
+    // in six 20 times as bright: every inner node has a spread to find, and the nodes where a
+    // bright surfel limits the line spread exponentially.
     const size_t nS = b.bake.surfels.size();
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(0.0f, 0.5f);
@@ -84,6 +85,7 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
     for (size_t i = 0; i < nS; ++i) {
         const float x = b.bake.surfels[i].position.x;
         nodes[i] = glm::vec3(2.0f + x, 2.0f - x, 1.0f) + glm::vec3(u(rng), u(rng), u(rng));
+        if (i % 6 == 0) nodes[i] *= 20.0f;
     }
     auto pulled = gpu->runPull(std::span<const glm::vec3>(nodes.data(), nS));
     ASSERT_TRUE(pulled) << pulled.error().message;
@@ -141,7 +143,7 @@ TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
     // Slopes of 0.1 and more in a good share of the nodes (about half with the bake's flux
     // weights today; the limiter cuts the rest): the comparison above is not of zeros.
     EXPECT_GT(sloped, (nodes.size() - nS) / 4);
-    // The noise makes some small nodes' fits go negative: exponential nodes are compared too.
+    // The bright surfels limit some flat nodes' lines: exponential nodes are compared too.
     EXPECT_GT(exponentials, 0u);
 }
 
