@@ -39,8 +39,9 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread);
 /// centre ∘ the slopes along axis k), so that a link at box point u reads centre + spread·u.
 /// An exponential node holds, per RGB channel, its spread's centre, slopes (column k: the RGB
 /// slopes along axis k) and ln Z, so that a link at u with spread share ρ reads
-/// centre ∘ exp(spread·u − (1 − ρ)·concentration).
-struct NodeLight {
+/// centre ∘ exp(spread·u − (1 − ρ)·concentration). One cache line each: links fetch their
+/// nodes scattered.
+struct alignas(64) NodeLight {
     glm::vec3 centre{0.0f};
     glm::mat3 spread{0.0f};
     glm::vec3 concentration{0.0f};
