@@ -128,6 +128,19 @@ TEST(CacheLighting, RtpLinkProjectsTheNodeConeWithYCoCgBandSplit) {
     }
 }
 
+/// oneCacheBake with lY = lC = 2 and one link to node 0: an RTP cone towards +y, or four SH
+/// coefficients.
+BakeData oneLinkBake(LinkMode mode) {
+    BakeData bake = oneCacheBake(mode, 2, 2, 1, 1);
+    if (mode == LinkMode::Rtp) {
+        bake.links.rtp[0] = RtpLink{0, 0.5f, encodeOctahedral(glm::vec3(0, 1, 0)), 0.2f};
+    } else {
+        const float c[4] = {0.5f, 0.25f, -0.125f, 0.75f};
+        for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
+    }
+    return bake;
+}
+
 TEST(CacheLighting, ALinksTintMultipliesItsNodesFluxPerChannel) {
     // The same link with and without a tint (bake/link_generation.h): every RGB coefficient of
     // the tinted cache is the neutral one's times the tint, in both link forms.
@@ -135,13 +148,7 @@ TEST(CacheLighting, ALinksTintMultipliesItsNodesFluxPerChannel) {
     const uint32_t code = encodeLinkTint(tint).code;
     const glm::vec3 decoded = decodeLinkTint(code);
     for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
-        BakeData bake = oneCacheBake(mode, 2, 2, 1, 1);
-        if (mode == LinkMode::Rtp) {
-            bake.links.rtp[0] = RtpLink{0, 0.5f, encodeOctahedral(glm::vec3(0, 1, 0)), 0.2f};
-        } else {
-            const float c[4] = {0.5f, 0.25f, -0.125f, 0.75f};
-            for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
-        }
+        BakeData bake = oneLinkBake(mode);
         const std::vector<glm::vec3> nodeFlux = {glm::vec3(3.0f, 2.0f, 1.0f)};
         CacheValues neutral, tinted;
         lightCaches(bake, nodeFlux, neutral);
@@ -169,13 +176,7 @@ TEST(CacheLighting, AnExponentialNodeIsReadAtTheLinksPointAndSpreadShare) {
     slopes[2] = {0.0f, 0.0f, 3.0f};
     for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
         for (const uint32_t tint : {kNeutralLinkTint, encodeLinkTint({0.25f, 1.0f, 0.5f}).code}) {
-            BakeData bake = oneCacheBake(mode, 2, 2, 1, 1);
-            if (mode == LinkMode::Rtp) {
-                bake.links.rtp[0] = RtpLink{0, 0.5f, encodeOctahedral(glm::vec3(0, 1, 0)), 0.2f};
-            } else {
-                const float c[4] = {0.5f, 0.25f, -0.125f, 0.75f};
-                for (int i = 0; i < 4; ++i) bake.links.shCoefficients[i] = floatToHalf(c[i]);
-            }
+            BakeData bake = oneLinkBake(mode);
             bake.links.tint[0] = tint;
             bake.links.spreadShare[0] = encodeSpreadShare(0.25f);
             LinkTable table = unpackLinks(bake, nodeSpread(bake));
