@@ -53,10 +53,10 @@ vec3 decodeLinkTint(uint code) {
     return vec3(uvec3(code, code >> 10u, code >> 20u) & 0x3FFu) * (1.0 / 1023.0);
 }
 
-/// The YCoCg radiance a link carries: its node's spread at the link's box point u (shared/pull.h),
-/// radiance·(1 + slopes·u) per channel (≥ 0 for u in the box) for a linear node,
-/// radiance·exp(slopes·u − (1 − v)·ln Z) for an exponential one, the link seeing share v of
-/// it; times its tint.
+/// The YCoCg radiance a link carries: its node's spread at the link's box point u
+/// (shared/pull.h), radiance·(1 + slopes·u) per channel (≥ 0 for u in the box) for a linear
+/// node, radiance·exp(slopes·u − (1 − ρ)·ln Z) for an exponential one, ρ the link's spread
+/// share (concentrationWeight = 1 − ρ); times its tint.
 vec3 linkRadiance(uint node, vec3 tint, uint point, float concentrationWeight) {
     const uvec4 light = texelFetch(nodeLight, int(node));
     const vec3 u = unpackSnorm4x8(point).xyz;
@@ -116,8 +116,8 @@ void addLink(uint slot) {
         // two per word, scaled by π·A at upload to take the node's radiance; chroma takes the
         // first lC².
         if (words[0] == kNoNode) return;
-        const vec3 radiance =
-            linkRadiance(words[0], decodeLinkTint(words[1]), words[2], concentrationWeightOf(words[2] >> 24u));
+        const vec3 radiance = linkRadiance(words[0], decodeLinkTint(words[1]), words[2],
+                                           concentrationWeightOf(words[2] >> 24u));
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
             const vec2 pair = unpackHalf2x16(words[3u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {

@@ -1,8 +1,9 @@
 #version 460
 // Pull (paper 000 Figure 2 step 3, §4.1): every node of one level gets the sum of its two
 // children's flux and the flux's first moment about its centroid, and writes its light for
-// cache lighting: its flux's limited linear spread, the radiance at its box centre as RGBE8
-// (§4.7) and the slopes along the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
+// cache lighting: its flux's limited linear spread (or, for a flat node the limiter acts on,
+// its exponential spread), the radiance at its box centre as RGBE8 (§4.7) and the slopes along
+// the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
 // levels in one workgroup. CPU twin: render/cpu/pull.cpp.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -130,12 +131,12 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
     vec3 variance = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k)
         if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
-    limited = limited && min(variance.x, min(variance.y, variance.z)) <=
-                             kFlatVariance * (variance.x + variance.y + variance.z);
-    if (limited)
+    const bool exponential = limited && min(variance.x, min(variance.y, variance.z)) <=
+                                            kFlatVariance * (variance.x + variance.y + variance.z);
+    if (exponential)
         for (int c = 0; c < 3; ++c)
             centre[c] = exponentialSpread(inner, flux[c], moments[c], slopes[c], concentration[c]);
-    nodeLight[node] = uvec4(packSpread(slopes[0], slopes[1], slopes[2], concentration, limited),
+    nodeLight[node] = uvec4(packSpread(slopes[0], slopes[1], slopes[2], concentration, exponential),
                             packRgbe8(centre * inner.radianceScale));
 }
 
