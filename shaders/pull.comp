@@ -1,9 +1,9 @@
 #version 460
 // Pull (paper 000 Figure 2 step 3, §4.1): every node of one level gets the sum of its two
 // children's flux and the flux's first moment about its centroid, and writes its light for
-// cache lighting: its flux's limited linear spread (or, for a flat node the limiter acts on,
-// its exponential spread), the radiance at its box centre as RGBE8 (§4.7) and the slopes along
-// the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
+// cache lighting: its flux's limited linear spread (or, for a flat node whose flux the line
+// cannot hold, its exponential spread), the radiance at its box centre as RGBE8 (§4.7) and the
+// slopes along the box's axes (shared/pull.h). Dispatched level by level, lowest first, then the small upper
 // levels in one workgroup. CPU twin: render/cpu/pull.cpp.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -27,7 +27,7 @@ layout(push_constant) uniform Push { PullPush pc; };
 /// so the spread stays ≥ 0 over the surfels' box; returns the flux at the box centre and sets
 /// the slopes along the axes per half extent, relative to it.
 float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes,
-                    inout bool limited) {
+                    inout bool concentrated) {
     slopes = vec3(0.0);
     if (!(flux > 0.0)) return 0.0;
     const vec3 low = vec3(inner.low0, inner.low1, inner.low2);
@@ -38,8 +38,9 @@ float limitedSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes,
     vec3 change = abs(g * halfExtent);
     const float swing = change.x + change.y + change.z;
     if (swing > atCentre) {
-        limited = true;
-        g *= flux / (swing - dot(g, centre));
+        const float kept = flux / (swing - dot(g, centre));
+        concentrated = concentrated || kept < kExponentialLimit;
+        g *= kept;
         atCentre = flux + dot(g, centre);
     }
     if (!(atCentre > 0.0)) return 0.0;
@@ -117,21 +118,21 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
     const vec3 flux = leftFlux + rightFlux;
     nodeFlux[node] = vec4(flux, 0.0);
     vec3 centre, slopes[3], moments[3], concentration = vec3(0.0);
-    bool limited = false;
+    bool concentrated = false;
     for (int c = 0; c < 3; ++c) {
         vec3 m = leftMoment[c] + rightMoment[c];
         m += leftFlux[c] * inner.leftOffset;
         m += rightFlux[c] * inner.rightOffset;
         nodeMoment[3u * node + uint(c)] = vec4(m, 0.0);
         moments[c] = m;
-        centre[c] = limitedSpread(inner, flux[c], m, slopes[c], limited);
+        centre[c] = limitedSpread(inner, flux[c], m, slopes[c], concentrated);
     }
-    // Where the limiter acts in any channel of a flat node, its spread is exponential in all
-    // three (render/cpu/pull.cpp isFlat).
+    // Where the limiter keeps less than kExponentialLimit of the gradient in any channel of a
+    // flat node, its spread is exponential in all three (render/cpu/pull.cpp isFlat).
     vec3 variance = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k)
         if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
-    const bool exponential = limited && min(variance.x, min(variance.y, variance.z)) <=
+    const bool exponential = concentrated && min(variance.x, min(variance.y, variance.z)) <=
                                             kFlatVariance * (variance.x + variance.y + variance.z);
     if (exponential)
         for (int c = 0; c < 3; ++c)

@@ -134,12 +134,15 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
     glm::vec3 change = glm::abs(g * half);
     const float swing = change.x + change.y + change.z;
     const bool limited = swing > atCentre;
+    float kept = 1.0f;  // the share of g the limiter keeps
     if (limited) {
-        g *= flux / (swing - glm::dot(g, centre));
+        kept = flux / (swing - glm::dot(g, centre));
+        g *= kept;
         atCentre = flux + glm::dot(g, centre);
     }
-    if (!(atCentre > 0.0f)) return {0.0f, glm::vec3(0.0f), limited};
-    ChannelSpread out{atCentre, g * half * (1.0f / atCentre), limited};
+    const bool concentrated = kept < gpu::kExponentialLimit;
+    if (!(atCentre > 0.0f)) return {0.0f, glm::vec3(0.0f), limited, concentrated};
+    ChannelSpread out{atCentre, g * half * (1.0f / atCentre), limited, concentrated};
     // Σ|slopes| ≤ 1 holds up to rounding; keep it exact, so no point of the box reads < 0.
     change = glm::abs(out.slopes);
     const float sum = change.x + change.y + change.z;
@@ -227,15 +230,15 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     for (int c = 0; c < 3; ++c) m[c] += nodeFlux[child][c] * offset;
                 }
                 moment[n] = m;
-                bool limited = false;
+                bool concentrated = false;
                 for (int c = 0; c < 3; ++c) {
                     const ChannelSpread channel = limitedSpread(spread, n, nodeFlux[n][c], m[c]);
                     centreFlux[n][c] = channel.centre;
                     slopes[n][c] = channel.slopes;
-                    limited = limited || channel.limited;
+                    concentrated = concentrated || channel.concentrated;
                 }
                 concentration[n] = glm::vec3(0.0f);
-                exponential[n] = limited && isFlat(spread, n) ? 1 : 0;
+                exponential[n] = concentrated && isFlat(spread, n) ? 1 : 0;
                 if (!exponential[n]) return;
                 for (int c = 0; c < 3; ++c) {
                     const ExponentialSpread channel = exponentialSpread(spread, n, nodeFlux[n][c], m[c]);

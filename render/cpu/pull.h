@@ -34,10 +34,10 @@ void pullFlux(const BakeData& bake, std::span<glm::vec3> nodeFlux);
 /// a cache that sees that end. The visible part's centroid lies among the node's surfels, so
 /// within the box [low, high], and links carry it in box coordinates (encodeBoxPoint).
 ///
-/// Where the limiter acts, light is concentrated in a part of the node (a sun patch, the
-/// corner next to a lamp) and a line cannot follow it: a flat node's spread is exponential
-/// instead (exponentialSpread), Φ_s = ω_s·Φ_n·e^{β·(x_s − x̄_n)} / Z(β), ≥ 0 everywhere and
-/// as peaked as the moment asks. Z is that of a model of the node: along each principal axis
+/// Where the limiter keeps less than half the fitted gradient (gpu::kExponentialLimit), light
+/// is concentrated in a part of the node (a sun patch, the corner next to a lamp) and a line
+/// cannot follow it: a flat node's spread is exponential instead (exponentialSpread),
+/// Φ_s = ω_s·Φ_n·e^{β·(x_s − x̄_n)} / Z(β), ≥ 0 everywhere and as peaked as the moment asks. Z is that of a model of the node: along each principal axis
 /// k its surfels spread evenly over ±a_k, a_k = √3·σ_k (the same variance), so that
 /// Z = Π_k sinh(β_k·a_k) / (β_k·a_k) and the moment fixes each β_k by the inverse Langevin
 /// function, a_k·L(β_k·a_k) = M_k / Φ_n. A link reads the model's mean over the part it sees,
@@ -74,6 +74,7 @@ struct ChannelSpread {
     float centre = 0.0f;     ///< W: Φ_n + g_n·c_n, c_n the box centre about x̄_n
     glm::vec3 slopes{0.0f};  ///< (g_n·axis_k)·halfExtent_k / centre
     bool limited = false;    ///< the limiter scaled g_n down
+    bool concentrated = false;  ///< by more than gpu::kExponentialLimit: the line cannot hold it
 };
 
 /// An exponential spread of one channel (NodeSpread): a point of the box at box coordinates u
@@ -107,8 +108,8 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
 /// From pulled `nodeFlux`: the first moments M_n (`moment`, column c = channel c, W·m; the
 /// leaves' are 0) summed up the hierarchy like the flux, M_n = Σ_children M_k + Φ_k ⊗ (x̄_k −
 /// x̄_n), and every node's spread: `centreFlux` (W per channel; a leaf's own flux) and
-/// `slopes` (column c = channel c's slopes; 0 for leaves). A flat node (isFlat) where the
-/// limiter acts in any channel is exponential in all three (`exponential` 1, its ln Z per
+/// `slopes` (column c = channel c's slopes; 0 for leaves). A flat node (isFlat) whose flux is
+/// concentrated (ChannelSpread::concentrated) in any channel is exponential in all three (`exponential` 1, its ln Z per
 /// channel in `concentration`); the others are linear (`exponential` 0, `concentration` 0).
 void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,

@@ -40,31 +40,37 @@ TEST(Pull, InnerNodesHoldExactSumsOfTheirLeaves) {
     EXPECT_EQ(flux[0], glm::vec3(1.0f, 0.5f, 0.0f));  // leaves untouched
 }
 
-/// Four unit-area surfels at x = 0, 1, 2, 3 under a balanced hierarchy: leaves 0-3,
-/// 4 = (0, 1), 5 = (2, 3), root 6 = (4, 5).
-BakeData lineBake() {
+/// `count` (a power of two) unit-area surfels at x = 0, 1, …, count − 1 under a balanced
+/// hierarchy, level by level: for four, leaves 0-3, 4 = (0, 1), 5 = (2, 3), root 6 = (4, 5).
+BakeData lineBake(uint32_t count = 4) {
     BakeData bake;
-    bake.surfels.resize(4);
-    for (uint32_t s = 0; s < 4; ++s) {
+    bake.surfels.resize(count);
+    for (uint32_t s = 0; s < count; ++s) {
         bake.surfels[s].position = {float(s), 0.0f, 0.0f};
         bake.surfels[s].area = 1.0f;
     }
-    bake.surfelWeights.assign(4, 1.0f);
-    bake.nodes.resize(7);
-    for (uint32_t s = 0; s < 4; ++s) {
+    bake.surfelWeights.assign(count, 1.0f);
+    bake.nodes.resize(2 * count - 1);
+    for (uint32_t s = 0; s < count; ++s) {
         bake.nodes[s].left = bake.nodes[s].right = kNoNode;
         bake.nodes[s].firstSurfel = s;
         bake.nodes[s].surfelCount = 1;
     }
-    const uint32_t children[3][2] = {{0, 1}, {2, 3}, {4, 5}};
-    for (uint32_t k = 0; k < 3; ++k) {
-        Node& node = bake.nodes[4 + k];
-        node.left = children[k][0];
-        node.right = children[k][1];
-        node.firstSurfel = k == 1 ? 2 : 0;
-        node.surfelCount = k == 2 ? 4 : 2;
+    uint32_t first = 0, width = count;  // the level below: nodes [first, first + width)
+    while (width > 1) {
+        const uint32_t begin = first + width;
+        for (uint32_t k = 0; k < width / 2; ++k) {
+            Node& node = bake.nodes[begin + k];
+            node.left = first + 2 * k;
+            node.right = first + 2 * k + 1;
+            node.firstSurfel = bake.nodes[node.left].firstSurfel;
+            node.surfelCount = 2 * bake.nodes[node.left].surfelCount;
+        }
+        first = begin;
+        width /= 2;
+        bake.levelOffsets.push_back(first);
     }
-    bake.levelOffsets = {4, 6, 7};
+    bake.levelOffsets.push_back(2 * count - 1);
     return bake;
 }
 
@@ -162,36 +168,56 @@ TEST(Pull, LimitedLinearSpreadStaysNonNegativeAndKeepsTheTotal) {
 }
 
 TEST(Pull, ConcentratedFluxSpreadsExponentially) {
-    // The same flux through pullFluxSpread: the root's limiter acts, so the root is
-    // exponential, and its reads follow the peak the line could not.
-    const BakeData bake = lineBake();
-    std::vector<glm::vec3> flux(7, glm::vec3(0.0f));
-    flux[3] = glm::vec3(1.0f, 0.0f, 1.0f);  // nothing in green
+    // All flux on the last of eight surfels: the fitted line would fall to 1 − 6/9·3.5 < −1
+    // at x = 0, so the limiter keeps 3/7 of it, less than kExponentialLimit, and the root,
+    // flat, spreads exponentially; its reads follow the peak the line could not.
+    const BakeData bake = lineBake(8);
+    const uint32_t root = 14, lit = 7;
+    std::vector<glm::vec3> flux(15, glm::vec3(0.0f));
+    flux[lit] = glm::vec3(1.0f, 0.0f, 1.0f);  // nothing in green
     pullFlux(bake, flux);
     const NodeSpread spread = nodeSpread(bake);
     const Spreads s = pulledSpreads(bake, spread, flux);
-    ASSERT_EQ(s.exponential[6], 1);
-    EXPECT_EQ(s.exponential[4], 0);  // no flux: nothing to limit
+    ASSERT_EQ(s.exponential[root], 1);
+    EXPECT_EQ(s.exponential[8], 0);  // surfels 0 and 1, no flux: nothing to limit
     // Green holds no flux and reads none.
-    EXPECT_EQ(s.centre[6].g, 0.0f);
-    EXPECT_EQ(spreadFlux(spread, s, 6, 3.0f, 0.25f, 1), 0.0f);
-    // A link that sees the whole node evenly (spread share 1, centroid at x̄ = 1.5) reads Φ.
-    EXPECT_NEAR(spreadFlux(spread, s, 6, 1.5f, 1.0f, 0, 1.0f), 1.0f, 1e-5f);
+    EXPECT_EQ(s.centre[root].g, 0.0f);
+    EXPECT_EQ(spreadFlux(spread, s, root, float(lit), 0.125f, 1), 0.0f);
+    // A link that sees the whole node evenly (spread share 1, centroid at x̄ = 3.5) reads Φ.
+    EXPECT_NEAR(spreadFlux(spread, s, root, 3.5f, 1.0f, 0, 1.0f), 1.0f, 1e-5f);
     // Each surfel seen alone (spread share 0): positive, rising towards the light, the lit one
-    // close to its whole flux (the limited line gave it 0.5) and the parts' sum close to Φ.
+    // with more than half of the flux (the limited line gives it 7/28 = 0.25) and the parts'
+    // sum close to Φ.
     float total = 0.0f, previous = 0.0f;
-    for (uint32_t x = 0; x < 4; ++x) {
-        const float part = spreadFlux(spread, s, 6, float(x), 0.25f, 0);
+    for (uint32_t x = 0; x < 8; ++x) {
+        const float part = spreadFlux(spread, s, root, float(x), 0.125f, 0);
         EXPECT_GT(part, previous) << "surfel " << x;
         previous = part;
         total += part;
     }
-    EXPECT_GT(spreadFlux(spread, s, 6, 3.0f, 0.25f, 0), 0.75f);
+    EXPECT_GT(spreadFlux(spread, s, root, float(lit), 0.125f, 0), 0.5f);
     EXPECT_NEAR(total, 1.0f, 0.1f);
     // The cap: Σ|slopes| ≤ 3, so the far end reads at least e^−6 of the near end.
-    const glm::vec3 slopes = s.slopes[6][0];
+    const glm::vec3 slopes = s.slopes[root][0];
     EXPECT_LE(std::abs(slopes.x) + std::abs(slopes.y) + std::abs(slopes.z),
               gpu::kExponentialSpreadCap + 1e-5f);
+}
+
+TEST(Pull, ALightlyLimitedNodeKeepsItsLine) {
+    // All flux on the last of four surfels: the limiter keeps 5/9 of the fitted gradient,
+    // more than kExponentialLimit, so the root stays linear (its reads 0, 1/6, 1/3, 1/2 as in
+    // LimitedLinearSpreadStaysNonNegativeAndKeepsTheTotal).
+    const BakeData bake = lineBake();
+    const NodeSpread spread = nodeSpread(bake);
+    const ChannelSpread channel = limitedSpread(spread, 6, 1.0f, glm::vec3(1.5f, 0.0f, 0.0f));
+    EXPECT_TRUE(channel.limited);
+    EXPECT_FALSE(channel.concentrated);
+    std::vector<glm::vec3> flux(7, glm::vec3(0.0f));
+    flux[3] = glm::vec3(1.0f);
+    pullFlux(bake, flux);
+    const Spreads s = pulledSpreads(bake, spread, flux);
+    EXPECT_EQ(s.exponential[6], 0);
+    EXPECT_NEAR(spreadFlux(spread, s, 6, 3.0f, 0.25f, 0), 0.5f, 1e-5f);
 }
 
 TEST(Pull, InverseLangevinInvertsTheMeanOfATiltedInterval) {
