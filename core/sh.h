@@ -87,9 +87,10 @@ inline constexpr LegendreTables makeLegendreTables() {
 
 inline constexpr LegendreTables kLegendre = makeLegendreTables();
 
-/// Writes Q_L^M times the azimuthal factors: y_L^M, and y_L^-M for M > 0.
-template <int L, int M>
-inline void storeBasis(float q, float cosTerm, float sinTerm, float* out) {
+/// Writes Q_L^M times the azimuthal factors: y_L^M, and y_L^-M for M > 0. T is float, or a
+/// vector of floats (GCC vector extensions) for kernels that evaluate several directions at once.
+template <int L, int M, class T>
+inline void storeBasis(T q, T cosTerm, T sinTerm, T* out) {
     if constexpr (M == 0) {
         out[shIndex(L, 0)] = q;
     } else {
@@ -100,13 +101,12 @@ inline void storeBasis(float q, float cosTerm, float sinTerm, float* out) {
 
 /// Order M, bands L .. Bands-1, by the upward recurrence from current = Q_{L-1}^M and
 /// previous = Q_{L-2}^M. Compile-time indices turn every table entry into an immediate.
-template <int Bands, int M, int L>
-inline void evaluateColumn(float z, float current, float previous, float cosTerm, float sinTerm,
-                           float* out) {
+template <int Bands, int M, int L, class T>
+inline void evaluateColumn(T z, T current, T previous, T cosTerm, T sinTerm, T* out) {
     if constexpr (L < Bands) {
         constexpr float a = kLegendre.a[L][M];
         constexpr float b = kLegendre.b[L][M];
-        const float next = a * z * current - b * previous;
+        const T next = a * z * current - b * previous;
         storeBasis<L, M>(next, cosTerm, sinTerm, out);
         evaluateColumn<Bands, M, L + 1>(z, next, current, cosTerm, sinTerm, out);
     }
@@ -114,14 +114,14 @@ inline void evaluateColumn(float z, float current, float previous, float cosTerm
 
 /// Orders M .. Bands-1; (cosTerm, sinTerm) = Re, Im of (x + iy)^M = sin^M θ (cos Mφ, sin Mφ),
 /// advanced by one complex product per order.
-template <int Bands, int M>
-inline void evaluateOrders(const glm::vec3& d, float cosTerm, float sinTerm, float* out) {
+template <int Bands, int M, class T>
+inline void evaluateOrders(T x, T y, T z, T cosTerm, T sinTerm, T* out) {
     if constexpr (M < Bands) {
-        constexpr float diagonal = kLegendre.diagonal[M];
+        const T diagonal = T{} + kLegendre.diagonal[M];
         storeBasis<M, M>(diagonal, cosTerm, sinTerm, out);
-        evaluateColumn<Bands, M, M + 1>(d.z, diagonal, 0.0f, cosTerm, sinTerm, out);
-        evaluateOrders<Bands, M + 1>(d, cosTerm * d.x - sinTerm * d.y,
-                                     cosTerm * d.y + sinTerm * d.x, out);
+        evaluateColumn<Bands, M, M + 1>(z, diagonal, T{}, cosTerm, sinTerm, out);
+        evaluateOrders<Bands, M + 1>(x, y, z, cosTerm * x - sinTerm * y, cosTerm * y + sinTerm * x,
+                                     out);
     }
 }
 
@@ -132,7 +132,15 @@ inline void evaluateOrders(const glm::vec3& d, float cosTerm, float sinTerm, flo
 template <int Bands>
 inline void shEvaluateFixed(const glm::vec3& direction, float* out) {
     static_assert(Bands >= 0 && Bands <= kMaxShBands);
-    detail::evaluateOrders<Bands, 0>(direction, 1.0f, 0.0f, out);
+    detail::evaluateOrders<Bands, 0>(direction.x, direction.y, direction.z, 1.0f, 0.0f, out);
+}
+
+/// shEvaluateFixed of several directions at once, T a vector of floats (GCC vector extensions)
+/// holding one direction per lane in (x, y, z): out[i] holds basis value i of every lane.
+template <int Bands, class T>
+inline void shEvaluateLanes(T x, T y, T z, T* out) {
+    static_assert(Bands >= 0 && Bands <= kMaxShBands);
+    detail::evaluateOrders<Bands, 0>(x, y, z, T{} + 1.0f, T{}, out);
 }
 
 /// The constants of shEvaluate's recurrence, for GPU shaders that evaluate the same basis:

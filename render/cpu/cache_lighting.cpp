@@ -24,6 +24,18 @@ constexpr size_t kCacheGrain = 16;
 /// How many links ahead cache lighting prefetches a link's node light.
 constexpr size_t kPrefetchLinks = 8;
 
+/// Runtime-projected links are summed kLinkLanes at a time, as one vector of floats (GCC
+/// vector extensions: one SSE register, which baseline x86-64 has), in blocks of kLinkBlock.
+constexpr size_t kLinkLanes = 4;
+constexpr size_t kLinkBlock = 64;
+using LinkLanes = float __attribute__((vector_size(kLinkLanes * sizeof(float))));
+
+inline LinkLanes loadLanes(const float* values) {
+    LinkLanes lanes;
+    std::memcpy(&lanes, values, sizeof(lanes));
+    return lanes;
+}
+
 /// Every binary16 pattern as float. The GPU reads half links natively; on the CPU one 256 KiB
 /// table lookup per coefficient is cheaper than converting bits in the inner loop.
 const float* halfTable() {
@@ -169,41 +181,70 @@ void lightCachesSh(const BakeData& bake, std::span<const NodeLight> light, const
 }
 
 /// Eq. 3 with runtime-projected links (§4.6): L = Σ Φ_node · tint · factor · K_l(α) ·
-/// y_lm(direction).
+/// y_lm(direction). In blocks of a cache's links: first each link's flux, scalar (its node is
+/// scattered and may be exponential), then the basis and the sums kLinkLanes links at a time.
 template <int BandsY>
 void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
                     CacheValues& out) {
+    constexpr int countY = shCount(BandsY);
     const int bandsC = int(out.bandsC);
     const LinkSet& links = bake.links;
-    const size_t nL = links.linksPerCache;
+    const size_t nL = links.linksPerCache, nLinks = links.rtp.size();
     parallelFor(
         0, bake.caches.size(),
         [&, bandsC](size_t c) {
-            CacheSh<BandsY> sh;
-            std::array<float, shCount(BandsY)> basis;
+            alignas(32) std::array<std::array<float, kLinkBlock>, 3> flux;  // Y, Co, Cg
+            LinkLanes sumY[countY] = {}, sumCo[countY] = {}, sumCg[countY] = {};
             const size_t end = (c + 1) * nL;
-            for (size_t slot = c * nL; slot < end; ++slot) {
-                // The nodes are scattered: fetch a later link's ahead of its use.
-                if (slot + kPrefetchLinks < end)
-                    __builtin_prefetch(&light[links.rtp[slot + kPrefetchLinks].node]);
-                const float* w = table.weights.data() + slot * BandsY;
-                // Padding links (factor 0, zero weights) would add exact zeros: skip their basis.
-                if (w[0] == 0.0f) continue;
-                const glm::vec3 flux = linkFlux(light[links.rtp[slot].node], links.tint[slot],
-                                                table.points[slot], table.concentrationWeight[slot]);
-                shEvaluateFixed<BandsY>(table.directions[slot], basis.data());
-                for (int l = 0; l < BandsY; ++l) {
-                    const float fluxY = flux.x * w[l];
-                    for (int i = l * l; i < (l + 1) * (l + 1); ++i) sh.y[i] += fluxY * basis[i];
-                    if (l < bandsC) {
-                        const float fluxCo = flux.y * w[l], fluxCg = flux.z * w[l];
-                        for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
-                            sh.co[i] += fluxCo * basis[i];
-                            sh.cg[i] += fluxCg * basis[i];
+            for (size_t begin = c * nL; begin < end; begin += kLinkBlock) {
+                const size_t count = std::min(kLinkBlock, end - begin);
+                for (size_t j = 0; j < count; ++j) {
+                    const size_t slot = begin + j;
+                    // The nodes are scattered: fetch a later link's ahead of its use.
+                    if (slot + kPrefetchLinks < end)
+                        __builtin_prefetch(&light[links.rtp[slot + kPrefetchLinks].node]);
+                    // Padding links (factor 0, zero weights) read no node.
+                    const glm::vec3 f =
+                        table.weights[slot] == 0.0f
+                            ? glm::vec3(0.0f)
+                            : linkFlux(light[links.rtp[slot].node], links.tint[slot],
+                                       table.points[slot], table.concentrationWeight[slot]);
+                    flux[0][j] = f.x, flux[1][j] = f.y, flux[2][j] = f.z;
+                }
+                // The last lanes of a short block take the next links' directions and weights
+                // (the table holds kLinkLanes more) with no flux: they add exact zeros.
+                std::fill_n(flux[0].begin() + count, kLinkBlock - count, 0.0f);
+                std::fill_n(flux[1].begin() + count, kLinkBlock - count, 0.0f);
+                std::fill_n(flux[2].begin() + count, kLinkBlock - count, 0.0f);
+                for (size_t j = 0; j < count; j += kLinkLanes) {
+                    const size_t slot = begin + j;
+                    LinkLanes basis[countY];
+                    shEvaluateLanes<BandsY>(loadLanes(&table.directions[0][slot]),
+                                            loadLanes(&table.directions[1][slot]),
+                                            loadLanes(&table.directions[2][slot]), basis);
+                    const LinkLanes fluxY = loadLanes(&flux[0][j]), fluxCo = loadLanes(&flux[1][j]),
+                                    fluxCg = loadLanes(&flux[2][j]);
+                    for (int l = 0; l < BandsY; ++l) {
+                        const LinkLanes w = loadLanes(&table.weights[size_t(l) * nLinks + slot]);
+                        const LinkLanes y = fluxY * w;
+                        for (int i = l * l; i < (l + 1) * (l + 1); ++i) sumY[i] += y * basis[i];
+                        if (l < bandsC) {
+                            const LinkLanes co = fluxCo * w, cg = fluxCg * w;
+                            for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
+                                sumCo[i] += co * basis[i];
+                                sumCg[i] += cg * basis[i];
+                            }
                         }
                     }
                 }
             }
+            CacheSh<BandsY> sh;
+            for (int i = 0; i < countY; ++i)
+                for (size_t k = 0; k < kLinkLanes; ++k) {
+                    sh.y[i] += sumY[i][k];
+                    sh.co[i] += sumCo[i][k];
+                    sh.cg[i] += sumCg[i][k];
+                }
             sh.store(c, shCount(bandsC), out);
         },
         kCacheGrain);
@@ -237,17 +278,21 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
         },
         4096);
     if (!rtp) return table;
-    table.directions.resize(links.rtp.size());
-    table.weights.resize(links.rtp.size() * bandsY);
+    // SoA, so that kLinkLanes links load as one vector each; kLinkLanes more past the end for
+    // the last cache's short block, zero.
+    const size_t nLinks = links.rtp.size();
+    for (auto& component : table.directions) component.assign(nLinks + kLinkLanes, 0.0f);
+    table.weights.assign(bandsY * nLinks + kLinkLanes, 0.0f);
     parallelFor(
-        0, links.rtp.size(),
+        0, nLinks,
         [&](size_t slot) {
             const RtpLink& link = links.rtp[slot];
-            table.directions[slot] = decodeOctahedral(link.directionOct);
+            const glm::vec3 direction = decodeOctahedral(link.directionOct);
+            for (int k = 0; k < 3; ++k) table.directions[k][slot] = direction[k];
             std::array<double, kMaxShBands> cone;
             coneZonalBands(int(bandsY), double(link.oneMinusCosAlpha), cone.data());
             for (uint32_t l = 0; l < bandsY; ++l)
-                table.weights[slot * bandsY + l] = float(double(link.factor) * cone[l]);
+                table.weights[l * nLinks + slot] = float(double(link.factor) * cone[l]);
         },
         1024);
     return table;
@@ -300,7 +345,7 @@ void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const L
         });
     } else {
         PIC_CHECK_EQ(bake.links.rtp.size(), nLinks);
-        PIC_CHECK_EQ(table.directions.size(), nLinks);
+        PIC_CHECK_EQ(table.directions[0].size(), nLinks + kLinkLanes);
         withBands(bandsY, [&](auto bands) {
             lightCachesRtp<decltype(bands)::value>(bake, light, table, out);
         });

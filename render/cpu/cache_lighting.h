@@ -3,6 +3,7 @@
 /// radiance of every cache as the sum over its nL links of node flux × transport, in YCoCg with
 /// lY bands for Y and lC ≤ lY bands for Co and Cg.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -26,8 +27,11 @@ struct LinkTable {
                                         ///< link's node (render/cpu/pull.h encodeBoxPoint)
     std::vector<float> concentrationWeight;  ///< nC·nL: 1 − the link's spread share
                                              ///< (LinkSet::spreadShare)
-    std::vector<glm::vec3> directions;  ///< RTP: nC·nL unit directions cache → node
-    std::vector<float> weights;  ///< RTP: nC·nL·lY band weights factor·K_l(α); 0 for padding
+    /// RTP: the unit directions cache → node, x, y and z each nC·nL (and a few zeros past the
+    /// end, as `weights`), link-minor so that consecutive links load as one vector.
+    std::array<std::vector<float>, 3> directions;
+    /// RTP: band weights factor·K_l(α) of link j in band l at l·nC·nL + j; 0 for padding.
+    std::vector<float> weights;
 };
 
 /// Unpacks the links of `bake` for its lY bands, their offsets in the boxes of `spread`
