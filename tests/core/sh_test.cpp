@@ -185,6 +185,26 @@ TEST(ShBasis, FewerBandsArePrefixOfMoreBands) {
     }
 }
 
+TEST(ShBasis, LanesEvaluateEachDirectionAsTheScalarBasis) {
+    // Four directions in the lanes of one vector (as the CPU twin's cache lighting evaluates
+    // them): every lane holds its own direction's basis, as shEvaluate gives it.
+    using Lanes = float __attribute__((vector_size(4 * sizeof(float))));
+    const std::array<glm::vec3, 4> d = {
+        glm::normalize(glm::vec3(-0.2f, 0.9f, 0.3f)), glm::vec3(0.0f, 0.0f, -1.0f),
+        glm::normalize(glm::vec3(0.7f, -0.1f, 0.7f)), glm::normalize(glm::vec3(-1.0f, -2.0f, 0.5f))};
+    Lanes x, y, z;
+    for (int k = 0; k < 4; ++k) x[k] = d[k].x, y[k] = d[k].y, z[k] = d[k].z;
+    std::array<Lanes, kMaxCount> lanes;
+    shEvaluateLanes<kMaxShBands>(x, y, z, lanes.data());
+    for (int k = 0; k < 4; ++k) {
+        std::array<float, kMaxCount> scalar;
+        shEvaluate(kMaxShBands, d[k], scalar.data());
+        for (int i = 0; i < kMaxCount; ++i)
+            EXPECT_NEAR(lanes[i][k], scalar[i], 1e-6f * (1.0f + std::abs(scalar[i])))
+                << "lane " << k << " basis " << i;
+    }
+}
+
 TEST(ShBasis, OrthonormalUpToEightBands) {
     // Gram matrix with an exact product rule: the identity up to float evaluation error.
     const std::vector<SpherePoint> points = sphereQuadrature();
