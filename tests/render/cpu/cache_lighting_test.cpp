@@ -1,12 +1,13 @@
-// The cache-lighting CPU twin (render/cpu/cache_lighting.h) on one cache with known links: an
+// The cache-lighting CPU twin (render/cpu/cache_lighting.h) on caches with known links: an
 // RTP link projects its node's cone (against quadrature and the closed form, with the YCoCg
-// band split), a tiny cone is a point source, and SH links pass their coefficients through,
-// losing only their half-float rounding.
+// band split), links summed in lanes equal them added one by one, a tiny cone is a point
+// source, and SH links pass their coefficients through, losing only their half-float rounding.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "core/bake_data.h"
@@ -22,9 +23,10 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 
-/// A bake of one cache over a one-node hierarchy with nL links of the given mode.
+/// A bake of `caches` caches (one by default) over a hierarchy of `surfels` leaves with nL links
+/// each of the given mode.
 BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t nL,
-                      uint32_t surfels) {
+                      uint32_t surfels, uint32_t caches = 1) {
     BakeData bake;
     bake.params.bandsY = bandsY;
     bake.params.bandsC = bandsC;
@@ -32,18 +34,19 @@ BakeData oneCacheBake(LinkMode mode, uint32_t bandsY, uint32_t bandsC, uint32_t 
     bake.surfels.resize(surfels);
     bake.nodes.resize(2 * surfels - 1);
     for (Node& node : bake.nodes) node.left = node.right = kNoNode;
-    bake.caches.resize(1);
+    bake.caches.resize(caches);
+    const size_t links = size_t{nL} * caches;
     bake.links.mode = mode;
     bake.links.linksPerCache = nL;
-    bake.links.tint.assign(nL, kNeutralLinkTint);
-    bake.links.offset.assign(size_t{nL} * 3, 0);
-    bake.links.spreadShare.assign(nL, encodeSpreadShare(1.0f));
+    bake.links.tint.assign(links, kNeutralLinkTint);
+    bake.links.offset.assign(links * 3, 0);
+    bake.links.spreadShare.assign(links, encodeSpreadShare(1.0f));
     if (mode == LinkMode::Sh) {
         bake.links.bands = bandsY;
-        bake.links.shNodes.assign(nL, 0u);
-        bake.links.shCoefficients.assign(size_t{nL} * bandsY * bandsY, floatToHalf(0.0f));
+        bake.links.shNodes.assign(links, 0u);
+        bake.links.shCoefficients.assign(links * bandsY * bandsY, floatToHalf(0.0f));
     } else {
-        bake.links.rtp.assign(nL, RtpLink{0, 0.0f, 0, 0.0f});
+        bake.links.rtp.assign(links, RtpLink{0, 0.0f, 0, 0.0f});
     }
     return bake;
 }
@@ -124,6 +127,55 @@ TEST(CacheLighting, RtpLinkProjectsTheNodeConeWithYCoCgBandSplit) {
             const double transport = factor * coneZonal(l, u) * basis[i];
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(back[c], rgb[c] * transport, 1e-5) << "coefficient " << i;
+        }
+    }
+}
+
+TEST(CacheLighting, RtpLinksSumInLanesAsOneByOne) {
+    // Three caches of 70 links each (a block of 64 and a short one; 70 is no multiple of the
+    // four lanes, so lanes read the next cache's links and past the last), random nodes,
+    // directions, cones and factors, every fifth link padding: each cache is the sum of its
+    // links' cones added one by one (core/sh.h shAddCone), tinted ones included.
+    const uint32_t bandsY = 3, bandsC = 2, nL = 70, caches = 3, surfels = 5;
+    BakeData bake = oneCacheBake(LinkMode::Rtp, bandsY, bandsC, nL, surfels, caches);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f), signedUnit(-1.0f, 1.0f);
+    std::vector<glm::vec3> nodeFlux(bake.nodes.size());
+    for (auto& flux : nodeFlux) flux = glm::vec3(unit(rng), unit(rng), unit(rng)) * 5.0f;
+    std::vector<float> expectedY(size_t{caches} * 9, 0.0f), expectedCo(size_t{caches} * 4, 0.0f),
+        expectedCg(size_t{caches} * 4, 0.0f);
+    for (uint32_t slot = 0; slot < caches * nL; ++slot) {
+        if (slot % 5 == 4) continue;  // padding: factor 0
+        const uint32_t node = uint32_t(rng() % surfels);
+        const glm::vec3 direction =
+            glm::normalize(glm::vec3(signedUnit(rng), signedUnit(rng), signedUnit(rng)) + 1e-3f);
+        const float factor = unit(rng), u = 0.05f + unit(rng);
+        bake.links.rtp[slot] = RtpLink{node, factor, encodeOctahedral(direction), u};
+        glm::vec3 rgb = nodeFlux[node];
+        if (slot % 7 == 0) {
+            bake.links.tint[slot] = encodeLinkTint(glm::vec3(0.9f, 0.5f, 0.2f)).code;
+            rgb *= decodeLinkTint(bake.links.tint[slot]);
+        }
+        const glm::vec3 flux = rgbToYCoCg(rgb);
+        const glm::vec3 d = decodeOctahedral(bake.links.rtp[slot].directionOct);
+        const size_t c = slot / nL;
+        shAddCone(int(bandsY), d, u, flux.x * factor, &expectedY[c * 9]);
+        shAddCone(int(bandsC), d, u, flux.y * factor, &expectedCo[c * 4]);
+        shAddCone(int(bandsC), d, u, flux.z * factor, &expectedCg[c * 4]);
+    }
+    CacheValues values;
+    lightCaches(bake, nodeFlux, values);
+    ASSERT_EQ(values.cacheCount(), caches);
+    for (uint32_t c = 0; c < caches; ++c) {
+        const float scale = std::abs(expectedY[c * 9]);
+        for (int i = 0; i < 9; ++i)
+            EXPECT_NEAR(values.y[c * 9 + i], expectedY[c * 9 + i], 1e-5f * scale)
+                << "cache " << c << " Y " << i;
+        for (int i = 0; i < 4; ++i) {
+            EXPECT_NEAR(values.co[c * 4 + i], expectedCo[c * 4 + i], 1e-5f * scale)
+                << "cache " << c << " Co " << i;
+            EXPECT_NEAR(values.cg[c * 4 + i], expectedCg[c * 4 + i], 1e-5f * scale)
+                << "cache " << c << " Cg " << i;
         }
     }
 }
