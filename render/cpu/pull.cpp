@@ -196,6 +196,11 @@ ExponentialSpread exponentialSpread(const NodeSpread& spread, size_t node, float
     return out;
 }
 
+namespace {
+/// How many nodes ahead the pull prefetches a node's children.
+constexpr size_t kPrefetchNodes = 8;
+}  // namespace
+
 void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
                     std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes,
@@ -220,9 +225,20 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
         std::fill(exponential.begin() + begin, exponential.begin() + end, uint8_t{0});
     }
     for (size_t level = 1; level < bake.levelOffsets.size(); ++level) {
+        const size_t levelEnd = bake.levelOffsets[level];
         parallelFor(
-            bake.levelOffsets[level - 1], bake.levelOffsets[level],
+            bake.levelOffsets[level - 1], levelEnd,
             [&](size_t n) {
+                // The children lie scattered over the levels below: fetch a later node's
+                // moments and centroids ahead of their use.
+                if (n + kPrefetchNodes < levelEnd) {
+                    const Node& later = bake.nodes[n + kPrefetchNodes];
+                    for (const uint32_t child : {later.left, later.right}) {
+                        __builtin_prefetch(&moment[child]);
+                        __builtin_prefetch(&spread.centroid[child]);
+                        __builtin_prefetch(&nodeFlux[child]);
+                    }
+                }
                 const Node& node = bake.nodes[n];
                 glm::mat3 m = moment[node.left] + moment[node.right];
                 for (const uint32_t child : {node.left, node.right}) {
