@@ -59,8 +59,9 @@ float inverseLangevin(float r) {
 }
 
 /// render/cpu/pull.cpp exponentialSpread: returns the flux at the box centre and sets the
-/// slopes β·halfExtent and ln Z.
-float exponentialSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes,
+/// slopes β·halfExtent and ln Z. `a` holds the node's box model, √3·σ_k per axis and 0 on flat
+/// axes (the same for every channel: writeNode computes it once).
+float exponentialSpread(PullNode inner, vec3 a, float flux, vec3 moment, out vec3 slopes,
                         out float concentration) {
     slopes = vec3(0.0);
     concentration = 0.0;
@@ -69,16 +70,9 @@ float exponentialSpread(PullNode inner, float flux, vec3 moment, out vec3 slopes
     const vec3 centre = 0.5 * (low + inner.high);
     const vec3 halfExtent = 0.5 * (inner.high - low);
     const vec3 mean = (moment * mat3(inner.axis0, inner.axis1, inner.axis2)) * (1.0 / flux);
-    vec3 variance = vec3(0.0);
+    vec3 beta = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k)
-        if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
-    const float total = variance.x + variance.y + variance.z;
-    vec3 beta = vec3(0.0), a = vec3(0.0);
-    [[unroll]] for (int k = 0; k < 3; ++k) {
-        if (!(variance[k] > kFlatVariance * total)) continue;
-        a[k] = sqrt(3.0 * variance[k]);
-        beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
-    }
+        if (a[k] > 0.0) beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
     const float sum = dot(abs(beta), halfExtent);
     if (sum > kExponentialSpreadCap) beta *= kExponentialSpreadCap / sum;
     [[unroll]] for (int k = 0; k < 3; ++k) {
@@ -132,11 +126,17 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
     vec3 variance = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k)
         if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
-    const bool exponential = concentrated && min(variance.x, min(variance.y, variance.z)) <=
-                                            kFlatVariance * (variance.x + variance.y + variance.z);
-    if (exponential)
+    const float total = variance.x + variance.y + variance.z;
+    const bool exponential =
+        concentrated && min(variance.x, min(variance.y, variance.z)) <= kFlatVariance * total;
+    if (exponential) {
+        vec3 a = vec3(0.0);
+        [[unroll]] for (int k = 0; k < 3; ++k)
+            if (variance[k] > kFlatVariance * total) a[k] = sqrt(3.0 * variance[k]);
         for (int c = 0; c < 3; ++c)
-            centre[c] = exponentialSpread(inner, flux[c], moments[c], slopes[c], concentration[c]);
+            centre[c] =
+                exponentialSpread(inner, a, flux[c], moments[c], slopes[c], concentration[c]);
+    }
     nodeLight[node] = uvec4(packSpread(slopes[0], slopes[1], slopes[2], concentration, exponential),
                             packRgbe8(centre * inner.radianceScale));
 }
