@@ -1,12 +1,15 @@
 #include "bench/link_error_benchmark.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
 #include <numbers>
 #include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "bake/link_generation.h"
@@ -120,6 +123,14 @@ Json ratiosJson(const Estimates& e, uint32_t caches) {
 }  // namespace
 
 int runLinkErrorBenchmark(const LinkErrorParams& params) {
+    if (!params.near.empty() &&
+        (params.near.size() != 4 || !std::all_of(params.near.begin(), params.near.end(),
+                                                 [](float v) { return std::isfinite(v); }) ||
+         !(params.near[3] > 0.0f)))
+        return reportError(Error{ErrorCode::InvalidInput,
+                                 fmt::format("--near takes x,y,z,r with a radius r > 0 in metres, "
+                                             "got {}",
+                                             fmt::join(params.near, ","))});
     auto scene = loadScene(params.scenePath);
     if (!scene) return reportError(scene.error());
     auto loaded = loadLightSet(params.lightsPath, *scene);
@@ -198,7 +209,22 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         return float(node > 0.0 ? std::min(1.0, part / node) : 1.0);
     };
     const size_t nC = bake->caches.size();
-    const size_t examined = std::min<size_t>(std::max(params.caches, 1u), nC);
+    // The caches to examine: --caches of them, evenly over the bake's or over those near the
+    // point --near names.
+    std::vector<size_t> candidates;
+    for (size_t c = 0; c < nC; ++c)
+        if (params.near.empty() ||
+            glm::distance(bake->caches[c].position,
+                          glm::vec3(params.near[0], params.near[1], params.near[2])) <= params.near[3])
+            candidates.push_back(c);
+    if (candidates.empty())
+        return reportError(Error{ErrorCode::InvalidInput,
+                                 fmt::format("no cache lies within {} m of ({}, {}, {}) (--near)",
+                                             params.near[3], params.near[0], params.near[1],
+                                             params.near[2])});
+    const size_t examined = std::min<size_t>(std::max(params.caches, 1u), candidates.size());
+    std::vector<size_t> chosen(examined);
+    for (size_t k = 0; k < examined; ++k) chosen[k] = candidates[k * candidates.size() / examined];
     const uint32_t nL = bake->links.linksPerCache;
     const size_t strideY = size_t{values.bandsY} * values.bandsY;
     const double y00 = 0.5 / std::sqrt(kPi);
@@ -229,7 +255,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     std::vector<Estimates> estimates(examined);
     Progress progress("link error", examined);
     parallelFor(0, examined, [&](size_t k) {
-        const size_t c = k * nC / examined;
+        const size_t c = chosen[k];
         const Cache& cache = bake->caches[c];
         const bool hemisphere = cache.kind == gpu::kCacheKindLightmap;
         Estimates& e = estimates[k];
@@ -280,7 +306,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     for (size_t k = 0; k < examined; ++k) {
         all += estimates[k];
         allCaches.push_back(k);
-        if (bake->caches[k * nC / examined].kind == gpu::kCacheKindLightmap) {
+        if (bake->caches[chosen[k]].kind == gpu::kCacheKindLightmap) {
             lightmap += estimates[k];
             lightmapCaches.push_back(k);
         } else {
@@ -295,6 +321,10 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                     {"link_mode", bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp"},
                     {"unique_caches", nC}};
     json["directions"] = params.directions;
+    if (!params.near.empty())
+        json["near"] = {{"point", {params.near[0], params.near[1], params.near[2]}},
+                        {"radius", params.near[3]},
+                        {"caches_within", candidates.size()}};
     json["one_sided_truth"] = params.oneSidedTruth;
     json["all"] = ratiosJson(all, uint32_t(examined));
     json["grid"] = ratiosJson(grid, uint32_t(gridCaches.size()));
@@ -306,10 +336,10 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     // luma and its own ratios.
     Json perCache = Json::array();
     for (size_t k = 0; k < examined; ++k) {
-        const Cache& cache = bake->caches[k * nC / examined];
+        const Cache& cache = bake->caches[chosen[k]];
         const Estimates& e = estimates[k];
         perCache.push_back(
-            {{"cache", k * nC / examined},
+            {{"cache", chosen[k]},
              {"kind", cache.kind == gpu::kCacheKindLightmap ? "lightmap" : "grid"},
              {"position", {cache.position.x, cache.position.y, cache.position.z}},
              {"normal", {cache.normal.x, cache.normal.y, cache.normal.z}},
@@ -323,8 +353,9 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     }
     json["caches"] = std::move(perCache);
 
-    std::printf("%s: one bounce, %zu of %zu caches, nL %u (%s)\n", params.scenePath.c_str(), examined,
-                nC, nL, bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");
+    std::printf("%s: one bounce, %zu of %zu caches%s, nL %u (%s)\n", params.scenePath.c_str(), examined,
+                candidates.size(), params.near.empty() ? "" : " near the --near point", nL,
+                bake->params.linkMode == LinkMode::Sh ? "sh" : "rtp");
     std::printf("  %-9s %7s %14s %15s %10s %11s %11s %11s\n", "caches", "count", "linked/traced",
                 "representation", "coverage", "node mean", "node spread", "visibility");
     const char* factors[] = {"linked_over_traced", "representation",       "cut_coverage",

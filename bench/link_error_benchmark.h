@@ -27,6 +27,7 @@
 /// cache's place, kind and ratios under `caches`; never asserts.
 
 #include <string>
+#include <vector>
 
 #include "bake/bake.h"
 
@@ -37,6 +38,9 @@ struct LinkErrorParams {
     std::string lightsPath;        ///< empty: the scene's own lights
     BakeOptions bake;
     uint32_t caches = 400;         ///< caches to examine, evenly spread over the cache list
+    /// Empty, or x, y, z, r: examine only the caches within r metres of (x, y, z) (a region
+    /// an image shows, whose caches a sample of the whole bake may miss)
+    std::vector<float> near;
     uint32_t directions = 1024;    ///< path-traced directions per examined cache
     bool oneSidedTruth = false;    ///< the traced bounce takes no light off a surface's back,
                                    ///< as the surfels (front faces only) do

@@ -87,6 +87,10 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     links->add_flag("--one-sided-truth", linkParams.oneSidedTruth,
                     "the traced first bounce takes no light off the back of a surface, as the surfels do (default: both faces reflect, as picref's path tracer)");
+    links->add_option("--near", linkParams.near,
+                      "x,y,z,r: examine only the caches within r metres of (x, y, z), the region an image shows (default: all caches)")
+        ->delimiter(',')
+        ->expected(4);
     links->add_option("--json", linkParams.jsonPath, "write the ratios to this JSON file");
     links->add_option("--ref-seed", linkParams.seed, "path tracer seed (default 1)");
     linkFlags.addTo(*links);

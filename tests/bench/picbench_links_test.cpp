@@ -148,6 +148,31 @@ TEST_F(PicbenchLinks, AccuracySplitsTheBlotchIndexBySHBand) {
     }
 }
 
+TEST_F(PicbenchLinks, NearExaminesOnlyTheCachesAroundAPoint) {
+    // --near x,y,z,r: the sample comes from the caches within r of the point (a region an image
+    // shows), fewer than the bake holds; a radius that is not positive or a point with no cache
+    // near it is bad input naming the option.
+    const fs::path json = mDir / "near.json";
+    std::string err;
+    ASSERT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --caches 10 "
+                  "--directions 32 --near 0,1,0,0.3 --json " + json.string(), err), 0) << err;
+    std::ifstream in(json);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    const size_t within = report.at("near").at("caches_within").get<size_t>();
+    EXPECT_GE(within, 10u);
+    EXPECT_LT(within, report.at("bake").at("unique_caches").get<size_t>());
+    ASSERT_EQ(report.at("caches").size(), 10u);
+    for (const nlohmann::json& c : report.at("caches")) {
+        const auto p = c.at("position");
+        const double distance = std::hypot(p[0].get<double>(), p[1].get<double>() - 1.0, p[2].get<double>());
+        EXPECT_LE(distance, 0.3 + 1e-6);
+    }
+    EXPECT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --near 0,1,0,-1", err), 2);
+    EXPECT_NE(err.find("--near"), std::string::npos) << err;
+    EXPECT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --near 100,100,100,0.1", err), 2);
+    EXPECT_NE(err.find("no cache lies within"), std::string::npos) << err;
+}
+
 TEST_F(PicbenchLinks, MissingSceneIsBadInputNamingThePath) {
     std::string err;
     EXPECT_EQ(run("links --scene /nonexistent/scene.gltf", err), 2);
