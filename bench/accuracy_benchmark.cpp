@@ -208,8 +208,8 @@ int runLinksSweep(const AccuracyParams& params, const Scene& scene, const Embree
             : params.jsonPath;
     std::error_code ec;
     std::filesystem::create_directories(std::filesystem::path(jsonPath).parent_path(), ec);
-    if (int exit = writeChartFile(chart, chartPathFor(jsonPath)); exit != 0) return exit;
-    return writeJson(json, jsonPath);
+    if (int exit = writeJson(json, jsonPath); exit != 0) return exit;
+    return writeChartFile(chart, chartPathFor(jsonPath));
 }
 
 }  // namespace

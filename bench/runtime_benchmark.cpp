@@ -348,9 +348,8 @@ int runRuntimeBenchmark(const RuntimeBenchmarkParams& params) {
         floor->deviceCopy ? "by timestamps"
                           : "by wall clock with their uploads and read-backs",
         floorName);
-    if (int exit = writeChartFile(ratioChart(json), chartPathFor(params.jsonPath)); exit != 0)
-        return exit;
-    return writeJson(json, params.jsonPath);
+    if (int exit = writeJson(json, params.jsonPath); exit != 0) return exit;
+    return writeChartFile(ratioChart(json), chartPathFor(params.jsonPath));
 }
 
 int runShadowBenchmark(const ShadowBenchmarkParams& params) {
@@ -491,8 +490,8 @@ int runShadowBenchmark(const ShadowBenchmarkParams& params) {
     chart.xLabel = "GPU visibility + direct surfel lighting, ms (median)";
     chart.yLabel = "% of the direct surfel flux against the CPU twin's rays";
     chart.series = std::move(series);
-    if (int exit = writeChartFile(chart, chartPathFor(params.jsonPath)); exit != 0) return exit;
-    return writeJson(json, params.jsonPath);
+    if (int exit = writeJson(json, params.jsonPath); exit != 0) return exit;
+    return writeChartFile(chart, chartPathFor(params.jsonPath));
 }
 
 }  // namespace pic
