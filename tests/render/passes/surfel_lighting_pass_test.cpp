@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/light_set.h"
@@ -34,9 +35,37 @@ double fractionDiffering(const std::vector<glm::vec3>& gpu, const std::vector<gl
     return double(differing) / double(cpu.size());
 }
 
-/// Largest relative difference of a GPU flux from the CPU's over surfels and channels
-/// (differences below 1e−6 of the brightest surfel ignored).
-double largestDifference(const std::vector<glm::vec3>& gpu, const std::vector<glm::vec3>& cpu) {
+/// Relative tolerance of a surfel's direct flux between two devices that evaluate the same
+/// formula: float rounding (1e−4), widened inside a spot's soft edge. There the glTF ramp
+/// r = (cos − cos_outer)/(cos_inner − cos_outer), squared, turns a cosine that the device
+/// rounds a few ulp apart (Vulkan lets it contract into fma and round inversesqrt to 2 ulp)
+/// into a relative change of 2·δ/(cos − cos_outer), with δ = 8·2⁻²⁴. Surfels within 2δ of
+/// a hard cone's edge may fall either side of it and are not compared.
+std::vector<double> fluxTolerance(const BakeData& bake, const LightSet& lights) {
+    constexpr double kCosineUlps = 8.0 / double(1 << 24);
+    std::vector<double> tolerance(bake.surfels.size(), 1e-4);
+    for (const Light& light : lights.lights) {
+        if (light.type != LightType::Spot) continue;
+        const double cosOuter = std::cos(double(light.outerConeAngle));
+        const double cosInner = std::cos(double(light.innerConeAngle));
+        for (size_t i = 0; i < bake.surfels.size(); ++i) {
+            const glm::dvec3 toSurfel = glm::dvec3(bake.surfels[i].position) - glm::dvec3(light.position);
+            const double cd = glm::dot(glm::dvec3(light.direction), glm::normalize(toSurfel));
+            if (cd < cosOuter - 2.0 * kCosineUlps || cd >= cosInner) continue;
+            const double margin = cd - cosOuter;
+            tolerance[i] = margin > 2.0 * kCosineUlps && light.innerConeAngle < light.outerConeAngle
+                               ? tolerance[i] + 2.0 * kCosineUlps / margin
+                               : std::numeric_limits<double>::infinity();
+        }
+    }
+    return tolerance;
+}
+
+/// Largest difference of a GPU flux from the CPU's over surfels and channels, relative to
+/// each surfel's tolerance (1 = at it; differences below 1e−6 of the brightest surfel
+/// ignored).
+double largestDifference(const std::vector<glm::vec3>& gpu, const std::vector<glm::vec3>& cpu,
+                         const std::vector<double>& tolerance) {
     float brightest = 0.0f;
     for (const glm::vec3& f : cpu) brightest = std::max({brightest, f.r, f.g, f.b});
     double largest = 0.0;
@@ -44,13 +73,15 @@ double largestDifference(const std::vector<glm::vec3>& gpu, const std::vector<gl
         for (int c = 0; c < 3; ++c) {
             const double d = std::abs(double(gpu[i][c]) - double(cpu[i][c]));
             if (d > 1e-6 * brightest)
-                largest = std::max(largest, d / std::max(std::abs(double(cpu[i][c])), 1e-30));
+                largest = std::max(largest, d / std::max(std::abs(double(cpu[i][c])), 1e-30) /
+                                                tolerance[i]);
         }
     return largest;
 }
 
 /// Direct surfel flux for a scene and light set, with the visibility of shadow maps (within
-/// the bound) and of rays (the CPU twin's own rays: equal to float rounding).
+/// the bound) and of rays (the CPU twin's own rays: equal to float rounding, within
+/// fluxTolerance).
 void expectDirectMatches(const test::BakedScene& b, const LightSet& lights) {
     std::vector<glm::vec3> cpu(b.bake.surfels.size());
     directSurfelFlux(b.scene, *b.rays, b.bake, lights, cpu);
@@ -58,7 +89,7 @@ void expectDirectMatches(const test::BakedScene& b, const LightSet& lights) {
     ASSERT_TRUE(rays);
     auto traced = rays->runDirect(lights);
     ASSERT_TRUE(traced) << traced.error().message;
-    EXPECT_LE(largestDifference(*traced, cpu), 1e-4);
+    EXPECT_LE(largestDifference(*traced, cpu, fluxTolerance(b.bake, lights)), 1.0);
 
     auto gpu = test::gpuFor(b, {}, {.directVisibility = gpu::DirectVisibility::ShadowMaps});
     ASSERT_TRUE(gpu);
