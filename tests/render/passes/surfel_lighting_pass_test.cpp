@@ -40,7 +40,7 @@ double fractionDiffering(const std::vector<glm::vec3>& gpu, const std::vector<gl
 /// r = (cos − cos_outer)/(cos_inner − cos_outer), squared, turns a cosine that the device
 /// rounds a few ulp apart (Vulkan lets it contract into fma and round inversesqrt to 2 ulp)
 /// into a relative change of 2·δ/(cos − cos_outer), with δ = 8·2⁻²⁴. Surfels within 2δ of
-/// a hard cone's edge may fall either side of it and are not compared.
+/// a cone's outer edge may fall either side of it and are not compared.
 std::vector<double> fluxTolerance(const BakeData& bake, const LightSet& lights) {
     constexpr double kCosineUlps = 8.0 / double(1 << 24);
     std::vector<double> tolerance(bake.surfels.size(), 1e-4);
@@ -48,14 +48,15 @@ std::vector<double> fluxTolerance(const BakeData& bake, const LightSet& lights) 
         if (light.type != LightType::Spot) continue;
         const double cosOuter = std::cos(double(light.outerConeAngle));
         const double cosInner = std::cos(double(light.innerConeAngle));
+        const bool hard = light.innerConeAngle >= light.outerConeAngle;
         for (size_t i = 0; i < bake.surfels.size(); ++i) {
             const glm::dvec3 toSurfel = glm::dvec3(bake.surfels[i].position) - glm::dvec3(light.position);
             const double cd = glm::dot(glm::dvec3(light.direction), glm::normalize(toSurfel));
-            if (cd < cosOuter - 2.0 * kCosineUlps || cd >= cosInner) continue;
             const double margin = cd - cosOuter;
-            tolerance[i] = margin > 2.0 * kCosineUlps && light.innerConeAngle < light.outerConeAngle
-                               ? tolerance[i] + 2.0 * kCosineUlps / margin
-                               : std::numeric_limits<double>::infinity();
+            if (std::abs(margin) <= 2.0 * kCosineUlps)
+                tolerance[i] = std::numeric_limits<double>::infinity();  // either side of the edge
+            else if (!hard && margin > 0.0 && cd < cosInner)
+                tolerance[i] += 2.0 * kCosineUlps / margin;
         }
     }
     return tolerance;
