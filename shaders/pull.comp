@@ -122,17 +122,27 @@ void writeNode(uint node, PullNode inner, vec3 leftFlux, vec3 rightFlux, vec3 le
         centre[c] = limitedSpread(inner, flux[c], m, slopes[c], concentrated);
     }
     // Where the limiter keeps less than kExponentialLimit of the gradient in any channel of a
-    // flat node, its spread is exponential in all three (render/cpu/pull.cpp isFlat).
+    // flat node whose flux centroids lie within kExponentialReach of its box model, its
+    // spread is exponential in all three (render/cpu/pull.cpp isFlat, fitsBoxModel).
     vec3 variance = vec3(0.0);
     [[unroll]] for (int k = 0; k < 3; ++k)
         if (inner.inverseVariance[k] > 0.0) variance[k] = 1.0 / inner.inverseVariance[k];
     const float total = variance.x + variance.y + variance.z;
-    const bool exponential =
+    bool exponential =
         concentrated && min(variance.x, min(variance.y, variance.z)) <= kFlatVariance * total;
+    vec3 a = vec3(0.0);
     if (exponential) {
-        vec3 a = vec3(0.0);
         [[unroll]] for (int k = 0; k < 3; ++k)
             if (variance[k] > kFlatVariance * total) a[k] = sqrt(3.0 * variance[k]);
+        const mat3 axes = mat3(inner.axis0, inner.axis1, inner.axis2);
+        for (int c = 0; c < 3; ++c) {
+            if (!(flux[c] > 0.0)) continue;
+            const vec3 mean = (moments[c] * axes) * (1.0 / flux[c]);
+            [[unroll]] for (int k = 0; k < 3; ++k)
+                if (a[k] > 0.0 && abs(mean[k]) > kExponentialReach * a[k]) exponential = false;
+        }
+    }
+    if (exponential) {
         for (int c = 0; c < 3; ++c)
             centre[c] =
                 exponentialSpread(inner, a, flux[c], moments[c], slopes[c], concentration[c]);

@@ -158,6 +158,23 @@ bool isFlat(const NodeSpread& spread, size_t node) {
     return std::min({variance.x, variance.y, variance.z}) <= gpu::kFlatVariance * total;
 }
 
+bool fitsBoxModel(const NodeSpread& spread, size_t node, const glm::vec3& flux,
+                  const glm::mat3& moment) {
+    glm::vec3 variance(0.0f);
+    for (int k = 0; k < 3; ++k)
+        if (spread.inverseVariance[node][k] > 0.0f) variance[k] = 1.0f / spread.inverseVariance[node][k];
+    const float total = variance.x + variance.y + variance.z;
+    for (int c = 0; c < 3; ++c) {
+        if (!(flux[c] > 0.0f)) continue;
+        const glm::vec3 mean = (moment[c] * spread.axes[node]) * (1.0f / flux[c]);
+        for (int k = 0; k < 3; ++k)
+            if (variance[k] > gpu::kFlatVariance * total &&
+                std::abs(mean[k]) > gpu::kExponentialReach * std::sqrt(3.0f * variance[k]))
+                return false;
+    }
+    return true;
+}
+
 float inverseLangevin(float r) {
     const float a = std::min(std::abs(r), 0.99f);
     const float x = a * (3.0f - 2.6f * a + 0.7f * a * a) / ((1.0f - a) * (1.0f + 0.1f * a));
@@ -262,7 +279,8 @@ void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     concentrated = concentrated || channel.concentrated;
                 }
                 concentration[n] = glm::vec3(0.0f);
-                exponential[n] = concentrated && isFlat(spread, n) ? 1 : 0;
+                exponential[n] =
+                    concentrated && isFlat(spread, n) && fitsBoxModel(spread, n, nodeFlux[n], m) ? 1 : 0;
                 if (!exponential[n]) return;
                 for (int c = 0; c < 3; ++c) {
                     const ExponentialSpread channel = exponentialSpread(spread, n, nodeFlux[n][c], m[c]);

@@ -95,6 +95,12 @@ ExponentialSpread exponentialSpread(const NodeSpread& spread, size_t node, float
 /// patch of one surface; a leaf, whose variances are all 0, too).
 bool isFlat(const NodeSpread& spread, size_t node);
 
+/// Whether the flux centroid of every channel of `node` (moment column c over flux c) lies
+/// within gpu::kExponentialReach·√3·σ_k of the surfels' centroid along each axis the node is
+/// not flat on: the box model its exponential spread is normalised over.
+bool fitsBoxModel(const NodeSpread& spread, size_t node, const glm::vec3& flux,
+                  const glm::mat3& moment);
+
 /// x with L(x) = coth x − 1/x = r for |r| < 1 (the inverse Langevin function), by Jedynak's
 /// rational approximation (within 1.5 %); r is clamped to ±0.99.
 float inverseLangevin(float r);
@@ -109,8 +115,9 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
 /// leaves' are 0) summed up the hierarchy like the flux, M_n = Σ_children M_k + Φ_k ⊗ (x̄_k −
 /// x̄_n), and every node's spread: `centreFlux` (W per channel; a leaf's own flux) and
 /// `slopes` (column c = channel c's slopes; 0 for leaves). A flat node (isFlat) whose flux is
-/// concentrated (ChannelSpread::concentrated) in any channel is exponential in all three (`exponential` 1, its ln Z per
-/// channel in `concentration`); the others are linear (`exponential` 0, `concentration` 0).
+/// concentrated (ChannelSpread::concentrated) in any channel and fits its box model
+/// (fitsBoxModel) is exponential in all three (`exponential` 1, its ln Z per channel in
+/// `concentration`); the others are linear (`exponential` 0, `concentration` 0).
 void pullFluxSpread(const BakeData& bake, const NodeSpread& spread,
                     std::span<const glm::vec3> nodeFlux, std::span<glm::mat3> moment,
                     std::span<glm::vec3> centreFlux, std::span<glm::mat3> slopes,

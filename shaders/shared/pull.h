@@ -88,6 +88,13 @@ PIC_CONST(float, kFlatVariance, 1e-3f);
 // Where the limiter keeps more, the line is close (the furnished rooms' blotch index is the
 // same with the limit at 1 and at 0.5) and the links read it at less cost.
 PIC_CONST(float, kExponentialLimit, 0.5f);
+// An exponential spread's normaliser ln Z assumes the node's surfels lie evenly over
+// a_k = √3·σ_k about their centroid along each axis. A channel whose flux centroid lies
+// further than kExponentialReach·a_k from it contradicts that box model (an even rectangle's
+// surfels reach a_k, a disc's 1.15·a_k): the node keeps its limited line. (Exponential, a
+// flat node of sparse clumps 3.5 m long, lit at its far end, read 10.8 × at a cache of the
+// living room baked with seed 3.)
+PIC_CONST(float, kExponentialReach, 1.25f);
 
 struct PullPush {
     uint first;        // level mode: the level is nodes [first, end); tail mode: levels

@@ -203,6 +203,36 @@ TEST(Pull, ConcentratedFluxSpreadsExponentially) {
               gpu::kExponentialSpreadCap + 1e-5f);
 }
 
+TEST(Pull, AFluxCentroidBeyondTheBoxModelKeepsTheLine) {
+    // Seven surfels at x = 0…6 and one at 20, all flux on the far one. The root's box model
+    // is x̄ ± √3σ = 5.125 ± 10.26, and its flux centroid lies 14.875 from x̄, 1.45 of that:
+    // an exponential normalised over the model would read the far end many times over. The
+    // limiter keeps less than kExponentialLimit of the line, yet the root stays linear.
+    BakeData bake = lineBake(8);
+    bake.surfels[7].position.x = 20.0f;
+    const uint32_t root = 14, lit = 7;
+    std::vector<glm::vec3> flux(15, glm::vec3(0.0f));
+    flux[lit] = glm::vec3(1.0f);
+    pullFlux(bake, flux);
+    const NodeSpread spread = nodeSpread(bake);
+    const Spreads s = pulledSpreads(bake, spread, flux);
+    EXPECT_TRUE(isFlat(spread, root));
+    EXPECT_TRUE(limitedSpread(spread, root, 1.0f, s.moment[root][0]).concentrated);
+    EXPECT_FALSE(fitsBoxModel(spread, root, flux[root], s.moment[root]));
+    EXPECT_EQ(s.exponential[root], 0);
+    EXPECT_EQ(s.concentration[root], glm::vec3(0.0f));
+    // The even line of ConcentratedFluxSpreadsExponentially fits: its flux centroid, 3.5 from
+    // x̄, is 0.88 of √3σ.
+    const BakeData even = lineBake(8);
+    std::vector<glm::vec3> evenFlux(15, glm::vec3(0.0f));
+    evenFlux[lit] = glm::vec3(1.0f);
+    pullFlux(even, evenFlux);
+    const NodeSpread evenSpread = nodeSpread(even);
+    const Spreads e = pulledSpreads(even, evenSpread, evenFlux);
+    EXPECT_TRUE(fitsBoxModel(evenSpread, root, evenFlux[root], e.moment[root]));
+    EXPECT_EQ(e.exponential[root], 1);
+}
+
 TEST(Pull, ALightlyLimitedNodeKeepsItsLine) {
     // All flux on the last of four surfels: the limiter keeps 5/9 of the fitted gradient,
     // more than kExponentialLimit, so the root stays linear (its reads 0, 1/6, 1/3, 1/2 as in
