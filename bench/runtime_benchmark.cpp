@@ -75,10 +75,11 @@ struct BackendFigures {
     int lightsTraced = 0;          ///< GPU, rays: lights whose rays each update traced
 };
 
-/// Times `repeat` updates of each runtime in `runtimes`, each what the server's relight does
-/// for a light change: setLights, then textures() (the light-map copy: the CPU twin, and the
-/// GPU runtime copying on the host, copy the caches here; on the device, the GPU runtime
-/// records the copy in setLights and reads the layers back here). The runtimes take turns,
+/// Times `repeat` updates of each runtime in `runtimes`, each a light change as a renderer
+/// beside the runtime sees it: setLights, then textures() (the light-map copy: the CPU twin,
+/// and the GPU runtime copying on the host, copy the caches here; on the device, the GPU
+/// runtime records the copy in setLights and reads the layers back here). picserver's relight
+/// is setLights alone: it streams the caches. The runtimes take turns,
 /// update by update, so that a busy spell of a shared machine slows both and their ratio
 /// holds.
 Result<std::vector<BackendFigures>> timeBackends(std::span<Runtime* const> runtimes,
