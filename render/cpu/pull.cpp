@@ -58,6 +58,25 @@ void symmetricEigen(glm::dmat3 a, glm::dvec3& values, glm::dmat3& vectors) {
     values = {a[0][0], a[1][1], a[2][2]};
 }
 
+/// A node's variance along each of its axes (0 for leaves).
+glm::vec3 variances(const NodeSpread& spread, size_t node) {
+    glm::vec3 variance(0.0f);
+    for (int k = 0; k < 3; ++k)
+        if (spread.inverseVariance[node][k] > 0.0f) variance[k] = 1.0f / spread.inverseVariance[node][k];
+    return variance;
+}
+
+/// A node's box model, the half extent a_k = √3·σ_k of an even spread with its variance along
+/// each axis; 0 along axes it is flat on (variance at most gpu::kFlatVariance of the total).
+glm::vec3 boxModel(const NodeSpread& spread, size_t node) {
+    const glm::vec3 variance = variances(spread, node);
+    const float total = variance.x + variance.y + variance.z;
+    glm::vec3 a(0.0f);
+    for (int k = 0; k < 3; ++k)
+        if (variance[k] > gpu::kFlatVariance * total) a[k] = std::sqrt(3.0f * variance[k]);
+    return a;
+}
+
 }  // namespace
 
 NodeSpread nodeSpread(const BakeData& bake) {
@@ -151,26 +170,19 @@ ChannelSpread limitedSpread(const NodeSpread& spread, size_t node, float flux,
 }
 
 bool isFlat(const NodeSpread& spread, size_t node) {
-    glm::vec3 variance(0.0f);
-    for (int k = 0; k < 3; ++k)
-        if (spread.inverseVariance[node][k] > 0.0f) variance[k] = 1.0f / spread.inverseVariance[node][k];
+    const glm::vec3 variance = variances(spread, node);
     const float total = variance.x + variance.y + variance.z;
     return std::min({variance.x, variance.y, variance.z}) <= gpu::kFlatVariance * total;
 }
 
 bool fitsBoxModel(const NodeSpread& spread, size_t node, const glm::vec3& flux,
                   const glm::mat3& moment) {
-    glm::vec3 variance(0.0f);
-    for (int k = 0; k < 3; ++k)
-        if (spread.inverseVariance[node][k] > 0.0f) variance[k] = 1.0f / spread.inverseVariance[node][k];
-    const float total = variance.x + variance.y + variance.z;
+    const glm::vec3 a = boxModel(spread, node);
     for (int c = 0; c < 3; ++c) {
         if (!(flux[c] > 0.0f)) continue;
         const glm::vec3 mean = (moment[c] * spread.axes[node]) * (1.0f / flux[c]);
         for (int k = 0; k < 3; ++k)
-            if (variance[k] > gpu::kFlatVariance * total &&
-                std::abs(mean[k]) > gpu::kExponentialReach * std::sqrt(3.0f * variance[k]))
-                return false;
+            if (a[k] > 0.0f && std::abs(mean[k]) > gpu::kExponentialReach * a[k]) return false;
     }
     return true;
 }
@@ -184,21 +196,14 @@ float inverseLangevin(float r) {
 ExponentialSpread exponentialSpread(const NodeSpread& spread, size_t node, float flux,
                                     const glm::vec3& moment) {
     if (!(flux > 0.0f)) return {};
-    const glm::vec3 inverseVariance = spread.inverseVariance[node];
     const glm::vec3 low = spread.low[node], high = spread.high[node];
     const glm::vec3 centre = 0.5f * (low + high), half = 0.5f * (high - low);
     // The flux centroid's offset along the axes, M / Φ.
     const glm::vec3 mean = (moment * spread.axes[node]) * (1.0f / flux);
-    glm::vec3 variance(0.0f);
+    const glm::vec3 a = boxModel(spread, node);
+    glm::vec3 beta(0.0f);
     for (int k = 0; k < 3; ++k)
-        if (inverseVariance[k] > 0.0f) variance[k] = 1.0f / inverseVariance[k];
-    const float total = variance.x + variance.y + variance.z;
-    glm::vec3 beta(0.0f), a(0.0f);
-    for (int k = 0; k < 3; ++k) {
-        if (!(variance[k] > gpu::kFlatVariance * total)) continue;
-        a[k] = std::sqrt(3.0f * variance[k]);
-        beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
-    }
+        if (a[k] > 0.0f) beta[k] = inverseLangevin(mean[k] / a[k]) / a[k];
     const float sum = glm::dot(glm::abs(beta), half);
     if (sum > gpu::kExponentialSpreadCap) beta *= gpu::kExponentialSpreadCap / sum;
     ExponentialSpread out;
