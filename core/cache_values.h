@@ -19,6 +19,12 @@ struct CacheValues {
     std::vector<float> y;   ///< nC·lY² luma coefficients, cache-major
     std::vector<float> co;  ///< nC·lC² orange chroma coefficients
     std::vector<float> cg;  ///< nC·lC² green chroma coefficients
+    /// nC, or empty where unknown: RGB irradiance along each light-map cache's normal, W/m²,
+    /// every colour through the luma's lY bands (0 for grid caches). What a surfel on the
+    /// cache's surface receives: through the SH above, chroma keeps only lC bands, and the
+    /// colour of light arriving from aside bends towards that of the light from the front.
+    /// Cache lighting fills it for the next bounce; it is not stored, compressed or streamed.
+    std::vector<glm::vec3> irradiance;
 
     /// Zero-filled values for `caches` caches.
     static CacheValues zeros(size_t caches, uint32_t bandsY, uint32_t bandsC);
@@ -38,6 +44,10 @@ struct CacheStencil {
     uint32_t cache[8] = {};
     float weight[8] = {};
     int count = 0;
+    /// Bit k: cache k is a light-map cache on the reader's own surface, read through its
+    /// irradiance along its normal (CacheValues::irradiance; render/cpu/surfel_lighting.h
+    /// surfelStencils) rather than its SH.
+    uint8_t alongNormal = 0;
 };
 
 /// The stencil of lookupSurfaceRadiance (same arguments).

@@ -71,6 +71,9 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                    Buffer::create(ctx, 2 * nC * countC, kTexels, MemoryUse::Device, "caches Co"));
     PIC_TRY_ASSIGN(mCacheCg,
                    Buffer::create(ctx, 2 * nC * countC, kTexels, MemoryUse::Device, "caches Cg"));
+    // The bounce reads the irradiance along the light-map caches' normals as RGBA32F texels.
+    PIC_TRY_ASSIGN(mCacheIrradiance, Buffer::create(ctx, nC * sizeof(glm::vec4), kTexels,
+                                                    MemoryUse::Device, "cache irradiance"));
     if (!mCacheY.mapped() || !mCacheCo.mapped() || !mCacheCg.mapped()) {
         const VkDeviceSize bytes = mCacheY.size() + mCacheCo.size() + mCacheCg.size();
         PIC_TRY_ASSIGN(mCacheReadback,
@@ -101,7 +104,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
                                                              options.maxLinkTexelWords));
     PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeLight));
-    PIC_TRY(mCacheLighting->bind(ctx, mNodeLight, mCacheY, mCacheCo, mCacheCg, mShTables));
+    PIC_TRY(mCacheLighting->bind(ctx, mNodeLight, mCacheY, mCacheCo, mCacheCg, mCacheIrradiance,
+                                 mShTables));
     mLightmapCopyOnHost = options.lightmapCopyOnHost.value_or(ctx.isCpuDevice());
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
@@ -119,7 +123,7 @@ Result<gpu::LightmapCopyPass*> GpuRuntime::lightmapCopyPass() {
 
 Result<void> GpuRuntime::bindVisibility() {
     return mSurfels->bind({mShadows.get(), mRayVisibility.get(), &mNodeFlux, &mNodeLight, &mCacheY,
-                           &mCacheCo, &mCacheCg, &mShTables});
+                           &mCacheCo, &mCacheCg, &mCacheIrradiance, &mShTables});
 }
 
 Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
@@ -279,7 +283,9 @@ Result<void> GpuRuntime::uploadCaches(const CacheValues& values) {
     };
     PIC_TRY(put(values.y, mCacheY));
     PIC_TRY(put(values.co, mCacheCo));
-    return put(values.cg, mCacheCg);
+    PIC_TRY(put(values.cg, mCacheCg));
+    if (values.irradiance.empty()) return {};
+    return uploadFlux(values.irradiance, mCacheIrradiance);
 }
 
 void GpuRuntime::recordCacheReadback(VkCommandBuffer cmd) {
@@ -326,6 +332,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights,
 Result<std::vector<glm::vec3>> GpuRuntime::runBounce(std::span<const glm::vec3> direct,
                                                      const CacheValues& previous) {
     PIC_CHECK_EQ(direct.size(), mBake.surfels.size());
+    PIC_CHECK_EQ(previous.irradiance.size(), mBake.caches.size());
     PIC_TRY(uploadFlux(direct, const_cast<gpu::Buffer&>(mSurfels->directFlux())));
     PIC_TRY(uploadCaches(previous));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mSurfels->record(cmd, true, 0, 0); }));
@@ -374,6 +381,7 @@ Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::uvec4> nod
     }));
     CacheValues values = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
     readCaches(values);
+    PIC_TRY_ASSIGN(values.irradiance, downloadFlux(mCacheIrradiance, mBake.caches.size()));
     return values;
 }
 

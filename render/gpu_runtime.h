@@ -94,13 +94,15 @@ public:
     /// Visibility (shadow maps or rays) and the direct part of surfel lighting for `lights`:
     /// nS direct fluxes.
     Result<std::vector<glm::vec3>> runDirect(const LightSet& lights, UpdateStats* stats = nullptr);
-    /// One bounce of surfel lighting from `direct` (nS) and the caches `previous`: the leaves.
+    /// One bounce of surfel lighting from `direct` (nS) and the caches `previous` (with their
+    /// irradiance along the light-map caches' normals, as lightCaches fills it): the leaves.
     Result<std::vector<glm::vec3>> runBounce(std::span<const glm::vec3> direct,
                                              const CacheValues& previous);
     /// Pull from the leaves `leaves` (nS): all 2nS − 1 node fluxes.
     Result<std::vector<glm::vec3>> runPull(std::span<const glm::vec3> leaves);
     /// Cache lighting from `nodeFlux` (2nS − 1 nodes, pulled), uploaded as the node light that
-    /// surfel lighting and the pull write (packNodeLight).
+    /// surfel lighting and the pull write (packNodeLight); the values with their irradiance
+    /// along the light-map caches' normals.
     Result<CacheValues> runCacheLighting(std::span<const glm::vec3> nodeFlux);
     /// Cache lighting from node light packed already, so that a benchmark times the pass alone.
     Result<CacheValues> runCacheLighting(std::span<const glm::uvec4> nodeLight);
@@ -162,6 +164,7 @@ private:
     gpu::Buffer mCacheY;     ///< half, nC·lY²
     gpu::Buffer mCacheCo;    ///< half, nC·lC²
     gpu::Buffer mCacheCg;    ///< half, nC·lC²
+    gpu::Buffer mCacheIrradiance;  ///< vec4 per cache: CacheValues::irradiance, for the bounce
     gpu::Buffer mShTables;   ///< ShTables
     /// Host-visible Y, Co, Cg after one another, only when the cache buffers are not mapped
     /// (a discrete GPU): filled by the submission that wrote them, not by another one.

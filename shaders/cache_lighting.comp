@@ -35,6 +35,11 @@ layout(std430, binding = 2) writeonly buffer CacheY { float16_t cacheY[]; };
 layout(std430, binding = 3) writeonly buffer CacheCo { float16_t cacheCo[]; };
 layout(std430, binding = 4) writeonly buffer CacheCg { float16_t cacheCg[]; };
 layout(std140, binding = 5) uniform Sh { ShTables sh; };
+// Per cache: packSnorm4x8(normal, 1) for light-map caches, 0 for grid caches.
+layout(binding = 6) uniform usamplerBuffer cacheNormals;
+// Per cache: RGB irradiance along a light-map cache's normal (0 for grid caches), read by the
+// next bounce's surfel lighting (core/cache_values.h CacheValues::irradiance).
+layout(std430, binding = 7) writeonly buffer CacheIrradiance { vec4 cacheIrradiance[]; };
 layout(push_constant) uniform Push { CacheLightingPush pc; };
 
 #include "lib/rgbe8.glsl"
@@ -43,6 +48,8 @@ layout(push_constant) uniform Push { CacheLightingPush pc; };
 float y[kCountY];
 float co[kCountC];
 float cg[kCountC];
+vec3 alongNormal;   // YCoCg irradiance along the cache's normal
+vec4 cacheNormal;   // of the cache being lit: xyz its normal, w 1 for a light-map cache
 
 float16_t toHalf(float value) {
     return float16_t(clamp(value, -kHalfMax, kHalfMax));
@@ -101,8 +108,24 @@ void addLink(uint slot) {
                                            concentrationWeightOf(link.directionAndGreen >> 18u));
         float cone[kBandsY];
         coneZonal(visibleAndCone.y, cone);
+        const vec3 direction = decodeOctahedral9(link.directionAndGreen);
+        if (cacheNormal.w > 0.0) {
+            // The cone's projection convolved with the clamped cosine at the cache's normal
+            // (render/cpu/cache_lighting.h linkIrradiance): Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d).
+            const float x = dot(cacheNormal.xyz, direction);
+            float legendre = 1.0, previous = 0.0, w = 0.0;
+            [[unroll]] for (uint l = 0u; l < kBandsY; ++l) {
+                w += PIC_SH_TABLE(sh.clampedCosine, l) * cone[l] * (float(2u * l + 1u) / (4.0 * kPi)) *
+                     legendre;
+                const float next = (float(2u * l + 1u) * x * legendre - float(l) * previous) *
+                                   (1.0 / float(l + 1u));
+                previous = legendre;
+                legendre = next;
+            }
+            alongNormal += radiance * (visible * w);
+        }
         float basis[64];
-        shEvaluate(decodeOctahedral9(link.directionAndGreen), basis);
+        shEvaluate(direction, basis);
         [[unroll]] for (uint i = 0u; i < kCountY; ++i) {
             const float w = visible * cone[kShBandOf[i]] * basis[i];
             y[i] += radiance.x * w;
@@ -114,10 +137,12 @@ void addLink(uint slot) {
     } else {
         // SH-projected links: the node, its tint, its box point, then lY² half coefficients
         // two per word, scaled by π·A at upload to take the node's radiance; chroma takes the
-        // first lC².
+        // first lC². The half after them is the link's irradiance along a light-map cache's
+        // normal (0 for grid caches).
         if (words[0] == kNoNode) return;
         const vec3 radiance = linkRadiance(words[0], decodeLinkTint(words[1]), words[2],
                                            concentrationWeightOf(words[2] >> 24u));
+        alongNormal += radiance * unpackHalf2x16(words[3u + kCountY / 2u])[kCountY % 2u];
         [[unroll]] for (uint p = 0u; p < kShPairs; ++p) {
             const vec2 pair = unpackHalf2x16(words[3u + p]);
             [[unroll]] for (uint h = 0u; h < 2u; ++h) {
@@ -144,6 +169,7 @@ void store(uint local) {
         cg[0] = raised.z;
     }
     const uint cache = pc.firstCache + local;
+    cacheIrradiance[cache] = vec4(max(yCoCgToRgb(alongNormal), vec3(0.0)), 0.0);
     [[unroll]] for (uint i = 0u; i < kCountY; ++i) cacheY[cache * kCountY + i] = toHalf(y[i]);
     [[unroll]] for (uint i = 0u; i < kCountC; ++i) {
         cacheCo[cache * kCountC + i] = toHalf(co[i]);
@@ -151,7 +177,9 @@ void store(uint local) {
     }
 }
 
-void clear() {
+void clear(uint local) {
+    cacheNormal = unpackSnorm4x8(texelFetch(cacheNormals, int(pc.firstCache + local)).x);
+    alongNormal = vec3(0.0);
     [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = 0.0;
     [[unroll]] for (uint i = 0u; i < kCountC; ++i) { co[i] = 0.0; cg[i] = 0.0; }
 }
@@ -160,7 +188,7 @@ void main() {
     if (kMapping == kCachePerInvocation) {
         const uint local = gl_GlobalInvocationID.x;  // cache within the chunk
         if (local >= pc.cacheCount) return;
-        clear();
+        clear(local);
         for (uint j = 0u; j < kLinksPerCache; ++j) addLink(local * kLinksPerCache + j);
         store(local);
     } else {
@@ -170,9 +198,10 @@ void main() {
         const uint stride = gl_NumWorkGroups.x * gl_NumSubgroups;
         for (uint local = gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID; local < pc.cacheCount;
              local += stride) {
-            clear();
+            clear(local);
             for (uint j = gl_SubgroupInvocationID; j < kLinksPerCache; j += gl_SubgroupSize)
                 addLink(local * kLinksPerCache + j);
+            alongNormal = subgroupAdd(alongNormal);
             [[unroll]] for (uint i = 0u; i < kCountY; ++i) y[i] = subgroupAdd(y[i]);
             [[unroll]] for (uint i = 0u; i < kCountC; ++i) {
                 co[i] = subgroupAdd(co[i]);

@@ -2,8 +2,9 @@
 // Surfel lighting (paper 000 Figure 2 step 2): each leaf surfel's outgoing flux in W per RGB
 // channel. Direct mode: Φ = ρ·A·Σ E_light·V + π·L_e·A·emissiveScale, V from the shadow maps
 // or, in the rays mode, one bit per surfel and light traced on the host (RayVisibilityPass);
-// bounce mode: Φ = Φ_direct + ρ·A·max(0, E) with E the irradiance the previous bounce's caches
-// deliver at the surfel (its precomputed interpolation stencil), plus on the last bounce
+// bounce mode: Φ = Φ_direct + ρ·A·E with E the irradiance the previous bounce's caches deliver
+// at the surfel (its precomputed interpolation stencil: light-map caches on its surface through
+// their irradiance along their normal, others through their SH, cut at 0), plus on the last bounce
 // tail·max(Φ − Φ_previous, 0), the light of the bounces not computed (render/runtime.h
 // BounceSchedule). Each workgroup also writes
 // its summed flux for the progressive stop, in one of two slots so that consecutive passes
@@ -47,6 +48,8 @@ layout(std430, binding = 12) writeonly buffer GroupFlux { vec4 groupFlux[]; };
 layout(binding = 13) uniform usamplerBuffer visibility;
 layout(std430, binding = 14) writeonly buffer NodeLight { uvec4 nodeLight[]; };  // leaves (shared/pull.h)
 layout(binding = 15) uniform samplerBuffer directFluxTexels;  // binding 5, read by the bounce
+// Per cache: RGB irradiance along a light-map cache's normal (cache lighting writes it).
+layout(binding = 16) uniform samplerBuffer cacheIrradiance;
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
@@ -81,18 +84,24 @@ void main() {
                    (kPi * surfel.area * texelFetch(emissiveScale, int(surfel.material)).x) * surfel.emission;
             directFlux[i] = vec4(flux, 0.0);
         } else {
-            // Interpolate the previous bounce's caches in YCoCg, then convolve with the
-            // clamped cosine about the normal.
+            // Light-map caches on the surfel's surface (negative stencil weights) give their
+            // irradiance along their normal; the others are interpolated in YCoCg, then
+            // convolved with the clamped cosine about the surfel's normal.
             const SurfelStencil s = fetchStencil(stencilTexels, i);
             float y[kCountY];
             float co[kCountC];
             float cg[kCountC];
             [[unroll]] for (uint c = 0u; c < kCountY; ++c) y[c] = 0.0;
             [[unroll]] for (uint c = 0u; c < kCountC; ++c) { co[c] = 0.0; cg[c] = 0.0; }
+            vec3 alongNormal = vec3(0.0);
             [[unroll]] for (uint k = 0u; k < 8u; ++k) {
                 const float w = k < 4u ? s.weightLow[k] : s.weightHigh[k - 4u];
                 if (w == 0.0) continue;
                 const uint cache = k < 4u ? s.cacheLow[k] : s.cacheHigh[k - 4u];
+                if (w < 0.0) {
+                    alongNormal -= w * texelFetch(cacheIrradiance, int(cache)).xyz;
+                    continue;
+                }
                 [[unroll]] for (uint c = 0u; c < kCountY; ++c)
                     y[c] += w * texelFetch(cacheY, int(cache * kCountY + c)).x;
                 [[unroll]] for (uint c = 0u; c < kCountC; ++c) {
@@ -117,7 +126,7 @@ void main() {
                 }
             }
             // SH ringing can make irradiance negative on the dark side; cut at zero per channel.
-            const vec3 irradiance = max(yCoCgToRgb(e), vec3(0.0));
+            const vec3 irradiance = alongNormal + max(yCoCgToRgb(e), vec3(0.0));
             flux = texelFetch(directFluxTexels, int(i)).xyz + surfel.albedo * (surfel.area * irradiance);
             // The light of the bounces not computed (BounceSchedule); tail is 0 but on the last.
             flux += pc.tail.xyz * max(flux - nodeFlux[i].xyz, vec3(0.0));

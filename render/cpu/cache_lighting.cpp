@@ -5,6 +5,7 @@
 #include <cstring>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <type_traits>
 
 #include <glm/gtc/matrix_access.hpp>
@@ -82,8 +83,9 @@ struct CacheSh {
     std::array<float, kCountY> y{};
     std::array<float, kCountY> co{};  // only the first lC² are used
     std::array<float, kCountY> cg{};
+    glm::vec3 alongNormal{0.0f};  // YCoCg irradiance along a light-map cache's normal
 
-    /// Stores cache c (lC² chroma coefficients) into out. Band 0 of each RGB channel is that
+    /// Stores cache c (lC² chroma coefficients, and its irradiance along its normal) into out. Band 0 of each RGB channel is that
     /// channel's mean radiance, a sum of non-negative fluxes; where they cancel to nothing,
     /// the spread's and YCoCg's rounding can leave a channel a few ulps below 0, which is
     /// raised to 0 (shaders/cache_lighting.comp does the same).
@@ -105,6 +107,8 @@ struct CacheSh {
             dstCo[i] = co[i];
             dstCg[i] = cg[i];
         }
+        // A sum of non-negative terms but for YCoCg's rounding, as band 0 above.
+        out.irradiance[c] = glm::max(yCoCgToRgb(alongNormal), glm::vec3(0.0f));
     }
 };
 
@@ -164,6 +168,7 @@ void lightCachesSh(const BakeData& bake, std::span<const NodeLight> light, const
                 if (node == kNoNode) continue;
                 const glm::vec3 flux = linkFlux(light[node], links.tint[slot], table.points[slot],
                                                 table.concentrationWeight[slot]);
+                sh.alongNormal += flux * table.irradiance[slot];
                 const uint16_t* coefficients = links.shCoefficients.data() + slot * countY;
                 // Luma takes all lY² coefficients, chroma the low lC² only (paper 000 §4.8).
                 for (int i = 0; i < countY; ++i) {
@@ -195,6 +200,7 @@ void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, cons
         [&, bandsC](size_t c) {
             alignas(32) std::array<std::array<float, kLinkBlock>, 3> flux;  // Y, Co, Cg
             LinkLanes sumY[countY] = {}, sumCo[countY] = {}, sumCg[countY] = {};
+            LinkLanes alongNormal[3] = {};  // Y, Co, Cg
             const size_t end = (c + 1) * nL;
             for (size_t begin = c * nL; begin < end; begin += kLinkBlock) {
                 const size_t count = std::min(kLinkBlock, end - begin);
@@ -224,6 +230,10 @@ void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, cons
                                             loadLanes(&table.directions[2][slot]), basis);
                     const LinkLanes fluxY = loadLanes(&flux[0][j]), fluxCo = loadLanes(&flux[1][j]),
                                     fluxCg = loadLanes(&flux[2][j]);
+                    const LinkLanes e = loadLanes(&table.irradiance[slot]);
+                    alongNormal[0] += fluxY * e;
+                    alongNormal[1] += fluxCo * e;
+                    alongNormal[2] += fluxCg * e;
                     for (int l = 0; l < BandsY; ++l) {
                         const LinkLanes w = loadLanes(&table.weights[size_t(l) * nLinks + slot]);
                         const LinkLanes y = fluxY * w;
@@ -245,6 +255,8 @@ void lightCachesRtp(const BakeData& bake, std::span<const NodeLight> light, cons
                     sh.co[i] += sumCo[i][k];
                     sh.cg[i] += sumCg[i][k];
                 }
+            for (int i = 0; i < 3; ++i)
+                for (size_t k = 0; k < kLinkLanes; ++k) sh.alongNormal[i] += alongNormal[i][k];
             sh.store(c, shCount(bandsC), out);
         },
         kCacheGrain);
@@ -265,6 +277,8 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
     PIC_CHECK_EQ((rtp ? links.rtp.size() : links.shNodes.size()), links.tint.size());
     table.points.resize(links.tint.size());
     table.concentrationWeight.resize(links.tint.size());
+    // kLinkLanes zeros past the end, as `weights`, for the RTP kernel's last short block.
+    table.irradiance.assign(links.tint.size() + kLinkLanes, 0.0f);
     parallelFor(
         0, links.tint.size(),
         [&](size_t slot) {
@@ -275,6 +289,7 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
             // Through the code the GPU's links carry, so both backends read the same point.
             table.points[slot] = decodeBoxPoint(encodeBoxPoint(spread, node, offset));
             table.concentrationWeight[slot] = 1.0f - decodeSpreadShare(links.spreadShare[slot]);
+            table.irradiance[slot] = linkIrradiance(bake, slot);
         },
         4096);
     if (!rtp) return table;
@@ -296,6 +311,38 @@ LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread) {
         },
         1024);
     return table;
+}
+
+float linkIrradiance(const BakeData& bake, size_t slot) {
+    const LinkSet& links = bake.links;
+    const Cache& cache = bake.caches[slot / links.linksPerCache];
+    if (cache.kind != gpu::kCacheKindLightmap) return 0.0f;
+    const glm::vec3& normal = cache.normal;
+    const int bandsY = int(bake.params.bandsY);
+    if (links.mode == LinkMode::Rtp) {
+        // The cone's projection factor·K_l(α)·y_lm(d) convolved with the clamped cosine at n:
+        // Σ_m y_lm(d)·y_lm(n) = (2l + 1)/(4π)·P_l(n·d) (the addition theorem).
+        const RtpLink& link = links.rtp[slot];
+        const double x = glm::dot(normal, decodeOctahedral(link.directionOct));
+        std::array<double, kMaxShBands> cone;
+        coneZonalBands(bandsY, double(link.oneMinusCosAlpha), cone.data());
+        double sum = 0.0, legendre = 1.0, previous = 0.0;  // P_l(x), P_{l−1}(x)
+        for (int l = 0; l < bandsY; ++l) {
+            sum += double(clampedCosineZonal(l)) * cone[l] * (2 * l + 1) / (4.0 * std::numbers::pi) * legendre;
+            const double next = ((2 * l + 1) * x * legendre - l * previous) / (l + 1);
+            previous = legendre;
+            legendre = next;
+        }
+        return float(double(link.factor) * sum);
+    }
+    float basis[shCount(kMaxShBands)];
+    shEvaluate(bandsY, normal, basis);
+    const uint16_t* coefficients = links.shCoefficients.data() + slot * size_t(shCount(bandsY));
+    float sum = 0.0f;
+    for (int l = 0; l < bandsY; ++l)
+        for (int i = l * l; i < (l + 1) * (l + 1); ++i)
+            sum += clampedCosineZonal(l) * halfToFloat(coefficients[i]) * basis[i];
+    return sum;
 }
 
 void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,
@@ -331,11 +378,13 @@ void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const L
     const size_t nC = bake.caches.size();
     if (out.bandsY != bandsY || out.bandsC != bandsC || out.cacheCount() != nC)
         out = CacheValues::zeros(nC, bandsY, bandsC);
+    out.irradiance.resize(nC);
 
     const size_t nLinks = nC * bake.links.linksPerCache;
     PIC_CHECK_EQ(bake.links.tint.size(), nLinks);
     PIC_CHECK_EQ(table.bands, bandsY);
     PIC_CHECK_EQ(table.points.size(), nLinks);
+    PIC_CHECK_EQ(table.irradiance.size(), nLinks + kLinkLanes);
     if (bake.links.mode == LinkMode::Sh) {
         PIC_CHECK_EQ(bake.links.bands, bandsY);
         PIC_CHECK_EQ(bake.links.shNodes.size(), nLinks);

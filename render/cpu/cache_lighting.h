@@ -32,7 +32,18 @@ struct LinkTable {
     std::array<std::vector<float>, 3> directions;
     /// RTP: band weights factor·K_l(α) of link j in band l at l·nC·nL + j; 0 for padding.
     std::vector<float> weights;
+    /// nC·nL (and kLinkLanes zeros past the end): linkIrradiance of every link.
+    std::vector<float> irradiance;
 };
+
+/// What link `slot` of `bake` adds to its cache's irradiance along the cache's normal n per
+/// unit of its node's flux (LinkTable::irradiance): the link's lY-band projection convolved
+/// with the clamped cosine at n, Σ_l K_l·Σ_m c_lm·y_lm(n) — for an RTP link's cone
+/// factor·Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d) by the addition theorem. The luma's irradiance
+/// from the same links, so that no colour loses the chroma's higher bands; 0 for a grid cache's
+/// links, which have no normal. (The cone's exact clamped cosine read 1–2 % more light than
+/// these bands in the white rooms, and the path tracer sided with the bands.)
+float linkIrradiance(const BakeData& bake, size_t slot);
 
 /// Unpacks the links of `bake` for its lY bands, their offsets in the boxes of `spread`
 /// (nodeSpread(bake)).
@@ -69,7 +80,9 @@ void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3>
 ///             (core/sh.h shAddCone), from the unpacked table; Y to lY bands, Co and Cg to lC
 ///             bands.
 /// Padding links contribute nothing. Nothing is clamped: radiance is as linear as the flux,
-/// and the limited spread is ≥ 0 over every node's box. `table` must be unpackLinks(bake, ·).
+/// and the limited spread is ≥ 0 over every node's box. `out.irradiance` takes every cache's
+/// Σ_links Φ_link·LinkTable::irradiance (0 for grid caches). `table` must be
+/// unpackLinks(bake, ·).
 void lightCaches(const BakeData& bake, std::span<const NodeLight> light, const LinkTable& table,
                  CacheValues& out);
 

@@ -16,6 +16,10 @@ constexpr float kPi = std::numbers::pi_v<float>;
 /// Surfels per task: a surfel costs one shadow ray per light or one cache lookup.
 constexpr size_t kSurfelGrain = 256;
 
+/// A light-map cache lies on a surfel's own surface where their normals are within 25°: its
+/// irradiance along its normal is then what the surfel receives (surfelStencils).
+constexpr float kSameSurfaceCos = 0.9f;
+
 /// E_light·V at `surfel`: the light's irradiance there, or zero where the surfel faces away,
 /// lies outside the cone or range (no ray is cast) or the ray to the light is occluded. Rays
 /// start just above the surface so that they do not hit the surfel's own triangle.
@@ -101,12 +105,19 @@ std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& 
             total += all.weight[k];
             ++seen.count;
         }
+        CacheStencil& out = stencils[i];
         if (seen.count == all.count || seen.count == 0 || !(total > 0.0f)) {
-            stencils[i] = all;
-            return;
+            out = all;
+        } else {
+            for (int k = 0; k < seen.count; ++k) seen.weight[k] /= total;
+            out = seen;
         }
-        for (int k = 0; k < seen.count; ++k) seen.weight[k] /= total;
-        stencils[i] = seen;
+        for (int k = 0; k < out.count; ++k) {
+            const Cache& cache = bake.caches[out.cache[k]];
+            if (cache.kind == gpu::kCacheKindLightmap &&
+                glm::dot(cache.normal, surfel.normal) >= kSameSurfaceCos)
+                out.alongNormal |= uint8_t(1u << k);
+        }
     }, kSurfelGrain / 4);
     return stencils;
 }
@@ -119,13 +130,31 @@ void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stenci
     PIC_CHECK_EQ(surfelFlux.size(), bake.surfels.size());
     PIC_CHECK(directFlux.data() != surfelFlux.data());
 
+    const bool alongNormal = !previousBounce.irradiance.empty();
+    PIC_CHECK(!alongNormal || previousBounce.irradiance.size() == bake.caches.size());
     parallelFor(0, bake.surfels.size(), [&](size_t i) {
         const Surfel& surfel = bake.surfels[i];
-        const RadianceSh radiance = blendCaches(previousBounce, stencils[i]);
+        CacheStencil sh = stencils[i];
+        glm::vec3 e(0.0f);
+        if (alongNormal && sh.alongNormal) {
+            // Caches on the surfel's surface give their irradiance along its normal; the
+            // others, if any, their SH at the surfel's normal.
+            int kept = 0;
+            for (int k = 0; k < sh.count; ++k) {
+                if (sh.alongNormal & (1u << k)) {
+                    e += sh.weight[k] * previousBounce.irradiance[sh.cache[k]];
+                } else {
+                    sh.cache[kept] = sh.cache[k];
+                    sh.weight[kept++] = sh.weight[k];
+                }
+            }
+            sh.count = kept;
+        }
         // Truncated SH ring: the clamped-cosine convolution can dip below zero on the dark
         // side of a bright cache. Irradiance is never negative, and negative flux would carry
         // negative light into the next bounce, so it is cut at zero.
-        const glm::vec3 e = glm::max(irradiance(radiance, surfel.normal), glm::vec3(0.0f));
+        if (sh.count > 0)
+            e += glm::max(irradiance(blendCaches(previousBounce, sh), surfel.normal), glm::vec3(0.0f));
         const glm::vec3 flux = directFlux[i] + surfel.albedo * (surfel.area * e);
         surfelFlux[i] = flux + tail * glm::max(flux - surfelFlux[i], glm::vec3(0.0f));
     }, kSurfelGrain);

@@ -43,13 +43,19 @@ void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light
 /// texels and trilinear grid vertices otherwise reach through a thin wall: a floor that runs
 /// under a partition interpolates the texels on its far side, and surfels there re-emit the
 /// other room's light at every bounce. One ray per stencil entry, computed once per bake.
+/// Light-map caches whose normal is within 25° of the surfel's are marked
+/// (CacheStencil::alongNormal): the bounce reads their irradiance along their normal.
 std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& rays,
                                          const BakeData& bake);
 
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
 /// irradiance that the caches of `previousBounce` deliver at the surfel through its stencil
-/// (surfelStencils; clamped-cosine about its normal), per channel cut at zero where SH
-/// ringing makes it negative. `surfelFlux` holds the previous bounce's flux S on entry; with a
+/// (surfelStencils): the marked light-map caches' irradiance along their normal
+/// (CacheValues::irradiance, when `previousBounce` has it), the others' SH convolved with the
+/// clamped cosine about the surfel's normal, per channel cut at zero where SH ringing makes it
+/// negative. Through the SH alone the chroma's lC = 2 bands bent the colour of light that
+/// arrives from another direction than most of the light (opposite_colors: the far lamp's
+/// colour 5–10 % too strong on the walls two bounces on). `surfelFlux` holds the previous bounce's flux S on entry; with a
 /// `tail` (BounceSchedule: the light of the bounces not computed) each surfel's new flux S'
 /// becomes S' + tail·max(S' − S, 0), per channel.
 /// `stencils`, `directFlux` and `surfelFlux` hold nS entries; the last two may not alias.

@@ -5,8 +5,11 @@
 #include <cmath>
 #include <numbers>
 
+#include <glm/gtc/packing.hpp>
+
 #include "core/color.h"
 #include "core/parallel.h"
+#include "render/cpu/cache_lighting.h"
 #include "shaders/shared/cache_lighting.h"
 #include "spirv/cache_lighting_comp.h"
 
@@ -18,7 +21,7 @@ namespace {
 constexpr uint32_t kChunkAlignment = 256;
 
 /// Node light, links, caches Y, Co, Cg, SH tables.
-constexpr uint32_t kBindingCount = 6;
+constexpr uint32_t kBindingCount = 8;
 
 /// The uint texel format of `words` 32-bit components.
 VkFormat uintTexelFormat(uint32_t words) {
@@ -126,7 +129,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
     layout.bindings.assign(kBindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     layout.bindings[0] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // node light
     layout.bindings[1] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // links
-    layout.bindings[kBindingCount - 1] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;  // SH tables
+    layout.bindings[5] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;                  // SH tables
+    layout.bindings[6] = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;            // cache normals
     layout.pushBytes = sizeof(CacheLightingPush);
     layout.specialization = {bake.params.bandsY,
                              bake.params.bandsC,
@@ -174,11 +178,26 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 for (uint32_t i = 0; i < countY; ++i)
                     record[3 + i / 2] |= uint32_t(radianceShCoefficient(coefficients[i], area))
                                          << (16 * (i % 2));
+                // The half after the coefficients (shLinkWords leaves room): the link's
+                // irradiance along a light-map cache's normal, also per unit of radiance.
+                if (node != kNoNode)
+                    record[3 + countY / 2] |=
+                        uint32_t(floatToHalfClamped(float(double(linkIrradiance(bake, slot)) * std::numbers::pi * double(area))))
+                        << (16 * (countY % 2));
             },
             4096);
         PIC_TRY_ASSIGN(pass->mLinks, Buffer::createWith(context, std::span<const uint32_t>(sh),
                                                         kTexels, "SH links"));
     }
+    // Light-map caches' normals for the irradiance along them; grid caches have none (w 0).
+    std::vector<uint32_t> normals(bake.caches.size(), 0u);
+    for (size_t c = 0; c < normals.size(); ++c)
+        if (bake.caches[c].kind == kCacheKindLightmap)
+            normals[c] = glm::packSnorm4x8(glm::vec4(bake.caches[c].normal, 1.0f));
+    PIC_TRY_ASSIGN(pass->mNormals, Buffer::createWith(context, std::span<const uint32_t>(normals),
+                                                      kTexels, "cache normals"));
+    PIC_TRY_ASSIGN(pass->mNormalView, TexelView::create(context, pass->mNormals,
+                                                        VK_FORMAT_R32_UINT, "cache normals"));
     pass->mLinkBytes = nLinks * linkWords * sizeof(uint32_t);
     const VkFormat format = uintTexelFormat(pass->mTexelWords);
     const VkDeviceSize texelBytes = VkDeviceSize{pass->mTexelWords} * sizeof(uint32_t);
@@ -194,7 +213,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
 
 Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeLight,
                                      const Buffer& cacheY, const Buffer& cacheCo,
-                                     const Buffer& cacheCg, const Buffer& shTables) {
+                                     const Buffer& cacheCg, const Buffer& cacheIrradiance,
+                                     const Buffer& shTables) {
     mSets.clear();
     PIC_TRY(mKernel.resetSets());
     PIC_TRY_ASSIGN(mRadianceView, TexelView::create(context, nodeLight, VK_FORMAT_R32G32B32A32_UINT,
@@ -204,6 +224,7 @@ Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeLight,
             BindingResource::texels(0, mRadianceView), BindingResource::texels(1, mLinkViews[k]),
             BindingResource::storage(2, cacheY),       BindingResource::storage(3, cacheCo),
             BindingResource::storage(4, cacheCg),      BindingResource::storage(5, shTables),
+            BindingResource::texels(6, mNormalView),   BindingResource::storage(7, cacheIrradiance),
         };
         PIC_TRY_ASSIGN(VkDescriptorSet set, mKernel.makeSet(resources));
         mSets.push_back(set);

@@ -32,8 +32,10 @@ uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 
 class CacheLightingPass {
 public:
-    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box point and
-    /// lY² half coefficients, radianceShCoefficient, in shLinkWords(lY²) words), their box
+    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box point,
+    /// lY² half coefficients, radianceShCoefficient, and the link's irradiance along a
+    /// light-map cache's normal (render/cpu/cache_lighting.h linkIrradiance) rescaled alike, in
+    /// shLinkWords(lY²) words) and the caches' normals, their box
     /// points in the boxes of `spread` (nodeSpread(bake)). Fails naming the count where the
     /// bake has more nodes than a GPU link addresses (2^24).
     /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
@@ -45,9 +47,11 @@ public:
                                                              bool cachePerSubgroup,
                                                              uint32_t maxTexelWords = 4);
     /// Binds the node light (4 words per node, shaders/shared/pull.h; its usage must allow
-    /// uniform texel buffers), the output caches (half) and the SH tables.
+    /// uniform texel buffers), the output caches (half), the output irradiance along the
+    /// light-map caches' normals (vec4 per cache, CacheValues::irradiance) and the SH tables.
     Result<void> bind(Context& context, const Buffer& nodeLight, const Buffer& cacheY,
-                      const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& shTables);
+                      const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& cacheIrradiance,
+                      const Buffer& shTables);
     void record(VkCommandBuffer cmd);
     /// Link bytes read per update.
     VkDeviceSize linkBytes() const { return mLinkBytes; }
@@ -68,6 +72,8 @@ private:
     uint32_t mTexelWords = 1;
     Buffer mLinks;            ///< RTP: GpuRtpLink per link; SH: shLinkWords(lY²) words per link
     TexelView mRadianceView;  ///< node radiance as uint texels
+    Buffer mNormals;          ///< per cache: packSnorm4x8(normal, 1) (light map) or 0 (grid)
+    TexelView mNormalView;
     std::vector<TexelView> mLinkViews;  ///< per chunk: its links, mTexelWords words per texel
     std::vector<uint32_t> mChunkFirst;
     std::vector<uint32_t> mChunkCount;

@@ -11,11 +11,11 @@
 namespace pic::gpu {
 namespace {
 
-constexpr uint32_t kBindingCount = 16;
+constexpr uint32_t kBindingCount = 17;
 constexpr uint32_t kSamplerBinding = 4;
 constexpr uint32_t kShTablesBinding = 11;
 /// Bindings read as uniform texel buffers (shaders/surfel_lighting.comp says why).
-constexpr std::array<uint32_t, 9> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15};
+constexpr std::array<uint32_t, 10> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15, 16};
 constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 
 }  // namespace
@@ -66,12 +66,15 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
         SurfelStencil& out = records[i];
         out = SurfelStencil{};
         for (int k = 0; k < s.count; ++k) {
+            // A negative weight reads the cache's irradiance along its normal
+            // (CacheStencil::alongNormal), a positive one its SH.
+            const float weight = (s.alongNormal & (1u << k)) ? -s.weight[k] : s.weight[k];
             if (k < 4) {
                 out.cacheLow[k] = s.cache[k];
-                out.weightLow[k] = s.weight[k];
+                out.weightLow[k] = weight;
             } else {
                 out.cacheHigh[k - 4] = s.cache[k];
-                out.weightHigh[k - 4] = s.weight[k];
+                out.weightHigh[k - 4] = weight;
             }
         }
     }, 1024);
@@ -119,7 +122,8 @@ Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
 Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
     const bool rays = mVisibility == DirectVisibility::Rays;
     PIC_CHECK(rays ? r.rays != nullptr : r.shadows != nullptr);
-    PIC_CHECK(r.nodeFlux && r.nodeRadiance && r.cacheY && r.cacheCo && r.cacheCg && r.shTables);
+    PIC_CHECK(r.nodeFlux && r.nodeRadiance && r.cacheY && r.cacheCo && r.cacheCg &&
+              r.cacheIrradiance && r.shTables);
     PIC_TRY(mDirect.resetSets());
     PIC_TRY(mBounce.resetSets());
     const Buffer& lights = rays ? r.rays->lightBuffer() : r.shadows->lightBuffer();
@@ -133,6 +137,8 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         PIC_TRY_ASSIGN(mCacheViews[c],
                        TexelView::create(mContext, *caches[c], VK_FORMAT_R16_SFLOAT, "caches"));
     }
+    PIC_TRY_ASSIGN(mIrradianceView, TexelView::create(mContext, *r.cacheIrradiance,
+                                                      VK_FORMAT_R32G32B32A32_SFLOAT, "irradiance"));
     const std::array<BindingResource, kBindingCount> resources = {
         BindingResource::texels(0, mSurfelView),
         BindingResource::texels(1, mLightView),
@@ -151,6 +157,7 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         BindingResource::texels(13, mVisibilityView),
         BindingResource::storage(14, *r.nodeRadiance),
         BindingResource::texels(15, mDirectFluxView),
+        BindingResource::texels(16, mIrradianceView),
     };
     PIC_TRY_ASSIGN(mDirectSet, mDirect.makeSet(resources));
     PIC_TRY_ASSIGN(mBounceSet, mBounce.makeSet(resources));

@@ -50,6 +50,7 @@ struct SurfelLightingResources {
     const Buffer* cacheY = nullptr;      ///< half, nC·lY²: the previous bounce
     const Buffer* cacheCo = nullptr;     ///< half, nC·lC²
     const Buffer* cacheCg = nullptr;     ///< half, nC·lC²
+    const Buffer* cacheIrradiance = nullptr;  ///< vec4 per cache (CacheValues::irradiance)
     const Buffer* shTables = nullptr;    ///< ShTables
 };
 
@@ -107,6 +108,7 @@ private:
     TexelView mLightView;
     TexelView mVisibilityView;
     std::array<TexelView, 3> mCacheViews;  ///< Y, Co, Cg
+    TexelView mIrradianceView;             ///< CacheValues::irradiance, RGBA32F
 };
 
 }  // namespace pic::gpu

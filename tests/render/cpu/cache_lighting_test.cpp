@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <array>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -177,6 +178,70 @@ TEST(CacheLighting, RtpLinksSumInLanesAsOneByOne) {
             EXPECT_NEAR(values.cg[c * 4 + i], expectedCg[c * 4 + i], 1e-5f * scale)
                 << "cache " << c << " Cg " << i;
         }
+    }
+}
+
+TEST(CacheLighting, EveryColourReachesTheIrradianceAlongTheNormalThroughTheLumasBands) {
+    // A light-map cache facing +z and a grid cache, 40 random links each in both link forms,
+    // red, green and blue light from different directions (tints): the light-map cache's
+    // irradiance along its normal is, per RGB channel, the clamped-cosine convolution of its
+    // links' lY-band projections; the grid cache's is 0. Through the stored SH, whose chroma
+    // keeps lC = 2 bands, the colours come out bent.
+    const uint32_t bandsY = 3, bandsC = 2, nL = 40, surfels = 3;
+    const glm::vec3 normal(0.0f, 0.0f, 1.0f);
+    for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
+        BakeData bake = oneCacheBake(mode, bandsY, bandsC, nL, surfels, 2);
+        bake.caches[0].kind = gpu::kCacheKindLightmap;
+        bake.caches[0].normal = normal;
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> unit(0.0f, 1.0f), signedUnit(-1.0f, 1.0f);
+        std::vector<glm::vec3> nodeFlux(bake.nodes.size(), glm::vec3(2.0f));
+        const glm::vec3 tints[3] = {{1.0f, 0.1f, 0.1f}, {0.1f, 1.0f, 0.1f}, {0.1f, 0.1f, 1.0f}};
+        std::array<std::array<float, 9>, 3> rgbSh{};  // the light-map cache's, lY bands per channel
+        for (uint32_t slot = 0; slot < 2 * nL; ++slot) {
+            const uint32_t node = uint32_t(rng() % surfels);
+            const int colour = int(slot % 3);
+            // Each colour from its own side of the hemisphere.
+            const glm::vec3 direction = glm::normalize(
+                glm::vec3(float(colour - 1) + 0.3f * signedUnit(rng), 0.3f * signedUnit(rng),
+                          0.2f + unit(rng)));
+            const EncodedLinkTint tint = encodeLinkTint(tints[colour]);
+            bake.links.tint[slot] = tint.code;
+            std::array<float, 9> projection{};
+            if (mode == LinkMode::Rtp) {
+                const float factor = 0.2f + unit(rng), u = 0.02f + 0.5f * unit(rng);
+                bake.links.rtp[slot] = RtpLink{node, factor, encodeOctahedral(direction), u};
+                shAddCone(int(bandsY), decodeOctahedral(bake.links.rtp[slot].directionOct), u,
+                          factor, projection.data());
+            } else {
+                bake.links.shNodes[slot] = node;
+                shAddCone(int(bandsY), direction, 0.1f, 0.5f + unit(rng), projection.data());
+                for (int i = 0; i < 9; ++i) {
+                    bake.links.shCoefficients[slot * 9 + i] = floatToHalf(projection[i]);
+                    projection[i] = halfToFloat(bake.links.shCoefficients[slot * 9 + i]);
+                }
+            }
+            if (slot >= nL) continue;  // the grid cache's
+            const glm::vec3 rgb = nodeFlux[node] * decodeLinkTint(tint.code);
+            for (int c = 0; c < 3; ++c)
+                for (int i = 0; i < 9; ++i) rgbSh[c][i] += rgb[c] * projection[i];
+        }
+        CacheValues values;
+        lightCaches(bake, nodeFlux, values);
+        ASSERT_EQ(values.irradiance.size(), 2u);
+        EXPECT_EQ(values.irradiance[1], glm::vec3(0.0f));
+        CacheStencil one;
+        one.count = 1;
+        one.weight[0] = 1.0f;
+        const glm::vec3 throughSh = irradiance(blendCaches(values, one), normal);
+        float bent = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float expected = shIrradiance(int(bandsY), rgbSh[c].data(), normal);
+            EXPECT_NEAR(values.irradiance[0][c], expected, 1e-4f * expected)
+                << "channel " << c << (mode == LinkMode::Rtp ? " rtp" : " sh");
+            bent = std::max(bent, std::abs(throughSh[c] / expected - 1.0f));
+        }
+        EXPECT_GT(bent, 0.01f) << "the stored SH should bend some colour by more than 1 %";
     }
 }
 

@@ -230,6 +230,48 @@ TEST(SurfelLighting, BounceAddsAlbedoAreaTimesCacheIrradiance) {
     EXPECT_EQ(bounced[0], combined[0]);
 }
 
+TEST(SurfelLighting, BounceReadsCachesOnItsSurfaceThroughTheirIrradianceAlongTheNormal) {
+    // Two caches of constant grey radiance L (SH irradiance π·L) whose irradiance along their
+    // normal says E_0 and E_1 instead: a stencil entry marked alongNormal adds its weight times
+    // E_k, an unmarked one its weight times π·L; without irradiance every entry reads the SH.
+    Scene scene = floorScene();
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    BakeData bake = oneSurfelBake({0.3f, 0.0f, -0.2f});
+    bake.params.bandsY = 3;
+    bake.params.bandsC = 2;
+    bake.caches.resize(2);
+    CacheValues values = CacheValues::zeros(2, 3, 2);
+    const double radiance = 0.75;
+    for (int c = 0; c < 2; ++c) values.y[size_t(c) * 9] = float(radiance * 2.0 * std::sqrt(kPi));
+    values.irradiance = {glm::vec3(1.0f, 2.0f, 3.0f), glm::vec3(0.5f, 0.0f, 4.0f)};
+    CacheStencil stencil;
+    stencil.count = 2;
+    stencil.cache[0] = 0, stencil.cache[1] = 1;
+    stencil.weight[0] = 0.25f, stencil.weight[1] = 0.75f;
+    const std::vector<glm::vec3> direct = {glm::vec3(0.1f)};
+    const glm::dvec3 albedoArea = glm::dvec3(0.5, 0.25, 0.8) * 0.01;  // oneSurfelBake's ρ·A
+    const glm::dvec3 sh(kPi * radiance);
+    const auto bounce = [&](uint8_t alongNormal, const CacheValues& from) {
+        stencil.alongNormal = alongNormal;
+        std::vector<glm::vec3> out(1);
+        bounceSurfelFlux(bake, std::span<const CacheStencil>(&stencil, 1), direct, from, out);
+        return out[0];
+    };
+    expectVecNear(bounce(0, values), glm::dvec3(direct[0]) + albedoArea * sh, 1e-5);
+    expectVecNear(bounce(3, values),
+                  glm::dvec3(direct[0]) + albedoArea * (0.25 * glm::dvec3(values.irradiance[0]) +
+                                                        0.75 * glm::dvec3(values.irradiance[1])),
+                  1e-5);
+    expectVecNear(bounce(2, values),
+                  glm::dvec3(direct[0]) +
+                      albedoArea * (0.25 * sh + 0.75 * glm::dvec3(values.irradiance[1])),
+                  1e-5);
+    CacheValues shOnly = values;
+    shOnly.irradiance.clear();
+    expectVecNear(bounce(3, shOnly), glm::dvec3(direct[0]) + albedoArea * sh, 1e-5);
+}
+
 TEST(SurfelLighting, ASurfelsStencilLeavesOutTheCachesBehindAWall) {
     // A one-cell grid over the floor: vertices at x = −1 hold cache 0, at x = +1 cache 1, so a
     // surfel at x = 0.2 reads them 0.4 : 0.6. A wall at x = 0.5 standing on the floor hides

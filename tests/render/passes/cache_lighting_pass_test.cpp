@@ -127,6 +127,16 @@ TEST_P(GpuCacheLighting, MatchesTheCpuTwinWithinOnePercent) {
     ASSERT_EQ(values->bandsC, bandsC);
     EXPECT_LE(test::relativeL2(*values, cpu), 0.01);
     EXPECT_GT(test::relativeL2(cpu, CacheValues::zeros(cpu.cacheCount(), bandsY, bandsC)), 0.0);
+    // The irradiance along the light-map caches' normals (the bounce's), to the same 1 %.
+    ASSERT_EQ(values->irradiance.size(), cpu.irradiance.size());
+    double difference = 0.0, norm = 0.0;
+    for (size_t c = 0; c < cpu.irradiance.size(); ++c) {
+        const glm::dvec3 d = glm::dvec3(values->irradiance[c]) - glm::dvec3(cpu.irradiance[c]);
+        difference += glm::dot(d, d);
+        norm += glm::dot(glm::dvec3(cpu.irradiance[c]), glm::dvec3(cpu.irradiance[c]));
+    }
+    EXPECT_GT(norm, 0.0);
+    EXPECT_LE(std::sqrt(difference / norm), 0.01);
 }
 
 INSTANTIATE_TEST_SUITE_P(LinkFormsAndBands, GpuCacheLighting,
