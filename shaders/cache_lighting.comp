@@ -1,8 +1,9 @@
 #version 460
 // Cache lighting (paper 000 Figure 2 step 4, eq. 3): per cache, L = Σ over its nL links of
 // the node's radiance Φ / (π·A) (RGBE8, §4.7) times its transport, in YCoCg, Y with lY bands
-// and Co, Cg with lC bands, stored as half floats. The CPU twin (render/cpu/cache_lighting.cpp)
-// takes Φ times the bake's factor V / (π·A): the same product.
+// and Co, Cg with lC bands, stored as half floats; and a light-map cache's RGB irradiance
+// along its normal, every colour through the luma's lY bands, for the next bounce. The CPU twin
+// (render/cpu/cache_lighting.cpp) takes Φ times the bake's factor V / (π·A): the same product.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_shader_16bit_storage : require
@@ -110,13 +111,14 @@ void addLink(uint slot) {
         coneZonal(visibleAndCone.y, cone);
         const vec3 direction = decodeOctahedral9(link.directionAndGreen);
         if (cacheNormal.w > 0.0) {
-            // The cone's projection convolved with the clamped cosine at the cache's normal
-            // (render/cpu/cache_lighting.h linkIrradiance): Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d).
+            // The cone's projection convolved with the clamped cosine at the cache's normal,
+            // Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d) (render/cpu/cache_lighting.h
+            // linkIrradiance).
             const float x = dot(cacheNormal.xyz, direction);
             float legendre = 1.0, previous = 0.0, w = 0.0;
             [[unroll]] for (uint l = 0u; l < kBandsY; ++l) {
-                w += PIC_SH_TABLE(sh.clampedCosine, l) * cone[l] * (float(2u * l + 1u) / (4.0 * kPi)) *
-                     legendre;
+                const float band = float(2u * l + 1u) / (4.0 * kPi);
+                w += PIC_SH_TABLE(sh.clampedCosine, l) * cone[l] * band * legendre;
                 const float next = (float(2u * l + 1u) * x * legendre - float(l) * previous) *
                                    (1.0 / float(l + 1u));
                 previous = legendre;

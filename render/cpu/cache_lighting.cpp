@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numbers>
 #include <type_traits>
 
@@ -85,10 +85,10 @@ struct CacheSh {
     std::array<float, kCountY> cg{};
     glm::vec3 alongNormal{0.0f};  // YCoCg irradiance along a light-map cache's normal
 
-    /// Stores cache c (lC² chroma coefficients, and its irradiance along its normal) into out. Band 0 of each RGB channel is that
-    /// channel's mean radiance, a sum of non-negative fluxes; where they cancel to nothing,
-    /// the spread's and YCoCg's rounding can leave a channel a few ulps below 0, which is
-    /// raised to 0 (shaders/cache_lighting.comp does the same).
+    /// Stores cache c (lC² chroma coefficients, and its irradiance along its normal) into out. Band
+    /// 0 of each RGB channel is that channel's mean radiance, a sum of non-negative fluxes; where
+    /// they cancel to nothing, the spread's and YCoCg's rounding can leave a channel a few ulps
+    /// below 0, which is raised to 0 (shaders/cache_lighting.comp does the same).
     void store(size_t c, int countC, CacheValues& out) {
         const glm::vec3 band0 = yCoCgToRgb(glm::vec3(y[0], co[0], cg[0]));
         if (band0.r < 0.0f || band0.g < 0.0f || band0.b < 0.0f) {
@@ -328,7 +328,8 @@ float linkIrradiance(const BakeData& bake, size_t slot) {
         coneZonalBands(bandsY, double(link.oneMinusCosAlpha), cone.data());
         double sum = 0.0, legendre = 1.0, previous = 0.0;  // P_l(x), P_{l−1}(x)
         for (int l = 0; l < bandsY; ++l) {
-            sum += double(clampedCosineZonal(l)) * cone[l] * (2 * l + 1) / (4.0 * std::numbers::pi) * legendre;
+            sum += double(clampedCosineZonal(l)) * cone[l] * (2 * l + 1) /
+                   (4.0 * std::numbers::pi) * legendre;
             const double next = ((2 * l + 1) * x * legendre - l * previous) / (l + 1);
             previous = legendre;
             legendre = next;

@@ -154,7 +154,8 @@ void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stenci
         // side of a bright cache. Irradiance is never negative, and negative flux would carry
         // negative light into the next bounce, so it is cut at zero.
         if (sh.count > 0)
-            e += glm::max(irradiance(blendCaches(previousBounce, sh), surfel.normal), glm::vec3(0.0f));
+            e += glm::max(irradiance(blendCaches(previousBounce, sh), surfel.normal),
+                          glm::vec3(0.0f));
         const glm::vec3 flux = directFlux[i] + surfel.albedo * (surfel.area * e);
         surfelFlux[i] = flux + tail * glm::max(flux - surfelFlux[i], glm::vec3(0.0f));
     }, kSurfelGrain);

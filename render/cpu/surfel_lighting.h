@@ -55,10 +55,10 @@ std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& 
 /// clamped cosine about the surfel's normal, per channel cut at zero where SH ringing makes it
 /// negative. Through the SH alone the chroma's lC = 2 bands bent the colour of light that
 /// arrives from another direction than most of the light (opposite_colors: the far lamp's
-/// colour 5–10 % too strong on the walls two bounces on). `surfelFlux` holds the previous bounce's flux S on entry; with a
-/// `tail` (BounceSchedule: the light of the bounces not computed) each surfel's new flux S'
-/// becomes S' + tail·max(S' − S, 0), per channel.
-/// `stencils`, `directFlux` and `surfelFlux` hold nS entries; the last two may not alias.
+/// colour 5–10 % too strong on the walls two bounces on). `surfelFlux` holds the previous bounce's
+/// flux S on entry; with a `tail` (BounceSchedule: the light of the bounces not computed) each
+/// surfel's new flux S' becomes S' + tail·max(S' − S, 0), per channel. `stencils`, `directFlux` and
+/// `surfelFlux` hold nS entries; the last two may not alias.
 void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stencils,
                       std::span<const glm::vec3> directFlux, const CacheValues& previousBounce,
                       std::span<glm::vec3> surfelFlux, glm::vec3 tail = glm::vec3(0.0f));

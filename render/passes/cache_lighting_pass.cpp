@@ -182,7 +182,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
                 // irradiance along a light-map cache's normal, also per unit of radiance.
                 if (node != kNoNode)
                     record[3 + countY / 2] |=
-                        uint32_t(floatToHalfClamped(float(double(linkIrradiance(bake, slot)) * std::numbers::pi * double(area))))
+                        uint32_t(floatToHalfClamped(float(double(linkIrradiance(bake, slot)) *
+                                                          std::numbers::pi * double(area))))
                         << (16 * (countY % 2));
             },
             4096);
@@ -196,8 +197,8 @@ Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& co
             normals[c] = glm::packSnorm4x8(glm::vec4(bake.caches[c].normal, 1.0f));
     PIC_TRY_ASSIGN(pass->mNormals, Buffer::createWith(context, std::span<const uint32_t>(normals),
                                                       kTexels, "cache normals"));
-    PIC_TRY_ASSIGN(pass->mNormalView, TexelView::create(context, pass->mNormals,
-                                                        VK_FORMAT_R32_UINT, "cache normals"));
+    PIC_TRY_ASSIGN(pass->mNormalView,
+                   TexelView::create(context, pass->mNormals, VK_FORMAT_R32_UINT, "cache normals"));
     pass->mLinkBytes = nLinks * linkWords * sizeof(uint32_t);
     const VkFormat format = uintTexelFormat(pass->mTexelWords);
     const VkDeviceSize texelBytes = VkDeviceSize{pass->mTexelWords} * sizeof(uint32_t);

@@ -46,10 +46,12 @@ PIC_STRUCT_CHECK(GpuRtpLink, 16);
 PIC_CONST(uint, kGpuLinkNodeBits, 24u);
 
 // An SH-projected link as the GPU reads it: the node index, its tint (unorm10 as in the bake),
-// its box point | its spread share's code << 24, then its lY² binary16 coefficients (rescaled by π·A to take the node's
-// radiance) two per 32-bit word, the last word's high half zero when lY² is odd, and zero
-// words up to a multiple of 4, so that 2- or 4-word texels divide it: 8, 8, 12 words for
-// lY = 2, 3, 4.
+// its box point | its spread share's code << 24, then its lY² binary16 coefficients (rescaled
+// by π·A to take the node's radiance) two per 32-bit word, then one binary16 more, its
+// irradiance along a light-map cache's normal (render/cpu/cache_lighting.h linkIrradiance,
+// rescaled alike; 0 for grid caches), and zero words up to a multiple of 4, so that 2- or
+// 4-word texels divide it: 8, 8, 12 words for lY = 2, 3, 4 (a record always has room for the
+// extra half).
 #ifdef __cplusplus
 inline constexpr uint shLinkWords(uint countY) {
     return (3u + (countY + 1u) / 2u + 3u) / 4u * 4u;

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -202,9 +202,9 @@ TEST(CacheLighting, EveryColourReachesTheIrradianceAlongTheNormalThroughTheLumas
             const uint32_t node = uint32_t(rng() % surfels);
             const int colour = int(slot % 3);
             // Each colour from its own side of the hemisphere.
-            const glm::vec3 direction = glm::normalize(
-                glm::vec3(float(colour - 1) + 0.3f * signedUnit(rng), 0.3f * signedUnit(rng),
-                          0.2f + unit(rng)));
+            const glm::vec3 direction =
+                glm::normalize(glm::vec3(float(colour - 1) + 0.3f * signedUnit(rng),
+                                         0.3f * signedUnit(rng), 0.2f + unit(rng)));
             const EncodedLinkTint tint = encodeLinkTint(tints[colour]);
             bake.links.tint[slot] = tint.code;
             std::array<float, 9> projection{};

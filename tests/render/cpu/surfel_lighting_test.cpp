@@ -263,10 +263,10 @@ TEST(SurfelLighting, BounceReadsCachesOnItsSurfaceThroughTheirIrradianceAlongThe
                   glm::dvec3(direct[0]) + albedoArea * (0.25 * glm::dvec3(values.irradiance[0]) +
                                                         0.75 * glm::dvec3(values.irradiance[1])),
                   1e-5);
-    expectVecNear(bounce(2, values),
-                  glm::dvec3(direct[0]) +
-                      albedoArea * (0.25 * sh + 0.75 * glm::dvec3(values.irradiance[1])),
-                  1e-5);
+    expectVecNear(
+        bounce(2, values),
+        glm::dvec3(direct[0]) + albedoArea * (0.25 * sh + 0.75 * glm::dvec3(values.irradiance[1])),
+        1e-5);
     CacheValues shOnly = values;
     shOnly.irradiance.clear();
     expectVecNear(bounce(3, shOnly), glm::dvec3(direct[0]) + albedoArea * sh, 1e-5);
