@@ -1,12 +1,14 @@
 #include "bake/link_generation.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <numbers>
 #include <queue>
 
 #include "bake/surfel_exposure.h"
+#include "bake/surfel_grid.h"
 #include "core/color.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
@@ -34,12 +36,14 @@ struct NodeEstimate {
     float unoccluded = 0.0f;   ///< estimated solid angle ignoring occlusion, sr
     float perArea = 0.0f;      ///< estimated Σ w·Ω·V / Σ w·a over the node, sr/m²
     glm::vec3 directionSum{0.0f};  ///< Σ w·Ω·V·ω over the samples
-    glm::vec3 colourSum{0.0f};     ///< Σ w·Ω·V·κ over the samples, in the units of perArea
-    glm::vec3 positionSum{0.0f};   ///< Σ w·Ω·V·x over the samples, in the units of perArea
+    // What the link reads of the part it sees, each sample counted by its share times the
+    // cache's LinkReadWeight k of its direction, in the units of perArea:
+    glm::vec3 colourSum{0.0f};     ///< Σ w·Ω·V·k·κ over the samples
+    glm::vec3 positionSum{0.0f};   ///< Σ w·Ω·V·k·x over the samples
     glm::vec3 reference{0.0f};     ///< a point of the node, which the next three are about
-    double shareSum = 0.0;         ///< perArea in double
-    glm::dvec3 localSum{0.0};      ///< Σ w·Ω·V·(x − reference)
-    double localSquareSum = 0.0;   ///< Σ w·Ω·V·|x − reference|²
+    double shareSum = 0.0;         ///< Σ w·Ω·V·k, in double
+    glm::dvec3 localSum{0.0};      ///< Σ w·Ω·V·k·(x − reference)
+    double localSquareSum = 0.0;   ///< Σ w·Ω·V·k·|x − reference|²
     uint32_t sampleBegin = 0;  ///< its visible samples in the per-cache sample list
     uint32_t sampleCount = 0;
     double visibleArea = 0.0;  ///< estimated Σ w·a of the surfels the cache sees, m²
@@ -72,6 +76,7 @@ public:
                 const std::vector<Node>& nodes, const LinkParams& params,
                 const std::vector<float>& weights)
         : mRays(rays), mSurfels(surfels), mNodes(nodes), mParams(params), mWeights(weights),
+          mCells(surfelCells(rays, surfels)), mReadWeight(params.bands),
           mPrefix(surfels.size() + 1, 0.0), mColourPrefix(surfels.size() + 1, glm::dvec3(0.0)),
           mPositionPrefix(surfels.size() + 1, glm::dvec3(0.0)),
           mSquarePrefix(surfels.size() + 1, 0.0) {
@@ -174,41 +179,41 @@ public:
     }
 
     /// The tint of a localised estimate's link: per channel, the colour of the part the cache
-    /// sees, Σ w·Ω·V·κ / Σ w·Ω·V, over that of the read node, Σ w·κ·a / Σ w·a. The read node's
-    /// flux then reaches the cache as the flux of what it sees would (surfel_exposure.h
+    /// sees, Σ w·Ω·V·k·κ / Σ w·Ω·V·k, over that of the read node, Σ w·κ·a / Σ w·a. The read
+    /// node's flux then reaches the cache as the flux of what it sees would (surfel_exposure.h
     /// fluxColour): a cache beside a red rug on a white floor reads the rug's red. Neutral
     /// under LinkReads::Node, and in a channel the read node has no colour in (its flux there
     /// has no known spread).
     glm::vec3 tintOf(const NodeEstimate& e) const {
         glm::vec3 tint(1.0f);
-        if (mParams.reads == LinkReads::Node || !(e.perArea > 0.0f)) return tint;
+        if (mParams.reads == LinkReads::Node || !(e.shareSum > 0.0)) return tint;
         const Node& read = mNodes[e.readNode];
         const size_t first = read.firstSurfel, last = read.firstSurfel + read.surfelCount;
         const double area = mPrefix[last] - mPrefix[first];
         const glm::dvec3 readColour = (mColourPrefix[last] - mColourPrefix[first]) / area;
-        const glm::vec3 seenColour = e.colourSum / e.perArea;
+        const glm::vec3 seenColour = e.colourSum / float(e.shareSum);
         for (int c = 0; c < 3; ++c)
             if (readColour[c] > 1e-6) tint[c] = float(seenColour[c] / readColour[c]);
         return tint;
     }
 
     /// The offset of a localised estimate's link: the centroid of the part the cache sees,
-    /// Σ w·Ω·V·x / Σ w·Ω·V, from the read node's flux centroid, Σ w·a·x / Σ w·a (metres). The
-    /// runtime scales the read node's flux by its linear spread along this offset
-    /// (render/cpu/pull.h). Zero for a surfel, and under LinkReads::Node, whose links read
-    /// the node's mean.
+    /// Σ w·Ω·V·k·x / Σ w·Ω·V·k (k: LinkReadWeight), from the read node's flux centroid,
+    /// Σ w·a·x / Σ w·a (metres). The runtime scales the read node's flux by its linear spread
+    /// along this offset (render/cpu/pull.h). Zero for a surfel, and under LinkReads::Node,
+    /// whose links read the node's mean.
     glm::vec3 offsetOf(const NodeEstimate& e) const {
         const Node& read = mNodes[e.readNode];
-        if (mParams.reads == LinkReads::Node || !(e.perArea > 0.0f) || read.surfelCount == 1)
+        if (mParams.reads == LinkReads::Node || !(e.shareSum > 0.0) || read.surfelCount == 1)
             return glm::vec3(0.0f);
         const size_t first = read.firstSurfel, last = read.firstSurfel + read.surfelCount;
         const glm::dvec3 centroid =
             (mPositionPrefix[last] - mPositionPrefix[first]) / (mPrefix[last] - mPrefix[first]);
-        return glm::vec3(glm::dvec3(e.positionSum) / double(e.perArea) - centroid);
+        return glm::vec3(glm::dvec3(e.positionSum) / e.shareSum - centroid);
     }
 
     /// The spread share ρ of a link: the trace of the covariance of the part the cache sees
-    /// (its visible samples, weights w·Ω·V) over that of its read node (weights w·a), ≤ 1. The
+    /// (its visible samples, weights w·Ω·V·k) over that of its read node (weights w·a), ≤ 1. The
     /// runtime's exponential spread reads a link of ρ = 1 at the node's mean and one of ρ = 0
     /// at the spread's value at the part's centroid (render/cpu/pull.h). 1 under
     /// LinkReads::Node, whose links read the node's mean.
@@ -323,17 +328,18 @@ private:
             e.lastVisible = std::max(e.lastVisible, s);
             e.perArea += share;
             e.directionSum += share * view.direction;
-            e.colourSum += share * fluxColour(mSurfels[s]);
-            e.positionSum += share * mSurfels[s].position;
+            const float aimed = share * mReadWeight(cache, view.direction);
+            e.colourSum += aimed * fluxColour(mSurfels[s]);
+            e.positionSum += aimed * mSurfels[s].position;
             const glm::dvec3 local = glm::dvec3(mSurfels[s].position) - glm::dvec3(e.reference);
-            e.shareSum += share;
-            e.localSum += double(share) * local;
-            e.localSquareSum += double(share) * glm::dot(local, local);
+            e.shareSum += aimed;
+            e.localSum += double(aimed) * local;
+            e.localSquareSum += double(aimed) * glm::dot(local, local);
             samples.push_back({view.direction, share});
         };
         // Exact: w_j·Ω_j / Σ w·a and Ω_j.
         auto addExact = [&](uint32_t s) {
-            const SurfelView view = viewSurfel(mRays, cache, mSurfels[s]);
+            const SurfelView view = viewSurfel(mRays, cache, mSurfels[s], mCells.of(s));
             rays += view.rays;
             if (view.solidAngle <= 0.0f) return;  // faces away or lies behind the cache
             e.unoccluded += view.solidAngle;
@@ -372,7 +378,7 @@ private:
             for (uint32_t s : drawn) {
                 if (std::binary_search(nearBegin, nearEnd, s)) continue;
                 const Surfel& surfel = mSurfels[s];
-                const SurfelView view = viewSurfel(mRays, cache, surfel);
+                const SurfelView view = viewSurfel(mRays, cache, surfel, mCells.of(s));
                 rays += view.rays;
                 if (view.solidAngle <= 0.0f) continue;
                 // Drawn: Ω_j / (k·a_j) and n·Ω_j / k; each draw stands for Σ w·a / k.
@@ -414,6 +420,8 @@ private:
     const std::vector<Node>& mNodes;
     const LinkParams& mParams;
     const std::vector<float>& mWeights;
+    SurfelCells mCells;  ///< each surfel's patch of surface, for caches near it
+    LinkReadWeight mReadWeight;
     std::vector<double> mPrefix;  ///< Σ w·a over the surfels before each (leaf order)
     std::vector<glm::dvec3> mColourPrefix;  ///< Σ w·κ·a over the surfels before each
     std::vector<glm::dvec3> mPositionPrefix;  ///< Σ w·a·x over the surfels before each
@@ -501,7 +509,8 @@ float surfelSolidAngle(const glm::vec3& from, const Surfel& surfel,
                                hemisphereNormal, 2);
 }
 
-SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel) {
+SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel,
+                      std::span<const glm::vec3> cell) {
     SurfelView view;
     const glm::vec3 v = surfel.position - cache.position;
     const float d2 = glm::dot(v, v);
@@ -528,24 +537,119 @@ SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel&
     // to the surfel's. Without this test a light-map cache on a chair in the living room,
     // 7 mm off the plane of a lamp-lit surfel of the same chair, read 2.5× the light a path
     // tracer finds there.
-    forDiscParts(
-        surfel.position, surfel.normal, surfel.radius, [&](const glm::vec3& centre, float radius) {
-            const float omega =
-                splitDiscSolidAngle(cache.position, centre, surfel.normal, radius, hemisphere, 1);
-            if (!(omega > 0.0f)) return;
-            ++view.rays;
-            const glm::vec3 toPart = centre - cache.position;
-            const float distance = glm::length(toPart);
-            const float tolerance = 0.5f * radius + 4.0f * epsilon;
-            const auto hit =
-                rays.intersect(cache.position, toPart / distance, epsilon, distance + tolerance);
-            if (!hit || hit->t < distance - tolerance ||
-                std::abs(glm::dot(hit->geometricNormal, surfel.normal)) < 0.7f)
-                return;
-            view.solidAngle += omega;
-            view.visible = true;
-        });
+    glm::vec3 seen(0.0f);  // Σ Ω·direction over the parts seen
+    auto part = [&](const glm::vec3& centre, float radius) {
+        const float omega =
+            splitDiscSolidAngle(cache.position, centre, surfel.normal, radius, hemisphere, 1);
+        if (!(omega > 0.0f)) return;
+        ++view.rays;
+        const glm::vec3 toPart = centre - cache.position;
+        const float distance = glm::length(toPart);
+        const float tolerance = 0.5f * radius + 4.0f * epsilon;
+        const auto hit =
+            rays.intersect(cache.position, toPart / distance, epsilon, distance + tolerance);
+        if (!hit || hit->t < distance - tolerance ||
+            std::abs(glm::dot(hit->geometricNormal, surfel.normal)) < 0.7f)
+            return;
+        view.solidAngle += omega;
+        seen += omega * (toPart / distance);
+        view.visible = true;
+    };
+    if (cell.empty()) {
+        forDiscParts(surfel.position, surfel.normal, surfel.radius, part);
+    } else {
+        // Each point of the cell stands for a square of half a radius (surfelCells).
+        const float radius = 0.5f * surfel.radius / std::sqrt(kPi);
+        for (const glm::vec3& p : cell) part(p, radius);
+    }
+    // The parts' mean direction: a near patch seen obliquely lies off its centre's direction.
+    if (glm::dot(seen, seen) > 0.0f) view.direction = glm::normalize(seen);
     return view;
+}
+
+LinkReadWeight::LinkReadWeight(uint32_t bands)
+    : mBands(std::clamp<int>(int(bands), 1, kMaxShBands)) {
+    for (int l = 0; l < mBands; ++l)
+        mCoefficients[l] = clampedCosineZonal(l) * float(2 * l + 1) / (4.0f * kPi);
+}
+
+float LinkReadWeight::operator()(const Cache& cache, const glm::vec3& direction) const {
+    if (cache.kind != gpu::kCacheKindLightmap) return 1.0f;
+    const float x = glm::dot(cache.normal, direction);
+    float sum = 0.0f, legendre = 1.0f, previous = 0.0f;  // P_l(x), P_{l−1}(x)
+    for (int l = 0; l < mBands; ++l) {
+        sum += mCoefficients[l] * legendre;
+        const float next = (float(2 * l + 1) * x * legendre - float(l) * previous) / float(l + 1);
+        previous = legendre;
+        legendre = next;
+    }
+    return std::max(sum, 0.0f);
+}
+
+SurfelCells surfelCells(const EmbreeScene& rays, const std::vector<Surfel>& surfels) {
+    SurfelCells cells;
+    const size_t nS = surfels.size();
+    cells.first.assign(nS + 1, 0);
+    if (nS == 0) return cells;
+    float radius = 0.0f;
+    for (const Surfel& s : surfels) radius = std::max(radius, s.radius);
+    // Candidates at (u, v)·r/2 within 2.5 r of the surfel; a surfel nearer to one than its own
+    // lies within 5 r of its own, so the grid's 3×3×3 cells of 5 r hold every rival.
+    constexpr int kSteps = 5;
+    const float reach = 2.0f * kSteps * 0.5f * radius;
+    const SurfelGrid grid(surfels, reach);
+    const float epsilon = rays.epsilon();
+    std::vector<std::vector<glm::vec3>> points(nS);
+    parallelFor(
+        0, nS,
+        [&](size_t i) {
+            const Surfel& s = surfels[i];
+            // Rivals: the surfels of the same surface (facing its way) within reach.
+            std::vector<glm::vec3> rivals;
+            grid.forNeighbours(s.position, [&](const SurfelGrid::Entry& e) {
+                if (e.index == i || glm::dot(e.normal, s.normal) < 0.7f) return;
+                const glm::vec3 d = e.position - s.position;
+                if (glm::dot(d, d) < reach * reach) rivals.push_back(e.position);
+            });
+            glm::vec3 t, b;
+            orthonormalBasis(s.normal, t, b);
+            const float step = 0.5f * s.radius;
+            const float lift = 0.25f * s.radius + 4.0f * epsilon;
+            const glm::vec3 from = s.position + lift * s.normal;
+            for (int v = -kSteps; v <= kSteps; ++v)
+                for (int u = -kSteps; u <= kSteps; ++u) {
+                    if (u * u + v * v > kSteps * kSteps) continue;
+                    const glm::vec3 offset = (float(u) * step) * t + (float(v) * step) * b;
+                    const glm::vec3 q = s.position + offset;
+                    // Nearest surfel of the surface, distance out of its plane counting four
+                    // times (surfel_exposure.cpp's metric): the top of a slab keeps its own cell.
+                    const float mine = glm::dot(offset, offset);
+                    bool nearest = true;
+                    for (const glm::vec3& r : rivals) {
+                        const glm::vec3 d = r - q;
+                        const float off = glm::dot(d, s.normal);
+                        if (glm::dot(d, d) + 15.0f * off * off < mine) {
+                            nearest = false;
+                            break;
+                        }
+                    }
+                    if (!nearest) continue;
+                    const glm::vec3 to = q + lift * s.normal;
+                    const glm::vec3 across = to - from;
+                    const float length = glm::length(across);
+                    if (length > epsilon && rays.occluded(from, across / length, 0.0f, length))
+                        continue;
+                    const auto hit = rays.intersect(to, -s.normal, 0.0f, 2.0f * lift);
+                    if (!hit || glm::dot(hit->geometricNormal, s.normal) < 0.7f) continue;
+                    points[i].push_back(to - hit->t * s.normal);
+                }
+        },
+        64);
+    for (size_t i = 0; i < nS; ++i)
+        cells.first[i + 1] = cells.first[i] + uint32_t(points[i].size());
+    cells.points.reserve(cells.first[nS]);
+    for (auto& p : points) cells.points.insert(cells.points.end(), p.begin(), p.end());
+    return cells;
 }
 
 uint32_t surfelPartsOnSurface(const EmbreeScene& rays, const Surfel& surfel) {

@@ -5,11 +5,14 @@
 /// SH-projected (eq. 2) or runtime-projected (direction, cone, scalar factor), each with a
 /// colour tint.
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/bake_data.h"
 #include "core/error.h"
+#include "core/sh.h"
 #include "rays/embree_scene.h"
 
 namespace pic {
@@ -69,7 +72,45 @@ struct SurfelView {
     bool visible = false;     ///< solidAngle > 0 and nothing blocks the segment
     uint32_t rays = 0;        ///< rays cast: one, one per part of the disc near it, or none
 };
-SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel);
+SurfelView viewSurfel(const EmbreeScene& rays, const Cache& cache, const Surfel& surfel,
+                      std::span<const glm::vec3> cell = {});
+
+/// The patch of surface each surfel stands for near a viewer, as points on it: its Voronoi
+/// cell on its own surface. Discs of equal area leave gaps and overlap where surfels lie
+/// unevenly (two surfels 4 radii apart along a room's corner leave the corner bare between
+/// them), which a cache beside them sees as missing or doubled light; the cells tile the
+/// surfaces. Candidate points on a grid of half a radius over ±2.5 radii about the surfel
+/// are kept where they lie on its surface (a ray across from above its centre passes nothing
+/// and one down finds a surface facing its way) and no other surfel of that surface is nearer.
+struct SurfelCells {
+    std::vector<uint32_t> first;    ///< per surfel, into points; one more entry at the end
+    std::vector<glm::vec3> points;  ///< on the surface, metres
+
+    std::span<const glm::vec3> of(size_t surfel) const {
+        return {points.data() + first[surfel], points.data() + first[surfel + 1]};
+    }
+};
+SurfelCells surfelCells(const EmbreeScene& rays, const std::vector<Surfel>& surfels);
+
+/// How much a visible direction ω counts in what a link reads of its node (the part's
+/// centroid that the node's spread is read at, its spread share and its tint). A light-map
+/// cache is shown, and read by the bounces on its surface, as its irradiance along its normal
+/// n through the lY bands, so ω counts by that irradiance's kernel
+/// k(n·ω) = Σ_{l<lY} K_l·(2l + 1)/(4π)·P_l(n·ω) (K_l the clamped cosine's zonal coefficients;
+/// ∫ L(ω)·k(n·ω) dω is the irradiance of L's lY-band projection, by the addition theorem),
+/// clamped at 0. A grid cache is seen from every direction: each counts 1. Weighted by the
+/// solid angle alone, the part's centroid lies nearer the cache than the light its normal
+/// gathers: in two_floors a floor or wall light-map cache read 0.982 of its surfels'
+/// irradiance along the normal where band 0 was right.
+class LinkReadWeight {
+public:
+    explicit LinkReadWeight(uint32_t bands);  ///< lY, clamped to [1, kMaxShBands]
+    float operator()(const Cache& cache, const glm::vec3& direction) const;
+
+private:
+    int mBands;
+    std::array<float, kMaxShBands> mCoefficients{};  ///< K_l·(2l + 1)/(4π)
+};
 
 /// How many of the kDiscParts parts of a surfel's disc lie on its own surface: a ray from
 /// above its centre to above the part passes nothing, and one down from there meets a surface

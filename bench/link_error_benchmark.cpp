@@ -37,9 +37,14 @@ constexpr double kPi = std::numbers::pi;
 /// The six band-0 RGB estimates of one cache (see the header), in W/(m²·sr) × y00.
 struct Estimates {
     glm::dvec3 traced{0.0}, gather{0.0}, cut{0.0}, mean{0.0}, spread{0.0}, linked{0.0};
+    /// Light-map caches: traced, gather, spread and linked as irradiance along the normal
+    /// through the lY bands (W/m²), what an image shows of the cache; 0 for grid caches.
+    glm::dvec3 tracedAlong{0.0}, gatherAlong{0.0}, spreadAlong{0.0}, linkedAlong{0.0};
     Estimates& operator+=(const Estimates& o) {
         traced += o.traced, gather += o.gather, cut += o.cut, mean += o.mean, spread += o.spread;
         linked += o.linked;
+        tracedAlong += o.tracedAlong, gatherAlong += o.gatherAlong, spreadAlong += o.spreadAlong;
+        linkedAlong += o.linkedAlong;
         return *this;
     }
 };
@@ -102,6 +107,28 @@ Json scatterJson(const std::vector<Estimates>& e, const std::vector<size_t>& cac
             {"node_mean_radiance", scatter(e, cache, mean, cut)},
             {"node_spread_radiance", scatter(e, cache, spread, cut)},
             {"visibility_estimate", scatter(e, cache, linked, spread)}};
+}
+
+/// Light-map caches' irradiance along the normal: the same chain, its steps merged where band 0
+/// shows them apart: representation, the cut with the node's spread model (cut coverage ×
+/// spread), and the links' cones with their visibility estimate.
+Json alongNormalJson(const Estimates& e) {
+    return {{"linked_over_traced", lumaRatio(e.linkedAlong, e.tracedAlong)},
+            {"representation", lumaRatio(e.gatherAlong, e.tracedAlong)},
+            {"node_spread_radiance", lumaRatio(e.spreadAlong, e.gatherAlong)},
+            {"cones_and_visibility", lumaRatio(e.linkedAlong, e.spreadAlong)}};
+}
+
+/// The scatter of the along-normal factors over the light-map caches `cache`.
+Json alongNormalScatterJson(const std::vector<Estimates>& e, const std::vector<size_t>& cache) {
+    auto traced = [](const Estimates& x) { return x.tracedAlong; };
+    auto gather = [](const Estimates& x) { return x.gatherAlong; };
+    auto spread = [](const Estimates& x) { return x.spreadAlong; };
+    auto linked = [](const Estimates& x) { return x.linkedAlong; };
+    return {{"linked_over_traced", scatter(e, cache, linked, traced)},
+            {"representation", scatter(e, cache, gather, traced)},
+            {"node_spread_radiance", scatter(e, cache, spread, gather)},
+            {"cones_and_visibility", scatter(e, cache, linked, spread)}};
 }
 
 Json ratiosJson(const Estimates& e, uint32_t caches) {
@@ -252,6 +279,8 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         }
         return radiance + scene->albedoAt(t, hit->b1, hit->b2) * irradiance / float(kPi);
     };
+    const SurfelCells cells = surfelCells(**rays, bake->surfels);
+    const LinkReadWeight readWeight(bake->params.bandsY);
     std::vector<Estimates> estimates(examined);
     Progress progress("link error", examined);
     parallelFor(0, examined, [&](size_t k) {
@@ -261,42 +290,56 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         Estimates& e = estimates[k];
         const size_t strideC = size_t{values.bandsC} * values.bandsC;
         e.linked = glm::dvec3(yCoCgToRgb({values.y[c * strideY], values.co[c * strideC], values.cg[c * strideC]}));
+        if (hemisphere) e.linkedAlong = glm::dvec3(values.irradiance[c]);
+        // The irradiance kernel along the normal (the bake's weight of a direction in what a
+        // link reads); grid caches have no normal and take 0.
+        auto along = [&](const glm::vec3& w) { return hemisphere ? double(readWeight(cache, w)) : 0.0; };
         for (size_t s = 0; s < nS; ++s) {
-            const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
-            if (view.visible) e.gather += radiance[s] * (double(view.solidAngle) * y00);
+            const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s], cells.of(s));
+            if (!view.visible) continue;
+            e.gather += radiance[s] * (double(view.solidAngle) * y00);
+            e.gatherAlong += radiance[s] * (double(view.solidAngle) * along(view.direction));
         }
         for (uint32_t j = 0; j < nL; ++j) {
             const uint32_t n = linkedNode(bake->links, c * nL + j);
             if (n == kNoNode) continue;
             const Node& node = bake->nodes[n];
-            glm::dvec3 mean(0.0), centroid(0.0);
+            glm::dvec3 mean(0.0), meanAlong(0.0), centroid(0.0);
             double centroidWeight = 0.0, second = 0.0;
             for (uint32_t s = node.firstSurfel; s < node.firstSurfel + node.surfelCount; ++s) {
-                const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s]);
+                const SurfelView view = viewSurfel(**rays, cache, bake->surfels[s], cells.of(s));
                 if (!view.visible) continue;
                 e.cut += radiance[s] * (double(view.solidAngle) * y00);
                 mean += modelled(n, s) * (double(view.solidAngle) * y00);
-                const double w = weights.empty() ? 1.0 : double(weights[s]);
-                centroid += w * double(view.solidAngle) * glm::dvec3(bake->surfels[s].position);
-                centroidWeight += w * double(view.solidAngle);
+                meanAlong += modelled(n, s) * (double(view.solidAngle) * along(view.direction));
+                const double w = (weights.empty() ? 1.0 : double(weights[s])) *
+                                 double(view.solidAngle) * readWeight(cache, view.direction);
                 const glm::dvec3 x(bake->surfels[s].position);
-                second += w * double(view.solidAngle) * glm::dot(x, x);
+                centroid += w * x;
+                centroidWeight += w;
+                second += w * glm::dot(x, x);
             }
             e.mean += mean;
-            if (centroidWeight > 0.0)
-                e.spread += mean * spreadRead(n, glm::vec3(centroid / centroidWeight),
-                                              spreadShare(n, centroid / centroidWeight,
-                                                          second / centroidWeight));
+            if (centroidWeight > 0.0) {
+                const glm::dvec3 ratio = spreadRead(n, glm::vec3(centroid / centroidWeight),
+                                                    spreadShare(n, centroid / centroidWeight,
+                                                                second / centroidWeight));
+                e.spread += mean * ratio;
+                e.spreadAlong += meanAlong * ratio;
+            }
         }
         // Uniform directions over the cache's sphere (hemisphere for light-map caches).
         Rng rng(params.seed, c);
-        glm::dvec3 sum(0.0);
+        glm::dvec3 sum(0.0), sumAlong(0.0);
         for (uint32_t i = 0; i < params.directions; ++i) {
             glm::vec3 w = sampleUniformSphere(rng.uniform(), rng.uniform());
             if (hemisphere && glm::dot(w, cache.normal) < 0.0f) w = -w;
-            sum += glm::dvec3(firstBounce(cache.position, w));
+            const glm::dvec3 radiance(firstBounce(cache.position, w));
+            sum += radiance;
+            sumAlong += radiance * along(w);
         }
         e.traced = sum * ((hemisphere ? 2.0 : 4.0) * kPi * y00 / params.directions);
+        e.tracedAlong = sumAlong * (2.0 * kPi / params.directions);
         progress.advance();
     }, 1);
     progress.finish();
@@ -332,6 +375,8 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
     json["all"]["scatter"] = scatterJson(estimates, allCaches);
     json["grid"]["scatter"] = scatterJson(estimates, gridCaches);
     json["lightmap"]["scatter"] = scatterJson(estimates, lightmapCaches);
+    json["lightmap"]["along_normal"] = alongNormalJson(lightmap);
+    json["lightmap"]["along_normal"]["scatter"] = alongNormalScatterJson(estimates, lightmapCaches);
     // Each examined cache, to find where a factor scatters: its place, its kind, the traced
     // luma and its own ratios.
     Json perCache = Json::array();
@@ -349,7 +394,8 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
              {"cut_coverage", lumaRatio(e.cut, e.gather)},
              {"node_mean_radiance", lumaRatio(e.mean, e.cut)},
              {"node_spread_radiance", lumaRatio(e.spread, e.cut)},
-             {"visibility_estimate", lumaRatio(e.linked, e.spread)}});
+             {"visibility_estimate", lumaRatio(e.linked, e.spread)},
+             {"along_normal", cache.kind == gpu::kCacheKindLightmap ? alongNormalJson(e) : Json()}});
     }
     json["caches"] = std::move(perCache);
 
@@ -381,6 +427,16 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
         std::printf("  %-9s %7s", "", "scatter");
         for (int f = 0; f < 6; ++f) std::printf(" %*.4f", widths[f], scattered[factors[f]].get<double>());
         std::printf("\n");
+    }
+    // The light-map caches' irradiance along the normal: linked/traced, representation, the
+    // cut with the spread model (under "node spread"), the cones and visibility.
+    const Json& along = json["lightmap"]["along_normal"];
+    for (const bool scattered : {false, true}) {
+        const Json& r = scattered ? along["scatter"] : along;
+        std::printf("  %-9s %7s %14.4f %15.4f %10s %11s %11.4f %11.4f\n", scattered ? "" : "along n",
+                    scattered ? "scatter" : "", r["linked_over_traced"].get<double>(),
+                    r["representation"].get<double>(), "", "", r["node_spread_radiance"].get<double>(),
+                    r["cones_and_visibility"].get<double>());
     }
     if (!params.jsonPath.empty()) {
         std::ofstream out(params.jsonPath);

@@ -12,7 +12,7 @@
 ///             weights), per channel in the surfels' colours κ, Φ·w·κ/(π·Σ w·κ·a), with
 ///             visible-part reads (the links' tints), exact visibility,
 ///   spread    the same with the node's flux spread (render/cpu/pull.h) read as the runtime
-///             reads it, at the centroid of the part the cache sees (Σ w·Ω·x / Σ w·Ω) with
+///             reads it, at the centroid of the part the cache sees (Σ w·Ω·k·x / Σ w·Ω·k) with
 ///             that part's spread share: what the runtime's links read, exact visibility,
 ///   linked    the runtime's cache (estimated visibility, the spread read at each link's box
 ///             point).
@@ -23,7 +23,11 @@
 /// relative deviation from it (weighted by the denominator's luma), how much neighbouring
 /// caches disagree in that factor, which shows as blotches rather than bias. The traced
 /// estimate's Monte Carlo noise adds to the scatter of the first two (about 0.2 at 1,024
-/// directions in a sunlit room; use ≥ 16,384 to read them). Writes JSON, with every examined
+/// directions in a sunlit room; use ≥ 16,384 to read them). For light-map caches, which an
+/// image shows as their irradiance along the normal through the lY bands, the same chain
+/// along the normal (`along_normal`): representation, the cut with the spread model, the
+/// links' cones and visibility; the spread is read at the part's centroid as the bake
+/// weighs it (bake/link_generation.h LinkReadWeight). Writes JSON, with every examined
 /// cache's place, kind and ratios under `caches`; never asserts.
 
 #include <string>

@@ -10,6 +10,8 @@
 #include "bake/surfel_hierarchy.h"
 #include "bake/surfel_exposure.h"
 #include "core/color.h"
+#include "core/sampling.h"
+#include "core/sh.h"
 #include "rays/embree_scene.h"
 #include "tests/support/baked_scene.h"
 
@@ -452,6 +454,100 @@ TEST(LinkReads, ALinkTakesTheColourOfThePartItSees) {
     EXPECT_NEAR(rootFlux.g / rootFlux.r, rootAlbedo.g / rootAlbedo.r, 1e-6f);
 }
 
+TEST(LinkReadWeight, IsTheKernelOfTheIrradianceOfTheLumasBands) {
+    // Σ_j L_j·k(n·ω_j) must equal the irradiance at n of the lY-band projection of the point
+    // radiances L_j at ω_j (core/sh.h shIrradiance): the addition theorem. A grid cache counts
+    // every direction once.
+    Rng rng(5, 2);
+    for (const uint32_t bands : {1u, 2u, 3u, 5u}) {
+        const LinkReadWeight weight(bands);
+        std::vector<float> sh(size_t(bands) * bands, 0.0f);
+        std::vector<glm::vec3> directions;
+        std::vector<float> radiance;
+        for (int j = 0; j < 12; ++j) {
+            directions.push_back(sampleUniformSphere(rng.uniform(), rng.uniform()));
+            radiance.push_back(0.2f + rng.uniform());
+            float basis[kMaxShBands * kMaxShBands];
+            shEvaluate(int(bands), directions.back(), basis);
+            for (size_t i = 0; i < sh.size(); ++i) sh[i] += radiance.back() * basis[i];
+        }
+        for (int k = 0; k < 8; ++k) {
+            Cache cache{};
+            cache.kind = gpu::kCacheKindLightmap;
+            cache.normal = sampleUniformSphere(rng.uniform(), rng.uniform());
+            double sum = 0.0;
+            for (size_t j = 0; j < directions.size(); ++j) {
+                const float w = weight(cache, directions[j]);
+                EXPECT_GE(w, 0.0f);
+                sum += double(radiance[j]) * w;
+            }
+            const float expected = shIrradiance(int(bands), sh.data(), cache.normal);
+            // Where k < 0 (below the horizon, bands ≥ 4) it is clamped: compare only if none was.
+            bool clamped = false;
+            for (const glm::vec3& d : directions) clamped = clamped || weight(cache, d) == 0.0f;
+            if (!clamped) {
+                EXPECT_NEAR(sum, expected, 1e-4 * std::abs(expected) + 1e-5) << bands << " bands";
+            }
+            cache.kind = gpu::kCacheKindGrid;
+            EXPECT_EQ(weight(cache, directions[0]), 1.0f);
+        }
+    }
+}
+
+TEST(LinkReads, ALightMapCacheReadsAWallWhereItsNormalGathersItsLight) {
+    // A 2 × 2 m wall of 8 × 8 surfels (x = 0, facing +x) and, 0.3 m in front of its foot, a
+    // light-map cache facing up and a grid cache at the same place, one link each (the wall,
+    // estimated exactly). The grid cache's link reads the wall's spread at the centroid of
+    // what it sees, Σ Ω·x / Σ Ω, low on the wall where the solid angle is; the light-map
+    // cache's at Σ Ω·k(n·ω)·x / Σ Ω·k, higher, where its normal gathers the wall's light.
+    Scene scene;
+    scene.sourcePath = "wall.gltf";
+    addQuad(scene, {0, 0, -1}, {0, 2, 0}, {0, 0, 2});
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    std::vector<Surfel> surfels;
+    addLattice(surfels, {0, 0, -1}, {0, 2, 0}, {0, 0, 2}, 8, 0.5f);
+    ASSERT_GT(surfels[0].normal.x, 0.0f);
+    auto hierarchy = buildHierarchy(surfels, HierarchyParams{.sceneExtent = 2.83f});
+    ASSERT_TRUE(hierarchy) << hierarchy.error().message;
+    const std::vector<Surfel>& leaves = hierarchy->surfels;
+    const std::vector<Node>& nodes = hierarchy->nodes;
+    Cache lightmap{};
+    lightmap.kind = gpu::kCacheKindLightmap;
+    lightmap.position = glm::vec3(0.3f, 0.01f, 0.1f);
+    lightmap.normal = glm::vec3(0, 1, 0);
+    Cache grid = lightmap;
+    grid.kind = gpu::kCacheKindGrid;
+    LinkParams params;
+    params.linksPerCache = 1;
+    auto links = generateLinks(**rays, leaves, nodes, {lightmap, grid}, params);
+    ASSERT_TRUE(links) << links.error().message;
+    ASSERT_EQ(links->links.rtp[0].node, nodes.size() - 1);
+    ASSERT_EQ(links->links.rtp[1].node, nodes.size() - 1);
+    // The centroids the links should read at, from every surfel's view (the wall's centroid is
+    // its middle, y = 1).
+    const LinkReadWeight weight(params.bands);
+    const SurfelCells cells = surfelCells(**rays, leaves);
+    auto centroid = [&](const Cache& cache) {
+        glm::dvec3 sum(0.0);
+        double total = 0.0;
+        for (size_t i = 0; i < leaves.size(); ++i) {
+            const Surfel& s = leaves[i];
+            const SurfelView view = viewSurfel(**rays, cache, s, cells.of(i));
+            if (!view.visible) continue;
+            const double w = double(view.solidAngle) * weight(cache, view.direction);
+            sum += w * glm::dvec3(s.position);
+            total += w;
+        }
+        return sum / total;
+    };
+    auto offsetY = [&](size_t slot) { return halfToFloat(links->links.offset[slot * 3 + 1]); };
+    const double lightmapY = centroid(lightmap).y, gridY = centroid(grid).y;
+    EXPECT_GT(lightmapY, gridY + 0.1);
+    EXPECT_NEAR(offsetY(0), lightmapY - 1.0, 0.01);
+    EXPECT_NEAR(offsetY(1), gridY - 1.0, 0.01);
+}
+
 TEST(LinkCut, RefinesALargeFarPatchBeforeASmallNearOne) {
     // A cache between two patches of 4 × 4 surfels that subtend about the same solid angle,
     // 0.16 sr: a 0.2 m square 0.5 m above it and a 2 m square 5 m below. The cut refines by
@@ -548,6 +644,72 @@ TEST(SurfelView, PartsOnSurfaceLeaveOutTheOverhang) {
     Surfel flipped = surfel;
     flipped.normal = glm::vec3(0, -1, 0);
     EXPECT_EQ(surfelPartsOnSurface(**rays, flipped), 0u);
+}
+
+/// Solid angle (sr) of the rectangle [x0, x1] × [z0, z1] of the plane y = 0 seen from p above
+/// it: the four rectangles with a corner under p, each atan(a·b / (h·√(a² + b² + h²))).
+double rectangleSolidAngle(const glm::dvec3& p, double x0, double x1, double z0, double z1) {
+    auto corner = [&](double a, double b) {
+        const double sa = a < 0.0 ? -1.0 : 1.0, sb = b < 0.0 ? -1.0 : 1.0;
+        a = std::abs(a), b = std::abs(b);
+        return sa * sb * std::atan(a * b / (p.y * std::sqrt(a * a + b * b + p.y * p.y)));
+    };
+    return corner(x1 - p.x, z1 - p.z) - corner(x0 - p.x, z1 - p.z) - corner(x1 - p.x, z0 - p.z) +
+           corner(x0 - p.x, z0 - p.z);
+}
+
+TEST(SurfelCells, NearCachesSeeTheWholeSurfaceNotTheDiscsGaps) {
+    // Surfels jittered about a 10 cm lattice on a 2 m floor, of equal area: their discs leave
+    // gaps and overlap. Caches 0.6–1.4 radii above the floor, where a surfel's gap or overlap
+    // fills much of what they see, must find the floor's solid angle. Each surfel's cell
+    // (surfelCells) tiles the floor: its points' count times a candidate's square (r/2)² sums
+    // to the floor's area.
+    Scene scene;
+    scene.sourcePath = "floor.gltf";
+    addSquare(scene, 0.0f, 1.0f, true);
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays) << rays.error().message;
+    Rng rng(3, 1);
+    std::vector<Surfel> surfels;
+    const float area = 4.0f / 400.0f;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) {
+            const glm::vec3 at(-0.95f + 0.1f * float(i) + 0.06f * (rng.uniform() - 0.5f), 0.0f,
+                               -0.95f + 0.1f * float(j) + 0.06f * (rng.uniform() - 0.5f));
+            Surfel s = surfelAt(at, {0, 1, 0});
+            s.area = area;
+            s.radius = std::sqrt(area / std::numbers::pi_v<float>);
+            surfels.push_back(s);
+        }
+    const SurfelCells cells = surfelCells(**rays, surfels);
+    const float r = surfels[0].radius;
+    EXPECT_NEAR(double(cells.points.size()) * 0.25 * r * r, 4.0, 0.2);
+    for (const glm::vec3& p : cells.points) {
+        EXPECT_LE(std::abs(p.x), 1.0f);
+        EXPECT_LE(std::abs(p.z), 1.0f);
+        EXPECT_NEAR(p.y, 0.0f, 1e-4f);
+    }
+    double cellError = 0.0, discError = 0.0;
+    const int caches = 64;
+    for (int k = 0; k < caches; ++k) {
+        gpu::Cache cache{};
+        cache.kind = gpu::kCacheKindGrid;
+        cache.position = glm::vec3(rng.uniform() - 0.5f, r * (0.6f + 0.8f * rng.uniform()), rng.uniform() - 0.5f);
+        double withCells = 0.0, withDiscs = 0.0;
+        for (size_t s = 0; s < surfels.size(); ++s) {
+            withCells += viewSurfel(**rays, cache, surfels[s], cells.of(s)).solidAngle;
+            withDiscs += viewSurfel(**rays, cache, surfels[s]).solidAngle;
+        }
+        const double exact = rectangleSolidAngle(glm::dvec3(cache.position), -1, 1, -1, 1);
+        cellError += std::pow(withCells / exact - 1.0, 2);
+        discError += std::pow(withDiscs / exact - 1.0, 2);
+    }
+    cellError = std::sqrt(cellError / caches);
+    discError = std::sqrt(discError / caches);
+    // The cells' points lie half a radius apart, coarse for a cache 0.6 radii above them: 5 %
+    // RMS here, against the discs' 11 %.
+    EXPECT_LT(cellError, 0.06) << "discs " << discError;
+    EXPECT_LT(cellError, 0.5 * discError);
 }
 
 }  // namespace
