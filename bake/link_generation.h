@@ -64,8 +64,10 @@ inline constexpr uint32_t kDiscParts = 32;
 /// faces away from the cache or lies behind a light-map cache's surface) and whether an
 /// occlusion ray reaches it. Within three radii of the cache, only the parts of the disc where
 /// a ray finds the surfel's surface count (one ray per part), so a disc overhanging its patch's
-/// edges or partly hidden counts what is there. The one test that link generation and its
-/// diagnostics share.
+/// edges or partly hidden counts what is there; given the surfel's `cell` (SurfelCells), its
+/// points are the parts instead, each a square of half a radius. There the direction is the
+/// mean of the parts seen, weighted by their solid angles. The one test that link generation
+/// and its diagnostics share.
 struct SurfelView {
     glm::vec3 direction{0.0f};
     float solidAngle = 0.0f;  ///< sr, ignoring occlusion
