@@ -150,7 +150,9 @@ void expectSpreadsMatch(const char* name) {
     EXPECT_GT(sloped, (nodes.size() - nS) / 4);
     // The bright surfels limit some flat nodes' lines: exponential nodes are compared too.
     EXPECT_GT(exponentials, 0u);
-    if (std::string_view(name) == "small_spot") EXPECT_GT(unfit, 0u);
+    if (std::string_view(name) == "small_spot") {
+        EXPECT_GT(unfit, 0u);
+    }
 }
 
 TEST(GpuPull, FluxSpreadsMatchTheCpuTwin) {
