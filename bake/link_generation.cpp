@@ -573,17 +573,80 @@ LinkReadWeight::LinkReadWeight(uint32_t bands)
         mCoefficients[l] = clampedCosineZonal(l) * float(2 * l + 1) / (4.0f * kPi);
 }
 
-float LinkReadWeight::operator()(const Cache& cache, const glm::vec3& direction) const {
-    if (cache.kind != gpu::kCacheKindLightmap) return 1.0f;
-    const float x = glm::dot(cache.normal, direction);
-    float sum = 0.0f, legendre = 1.0f, previous = 0.0f;  // P_l(x), P_{l−1}(x)
-    for (int l = 0; l < mBands; ++l) {
-        sum += mCoefficients[l] * legendre;
-        const float next = (float(2 * l + 1) * x * legendre - float(l) * previous) / float(l + 1);
+namespace {
+
+/// Σ_{l < bands} w_l·P_l(x), the Legendre polynomials by Bonnet's recurrence.
+template <typename T, typename W>
+T legendreSeries(const W* weights, int bands, T x) {
+    T sum = 0, legendre = 1, previous = 0;  // P_l(x), P_{l−1}(x)
+    for (int l = 0; l < bands; ++l) {
+        sum += T(weights[l]) * legendre;
+        const T next = (T(2 * l + 1) * x * legendre - T(l) * previous) / T(l + 1);
         previous = legendre;
         legendre = next;
     }
-    return std::max(sum, 0.0f);
+    return sum;
+}
+
+}  // namespace
+
+float LinkReadWeight::operator()(const Cache& cache, const glm::vec3& direction) const {
+    if (cache.kind != gpu::kCacheKindLightmap) return 1.0f;
+    const float x = glm::dot(cache.normal, direction);
+    return std::max(legendreSeries(mCoefficients.data(), mBands, x), 0.0f);
+}
+
+double LinkReadWeight::kernel(double x) const {
+    return legendreSeries(mCoefficients.data(), mBands, x);
+}
+
+double LinkReadWeight::coneKernel(double x, double oneMinusCosAlpha) const {
+    std::array<double, kMaxShBands> weights{};
+    coneZonalBands(mBands, oneMinusCosAlpha, weights.data());
+    if (!(weights[0] > 0.0)) return kernel(x);
+    const double band0 = weights[0];
+    for (int l = 0; l < mBands; ++l) weights[l] = double(mCoefficients[l]) * weights[l] / band0;
+    return legendreSeries(weights.data(), mBands, x);
+}
+
+glm::vec3 alongNormalDirection(const LinkReadWeight& weight, const glm::vec3& normal,
+                               const glm::vec3& direction, float oneMinusCosAlpha, double target) {
+    const double x0 = std::clamp(double(glm::dot(normal, direction)), -1.0, 1.0);
+    const glm::vec3 across = direction - float(x0) * normal;
+    const float acrossLength = glm::length(across);
+    // Along n itself there is no plane to tilt in; an over-reading link there is a disc seen
+    // face-on, which its cone matches.
+    if (!(acrossLength > 1e-6f) || !std::isfinite(target)) return direction;
+    const double u = oneMinusCosAlpha;
+    auto f = [&](double x) { return weight.coneKernel(x, u) - target; };
+    const double f0 = f(x0);
+    if (f0 == 0.0) return direction;
+    // Walk from x0 towards the side where f changes sign, in steps, then bisect: the nearest
+    // root, or the end of the range when the target lies beyond the cone's reach. The range
+    // keeps a link in front of the cache that was there: [min(x0, 0), 1].
+    const double lowest = std::min(x0, 0.0);
+    const double towards = (f0 > 0.0) == (f(std::min(x0 + 1e-3, 1.0)) > f0) ? -1.0 : 1.0;
+    double a = x0, b = x0;
+    bool bracketed = false;
+    for (int step = 1; step <= 64; ++step) {
+        b = std::clamp(x0 + towards * step / 32.0, lowest, 1.0);
+        if ((f(b) > 0.0) != (f0 > 0.0)) {
+            bracketed = true;
+            break;
+        }
+        a = b;
+        if (b == lowest || b == 1.0) break;
+    }
+    double x = b;
+    if (bracketed) {
+        for (int i = 0; i < 40; ++i) {
+            const double m = 0.5 * (a + b);
+            if ((f(m) > 0.0) == (f0 > 0.0)) a = m; else b = m;
+        }
+        x = 0.5 * (a + b);
+    }
+    const double sine = std::sqrt(std::max(0.0, 1.0 - x * x));
+    return glm::normalize(float(x) * normal + float(sine) * (across / acrossLength));
 }
 
 SurfelCells surfelCells(const EmbreeScene& rays, const std::vector<Surfel>& surfels) {
@@ -732,6 +795,7 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     std::vector<double> solidAngleSum(nC, 0.0);
     std::vector<uint32_t> used(nC, 0);
     Progress progress("links", nC);
+    const LinkReadWeight readWeight(params.bands);
     parallelForChunks(0, nC, [&](size_t begin, size_t end) {
         thread_local Scratch scratch;
         thread_local std::vector<uint32_t> chosen;
@@ -762,8 +826,23 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                     RtpLink& link = links.rtp[slot];
                     link.node = e.readNode;
                     link.factor = e.perArea * e.readScale / e.unoccluded * toRadiance;
-                    link.directionOct = encodeOctahedral(glm::normalize(e.directionSum));
                     link.oneMinusCosAlpha = std::min(2.0f, e.unoccluded / (2.0f * kPi));
+                    glm::vec3 direction = glm::normalize(e.directionSum);
+                    if (params.reads == LinkReads::Visible &&
+                        caches[c].kind == gpu::kCacheKindLightmap && e.exact &&
+                        e.sampleCount > 0) {
+                        double along = 0.0, total = 0.0;
+                        for (uint32_t j = 0; j < e.sampleCount; ++j) {
+                            const VisibleSample& s = scratch.samples[e.sampleBegin + j];
+                            along += double(s.share) *
+                                     readWeight.kernel(glm::dot(caches[c].normal, s.direction));
+                            total += s.share;
+                        }
+                        if (total > 0.0)
+                            direction = alongNormalDirection(readWeight, caches[c].normal, direction,
+                                                             link.oneMinusCosAlpha, along / total);
+                    }
+                    link.directionOct = encodeOctahedral(direction);
                 } else {
                     // Eq. 2 with weights: c_i = 1/(π Σ w·a) Σ_j y_i(ω_j) w_j V_j Ω_j over the
                     // node's visible samples.

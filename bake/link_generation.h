@@ -52,7 +52,9 @@ struct LinkResult {
 /// the cache sees (LinkReads::Visible); the links of a cache then need not form a cut. With
 /// LinkReads::Visible each link also has a tint (LinkSet::tint): per channel, the colour κ
 /// (surfel_exposure.h fluxColour) of the surfels it sees over the read node's, Σ w·κ·a / Σ w·a,
-/// so that the node's flux reaches the cache in the colour of what it sees.
+/// so that the node's flux reaches the cache in the colour of what it sees, and an RTP link of a
+/// light-map cache whose node's visibility is counted exactly turns its cone towards where the
+/// cache's normal gathers that node's light (alongNormalDirection).
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params, const std::vector<float>& weights = {});
@@ -108,11 +110,30 @@ class LinkReadWeight {
 public:
     explicit LinkReadWeight(uint32_t bands);  ///< lY, clamped to [1, kMaxShBands]
     float operator()(const Cache& cache, const glm::vec3& direction) const;
+    /// k(x) unclamped, x = n·ω.
+    double kernel(double x) const;
+    /// The mean of k(n·ω) over the cone of half-angle α (u = 1 − cos α) around a direction d
+    /// with n·d = x: Σ_l K_l·(2l + 1)/(4π)·K_l(α)/K_0(α)·P_l(x) (the addition theorem), what an
+    /// RTP link adds along n per unit of its band 0.
+    double coneKernel(double x, double oneMinusCosAlpha) const;
 
 private:
     int mBands;
     std::array<float, kMaxShBands> mCoefficients{};  ///< K_l·(2l + 1)/(4π)
 };
+
+/// The direction of an RTP link of a light-map cache with normal n: the cone around `direction`
+/// of half-angle α (u = 1 − cos α) stands for the node's visible part, and where that part is
+/// no circle (a strip of the wall beside the cache, seen at grazing angles) its mean of the
+/// kernel k(n·ω) along n (`target`, LinkReadWeight::kernel over the visible samples, weighted
+/// as band 0) differs from the cone's: k is convex in n·ω, so a round cone spread across the
+/// horizon reads more than a strip along it. Tilted in the plane of n and `direction` to the
+/// n·d whose coneKernel is `target` (the nearest such n·d in [min(n·direction, 0), 1], or that
+/// range's end where the target lies beyond the cone's reach), the link adds what its samples
+/// see along n in every band up to lY; band 0 does not move. `direction` along n, or a target
+/// that is not finite, stays as it is.
+glm::vec3 alongNormalDirection(const LinkReadWeight& weight, const glm::vec3& normal,
+                               const glm::vec3& direction, float oneMinusCosAlpha, double target);
 
 /// How many of the kDiscParts parts of a surfel's disc lie on its own surface: a ray from
 /// above its centre to above the part passes nothing, and one down from there meets a surface

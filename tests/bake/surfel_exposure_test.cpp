@@ -494,6 +494,61 @@ TEST(LinkReadWeight, IsTheKernelOfTheIrradianceOfTheLumasBands) {
     }
 }
 
+TEST(LinkReadWeight, ATiltedConeGathersAlongTheNormalWhatItsStripDoes) {
+    // A light-map cache facing +z beside a wall: the wall's strip just above the horizon
+    // (n·ω from 0.02 to 0.25, 120° of azimuth) is one link. The round cone of its solid angle
+    // around its mean direction spreads across n·ω, and k is convex there, so it reads more
+    // along n than the strip's directions do. Tilted (alongNormalDirection), the cone's
+    // projection gives, at n, the irradiance of the strip's own projection, band 0 unchanged.
+    constexpr double kPi = std::numbers::pi;
+    const glm::vec3 n(0.0f, 0.0f, 1.0f);
+    for (const uint32_t bands : {2u, 3u, 4u}) {
+        const LinkReadWeight weight(bands);
+        const int count = int(bands * bands);
+        std::vector<float> strip(count, 0.0f);
+        glm::vec3 directionSum(0.0f);
+        double omega = 0.0, along = 0.0;
+        float basis[kMaxShBands * kMaxShBands];
+        const int rows = 24, columns = 96;
+        const double zLow = 0.02, zHigh = 0.25, phi = 2.0 * kPi / 3.0;
+        for (int i = 0; i < rows; ++i)
+            for (int j = 0; j < columns; ++j) {
+                // Equal solid angles: uniform in z and in azimuth.
+                const double z = zLow + (i + 0.5) / rows * (zHigh - zLow);
+                const double a = -0.5 * phi + (j + 0.5) / columns * phi;
+                const double r = std::sqrt(1.0 - z * z);
+                const glm::vec3 w(float(r * std::cos(a)), float(r * std::sin(a)), float(z));
+                const double dOmega = (zHigh - zLow) * phi / (rows * columns);
+                omega += dOmega;
+                directionSum += float(dOmega) * w;
+                along += dOmega * weight.kernel(z);
+                shEvaluate(int(bands), w, basis);
+                for (int k = 0; k < count; ++k) strip[k] += float(dOmega) * basis[k];
+            }
+        const float oneMinusCosAlpha = float(omega / (2.0 * kPi));
+        const glm::vec3 mean = glm::normalize(directionSum);
+        const double target = along / omega;
+        const double x0 = glm::dot(n, mean);
+        EXPECT_GT(weight.coneKernel(x0, oneMinusCosAlpha), target * 1.01) << bands << " bands";
+
+        const glm::vec3 tilted = alongNormalDirection(weight, n, mean, oneMinusCosAlpha, target);
+        EXPECT_NEAR(glm::length(tilted), 1.0f, 1e-5f);
+        EXPECT_NEAR(glm::dot(glm::cross(n, mean), tilted), 0.0f, 1e-5f) << "stays in the plane";
+        EXPECT_GE(glm::dot(n, tilted), 0.0f);
+        EXPECT_NEAR(weight.coneKernel(glm::dot(n, tilted), oneMinusCosAlpha), target, 1e-5 * target);
+        std::vector<float> cone(count, 0.0f);
+        shAddCone(int(bands), tilted, oneMinusCosAlpha, 1.0f, cone.data());
+        EXPECT_NEAR(cone[0], strip[0], 1e-3f * strip[0]) << "band 0 does not move";
+        EXPECT_NEAR(shIrradiance(int(bands), cone.data(), n), shIrradiance(int(bands), strip.data(), n),
+                    2e-3f * shIrradiance(int(bands), strip.data(), n))
+            << bands << " bands";
+        // A cone that already reads its target stays where it is.
+        const glm::vec3 same = alongNormalDirection(weight, n, mean, oneMinusCosAlpha,
+                                                    weight.coneKernel(x0, oneMinusCosAlpha));
+        EXPECT_LT(glm::length(same - mean), 1e-5f);
+    }
+}
+
 TEST(LinkReads, ALightMapCacheReadsAWallWhereItsNormalGathersItsLight) {
     // A 2 × 2 m wall of 8 × 8 surfels (x = 0, facing +x) and, 0.3 m in front of its foot, a
     // light-map cache facing up and a grid cache at the same place, one link each (the wall,
