@@ -600,13 +600,18 @@ double LinkReadWeight::kernel(double x) const {
     return legendreSeries(mCoefficients.data(), mBands, x);
 }
 
-double LinkReadWeight::coneKernel(double x, double oneMinusCosAlpha) const {
+std::array<double, kMaxShBands> LinkReadWeight::coneWeights(double oneMinusCosAlpha) const {
     std::array<double, kMaxShBands> weights{};
     coneZonalBands(mBands, oneMinusCosAlpha, weights.data());
-    if (!(weights[0] > 0.0)) return kernel(x);
     const double band0 = weights[0];
-    for (int l = 0; l < mBands; ++l) weights[l] = double(mCoefficients[l]) * weights[l] / band0;
-    return legendreSeries(weights.data(), mBands, x);
+    for (int l = 0; l < mBands; ++l)
+        weights[l] = band0 > 0.0 ? double(mCoefficients[l]) * weights[l] / band0
+                                 : double(mCoefficients[l]);
+    return weights;
+}
+
+double LinkReadWeight::coneKernel(double x, double oneMinusCosAlpha) const {
+    return legendreSeries(coneWeights(oneMinusCosAlpha).data(), mBands, x);
 }
 
 glm::vec3 alongNormalDirection(const LinkReadWeight& weight, const glm::vec3& normal,
@@ -617,8 +622,8 @@ glm::vec3 alongNormalDirection(const LinkReadWeight& weight, const glm::vec3& no
     // Along n itself there is no plane to tilt in; an over-reading link there is a disc seen
     // face-on, which its cone matches.
     if (!(acrossLength > 1e-6f) || !std::isfinite(target)) return direction;
-    const double u = oneMinusCosAlpha;
-    auto f = [&](double x) { return weight.coneKernel(x, u) - target; };
+    const std::array<double, kMaxShBands> cone = weight.coneWeights(oneMinusCosAlpha);
+    auto f = [&](double x) { return legendreSeries(cone.data(), weight.bands(), x) - target; };
     const double f0 = f(x0);
     if (f0 == 0.0) return direction;
     // Walk from x0 towards the side where f changes sign, in steps, then bisect: the nearest

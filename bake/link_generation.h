@@ -116,6 +116,9 @@ public:
     /// with n·d = x: Σ_l K_l·(2l + 1)/(4π)·K_l(α)/K_0(α)·P_l(x) (the addition theorem), what an
     /// RTP link adds along n per unit of its band 0.
     double coneKernel(double x, double oneMinusCosAlpha) const;
+    /// coneKernel's Legendre weights, K_l·(2l + 1)/(4π)·K_l(α)/K_0(α) for l < bands().
+    std::array<double, kMaxShBands> coneWeights(double oneMinusCosAlpha) const;
+    int bands() const { return mBands; }
 
 private:
     int mBands;
