@@ -22,7 +22,7 @@ struct AccuracyParams {
     uint32_t shadeSpp = 4;        ///< subsamples per pixel when shading from caches
     int bounces = -1;             ///< runtime and reference bounces (−1: converged / unlimited)
     BakeOptions bake;
-    std::string outDir = "accuracy";
+    std::string outDir = "out/accuracy";
     std::string jsonPath;         ///< empty: <outDir>/<scene>_accuracy.json
     uint64_t seed = 1;
     /// Non-empty: the speed/accuracy trade-off instead of one comparison. One bake per nL,

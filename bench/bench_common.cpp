@@ -2,13 +2,26 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
-#include "core/chart.h"
+#include "bench/chart.h"
 #include "core/cli.h"
 #include "core/gltf_loader.h"
 
 namespace pic {
+
+namespace {
+
+/// Creates the folder `path` goes into (the benchmarks' defaults are under out/); a failure
+/// shows when the file is written.
+void createParentDirectory(const std::string& path) {
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    std::error_code ignored;
+    if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
+}
+
+}  // namespace
 
 double median(std::vector<double> values) {
     if (values.empty()) return 0.0;
@@ -51,25 +64,30 @@ LightSet changedLights(const LightSet& base, int k, float step, const std::strin
     return lights;
 }
 
-std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath) {
+std::unique_ptr<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath) {
+    auto inputs = std::make_unique<BenchInputs>();
     auto scene = loadScene(scenePath);
     if (!scene) {
         reportError(scene.error());
-        return std::nullopt;
+        return nullptr;
     }
-    auto lights = loadLightSet(lightsPath, *scene);
+    inputs->scene = std::move(*scene);
+    auto lights = loadLightSet(lightsPath, inputs->scene);
     if (!lights) {
         reportError(lights.error());
-        return std::nullopt;
+        return nullptr;
     }
-    if (lights->lights.empty())
+    inputs->lights = std::move(*lights);
+    if (inputs->lights.lights.empty())
         std::fprintf(stderr, "picbench: warning: the light set has no punctual lights\n");
-    auto rays = EmbreeScene::create(*scene);
+    // Built over the scene in its final place: the Embree scene keeps a pointer to it.
+    auto rays = EmbreeScene::create(inputs->scene);
     if (!rays) {
         reportError(rays.error());
-        return std::nullopt;
+        return nullptr;
     }
-    return BenchInputs{std::move(*scene), std::move(*lights), std::move(*rays)};
+    inputs->rays = std::move(*rays);
+    return inputs;
 }
 
 int reportError(const Error& error) { return reportError("picbench", error); }
@@ -82,6 +100,7 @@ std::string chartPathFor(const std::string& jsonPath) {
 }
 
 int writeChartFile(const Chart& chart, const std::string& path) {
+    createParentDirectory(path);
     if (auto written = writeChart(chart, path); !written) return reportError(written.error());
     std::printf("written %s\n", path.c_str());
     return 0;
@@ -104,6 +123,7 @@ Image imagesSideBySide(const std::vector<const Image*>& images) {
 }
 
 int writeJson(const nlohmann::ordered_json& json, const std::string& path) {
+    createParentDirectory(path);
     std::ofstream out(path);
     out << json.dump(2) << "\n";
     if (!out) {

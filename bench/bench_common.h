@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
-#include "core/chart.h"
+#include "bench/chart.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/light_set.h"
@@ -34,7 +34,7 @@ BakeOptions settingOptions(const std::string& setting, const std::string& linkMo
 /// change by a few per cent). `step` is in metres.
 LightSet changedLights(const LightSet& base, int k, float step, const std::string& change);
 
-/// A scene with its light set and rays.
+/// A scene with its light set and rays (over the scene: it stays where it was loaded).
 struct BenchInputs {
     Scene scene;
     LightSet lights;
@@ -42,8 +42,8 @@ struct BenchInputs {
 };
 
 /// Loads the scene, its light set (`lightsPath` empty: the scene's own) and its rays;
-/// prints the error and returns nullopt on failure.
-std::optional<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath);
+/// prints the error and returns null on failure.
+std::unique_ptr<BenchInputs> loadBenchInputs(const std::string& scenePath, const std::string& lightsPath);
 
 /// Prints `error` on stderr and returns its exit code.
 int reportError(const Error& error);
@@ -51,13 +51,13 @@ int reportError(const Error& error);
 /// The chart written beside a benchmark's JSON: "x.json" → "x.png".
 std::string chartPathFor(const std::string& jsonPath);
 
-/// Writes `chart` to `path` and says so; returns the exit code.
+/// Writes `chart` to `path` (creating its folder) and says so; returns the exit code.
 int writeChartFile(const Chart& chart, const std::string& path);
 
 /// The images placed left to right, top-aligned, on black (for side-by-side PNGs).
 Image imagesSideBySide(const std::vector<const Image*>& images);
 
-/// Writes `json` to `path` and says so; returns the exit code.
+/// Writes `json` to `path` (creating its folder) and says so; returns the exit code.
 int writeJson(const nlohmann::ordered_json& json, const std::string& path);
 
 }  // namespace pic

@@ -23,7 +23,7 @@ struct CodecBenchmarkParams {
     int updates = 10;
     std::vector<int> zstdLevels{1, 3, 6, 9,
                                 19};  ///< every frame is coded at each (picserver's default: 3)
-    std::string jsonPath = "codec_benchmark.json";
+    std::string jsonPath = "out/codec_benchmark.json";
 };
 
 int runCodecBenchmark(const CodecBenchmarkParams& params);

@@ -64,7 +64,7 @@ int picbenchMain(int argc, char** argv) {
     accuracy->add_option("--shade-spp", accuracyParams.shadeSpp, "subsamples per pixel when shading from caches (default 4)")
         ->check(CLI::PositiveNumber);
     accuracy->add_option("--bounces", accuracyParams.bounces, "bounces (default: converged / unlimited)");
-    accuracy->add_option("--out-dir", accuracyParams.outDir, "folder for images and JSON (default accuracy)");
+    accuracy->add_option("--out-dir", accuracyParams.outDir, "folder for images and JSON (default out/accuracy)");
     accuracy->add_option("--json", accuracyParams.jsonPath, "JSON file (default <out-dir>/<scene>_accuracy.json)");
     accuracy->add_option("--ref-seed", accuracyParams.seed, "path tracer seed (default 1)");
     accuracy
@@ -131,7 +131,7 @@ int picbenchMain(int argc, char** argv) {
     runtime->add_option("--changes", runtimeParams.changes,
                         "light changes: move-all, move-one, recolour (default: all three)")
         ->check(CLI::IsMember({"move-all", "move-one", "recolour"}));
-    runtime->add_option("--json", runtimeParams.jsonPath, "JSON file (default runtime_benchmark.json)");
+    runtime->add_option("--json", runtimeParams.jsonPath, "JSON file (default out/runtime_benchmark.json)");
 
     CLI::App* shadows = app.add_subcommand(
         "shadows", "shadow-map size against time and direct-light error (GPU against the CPU twin's rays)");
@@ -147,7 +147,7 @@ int picbenchMain(int argc, char** argv) {
     shadows->add_option("--repeat", shadowParams.repeat, "timed light changes per size (default 5)")
         ->check(CLI::Range(1, 1000));
     addDeviceOption(*shadows, shadowParams.device);
-    shadows->add_option("--json", shadowParams.jsonPath, "JSON file (default shadow_benchmark.json)");
+    shadows->add_option("--json", shadowParams.jsonPath, "JSON file (default out/shadow_benchmark.json)");
 
     CLI::App* codec = app.add_subcommand(
         "codec", "stream frame sizes (key and delta, bits per SH coefficient) and codec ms under light changes");
@@ -169,7 +169,7 @@ int picbenchMain(int argc, char** argv) {
                      "zstd levels to code every frame at, charted as size against encode time "
                      "(default 1 3 6 9 19)")
         ->check(CLI::Range(1, 19));
-    codec->add_option("--json", codecParams.jsonPath, "JSON file (default codec_benchmark.json)");
+    codec->add_option("--json", codecParams.jsonPath, "JSON file (default out/codec_benchmark.json)");
 
     CLI::App* stream = app.add_subcommand(
         "stream", "the server under load: light-change latency to N subscribers, server CPU per "
@@ -190,7 +190,7 @@ int picbenchMain(int argc, char** argv) {
     stream->add_option("--update-rate", streamParams.updateRate, "light changes per second (default 2)")
         ->check(CLI::PositiveNumber);
     stream->add_option("--picserver", streamParams.picserver, "picserver binary (default: the build tree's)");
-    stream->add_option("--json", streamParams.jsonPath, "JSON file (default stream_benchmark.json)");
+    stream->add_option("--json", streamParams.jsonPath, "JSON file (default out/stream_benchmark.json)");
 
     CLI::App* stability = app.add_subcommand(
         "stability", "paper 000 §5.2 / 001 §7 failure cases against path tracing, a moving "
@@ -226,7 +226,7 @@ int picbenchMain(int argc, char** argv) {
     stability->add_option("--ref-seed", stabilityParams.settings.seed,
                           "first random-set seed, path seed of the moving light, path tracer seed (default 1)");
     stability->add_option("--json", stabilityParams.jsonPath,
-                          "JSON file; PNGs go beside it (default stability/stability.json)");
+                          "JSON file; PNGs go beside it (default out/stability/stability.json)");
     stabilityFlags.addTo(*stability);
 
     CLI::App* compare = app.add_subcommand(

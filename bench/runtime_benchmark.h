@@ -37,7 +37,7 @@ struct RuntimeBenchmarkParams {
     std::vector<std::string> visibilities{"auto"};
     /// GpuRuntimeOptions::lightmapCopyOnHost: auto, host or device.
     std::string lightmapCopy = "auto";
-    std::string jsonPath = "runtime_benchmark.json";
+    std::string jsonPath = "out/runtime_benchmark.json";
 };
 
 /// Runs the benchmark; returns the process exit code.
@@ -51,7 +51,7 @@ struct ShadowBenchmarkParams {
     std::vector<std::string> sides{"uniform", "footprint"};  ///< GpuRuntimeOptions::shadowEqualFootprint
     int repeat = 5;
     std::string device;
-    std::string jsonPath = "shadow_benchmark.json";
+    std::string jsonPath = "out/shadow_benchmark.json";
 };
 
 /// Runs the shadow-map size sweep; returns the process exit code.

@@ -18,7 +18,7 @@
 #include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/progress.h"
-#include "core/random_lights.h"
+#include "bench/random_lights.h"
 #include "core/sampling.h"
 #include "core/sh.h"
 #include "render/cpu/cache_shading.h"

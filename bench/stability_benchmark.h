@@ -169,7 +169,7 @@ struct StabilityParams {
     std::vector<std::string> randomScenes{"cornell",    "cornell_area",    "closed_box",
                                           "two_floors", "opposite_colors", "small_spot",
                                           "thin_wall",  "furnished_room",  "furnished_study"};
-    std::string jsonPath = "stability/stability.json";
+    std::string jsonPath = "out/stability/stability.json";
 };
 
 /// Runs the suite, prints a table, writes the JSON and PNGs beside it (a chart of the moving

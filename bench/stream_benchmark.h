@@ -24,7 +24,7 @@ struct StreamBenchmarkParams {
     double duration = 10.0;       ///< seconds of light changes per subscriber count
     double updateRate = 2.0;      ///< light changes per second
     std::string picserver;        ///< empty: picserver next to picbench in the build tree
-    std::string jsonPath = "stream_benchmark.json";
+    std::string jsonPath = "out/stream_benchmark.json";
 };
 
 int runStreamBenchmark(const StreamBenchmarkParams& params);

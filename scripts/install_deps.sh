@@ -13,6 +13,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libzstd-dev
+  libplplot-dev plplot-driver-cairo
 )
 
 missing=()

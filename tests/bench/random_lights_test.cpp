@@ -1,4 +1,4 @@
-#include "core/random_lights.h"
+#include "bench/random_lights.h"
 
 #include <cmath>
 #include <set>
