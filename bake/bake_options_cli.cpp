@@ -3,6 +3,7 @@
 namespace pic {
 
 void BakeOptionFlags::addTo(CLI::App& command) {
+    const size_t first = command.get_options().size();
     mSurfelsOption = command.add_option("--surfels", mSurfels, "surfel count nS (default: from scene area and extent)");
     mLinksOption = command.add_option("--links", mLinks, "links per cache nL (default 128)");
     mBandsOption = command.add_option("--bands", mBands, "SH bands for luma lY, 1-8 (default 3)");
@@ -34,6 +35,18 @@ void BakeOptionFlags::addTo(CLI::App& command) {
         ->check(CLI::IsMember({"error", "solid-angle"}));
     command.add_option("--relax", mOptions.relaxIterations, "surfel relaxation iterations (default 4)");
     command.add_option("--seed", mOptions.seed, "random seed (default 1)");
+    const std::vector<CLI::Option*> all = command.get_options();
+    mAdded.assign(all.begin() + std::ptrdiff_t(first), all.end());
+}
+
+std::vector<std::string> BakeOptionFlags::toArgs() const {
+    std::vector<std::string> args;
+    for (const CLI::Option* option : mAdded) {
+        if (option->count() == 0) continue;
+        args.push_back("--" + option->get_single_name());
+        for (const std::string& value : option->results()) args.push_back(value);
+    }
+    return args;
 }
 
 BakeOptions BakeOptionFlags::toOptions() const {

@@ -3,6 +3,7 @@
 /// (`picbake bake`, `picbench bake`), so every tool spells them the same way.
 
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,8 @@ public:
     void addTo(CLI::App& command);
     /// The options the user set; unset ones stay empty so the bake picks defaults.
     BakeOptions toOptions() const;
+    /// The flags the user gave, as given ("--links", "32", …), to pass on to picbake.
+    std::vector<std::string> toArgs() const;
 
 private:
     BakeOptions mOptions;
@@ -32,6 +35,7 @@ private:
     CLI::Option* mChromaOption = nullptr;
     CLI::Option* mGridOption = nullptr;
     CLI::Option* mTexelOption = nullptr;
+    std::vector<const CLI::Option*> mAdded;  ///< every option addTo added, in order
 };
 
 }  // namespace pic

@@ -12,6 +12,7 @@
 #include "bench/runtime_benchmark.h"
 #include "bench/stability_benchmark.h"
 #include "bench/stream_benchmark.h"
+#include "bench/sweep_benchmark.h"
 #include "core/cli.h"
 
 namespace pic {
@@ -241,8 +242,58 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     compare->add_option("--json", compareParams.jsonPath, "write the figures to this JSON file");
 
+    CLI::App* sweep = app.add_subcommand(
+        "sweep", "bake and relight a scene over a grid of settings and the methods users would run "
+                 "instead; error against the path-traced reference, update ms, memory, bytes; CSV, "
+                 "JSON and Pareto charts");
+    SweepParams sweepParams;
+    addSceneOption(*sweep, sweepParams.scenePath);
+    addLightsOption(*sweep, sweepParams.lightsPath);
+    ViewFlags sweepView;
+    sweepView.addTo(*sweep, {.size = "96x72", .sceneCamera = 0});
+    sweep->add_option("--scene-cameras", sweepParams.sceneCameras,
+                      "views: these scene cameras, each measured and the errors averaged (default: "
+                      "--scene-camera's)");
+    sweep->add_option("--grid", sweepParams.grid,
+                      "settings grid: coarse (each parameter alone at 1-3 levels around the scene's "
+                      "defaults, plus two cheaper diagonals; about 22 bakes) or fine (more levels "
+                      "and a dearer diagonal; for a bigger machine) (default coarse)")
+        ->check(CLI::IsMember({"coarse", "fine"}));
+    sweep->add_option("--baselines", sweepParams.baselines,
+                      "methods to compare with: ideal, traced, lpv (default: all three)")
+        ->check(CLI::IsMember({"ideal", "traced", "lpv"}));
+    sweep->add_option("--spp", sweepParams.spp, "reference samples per pixel (default 256)")
+        ->check(CLI::Range(2u, 1u << 20));
+    sweep->add_option("--probe-samples", sweepParams.probeSamples,
+                      "directions per ideal cache (default 256)")
+        ->check(CLI::Range(4u, 1u << 20));
+    sweep->add_option("--shade-spp", sweepParams.shadeSpp,
+                      "subsamples per pixel shading from caches (default 2)")
+        ->check(CLI::Range(1u, 4096u));
+    sweep->add_option("--repeat", sweepParams.repeat, "timed updates per backend (default 3)")
+        ->check(CLI::Range(1, 1000));
+    sweep->add_flag("!--no-gpu", sweepParams.gpu, "time the CPU twin only");
+    addDeviceOption(*sweep, sweepParams.device);
+    sweep->add_option("--out-dir", sweepParams.outDir,
+                      "folder of the sweep: references, finished points, CSV, JSON, charts; a "
+                      "killed sweep resumes from it (default out/sweep/<scene>)");
+    sweep->add_option("--picbake", sweepParams.picbake, "picbake binary (default: the build tree's)");
+    sweep->add_option("--max-points", sweepParams.maxPoints,
+                      "measure only the first N settings of the grid (default: all)");
+    sweep->add_flag("--keep-bakes", sweepParams.keepBakes, "keep every setting's .pic file");
+    BakeOptionFlags sweepBakeFlags;
+    sweepBakeFlags.addTo(*sweep);
+
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (compare->parsed()) return runImageCompare(compareParams);
+    if (sweep->parsed()) {
+        auto view = sweepView.toView();
+        if (!view) return reportError(view.error());
+        sweepParams.view = *view;
+        if (sweepParams.sceneCameras.empty()) sweepParams.sceneCameras = {view->sceneCameraIndex};
+        sweepParams.baseBakeArgs = sweepBakeFlags.toArgs();
+        return runSweepBenchmark(sweepParams);
+    }
     if (stability->parsed()) {
         auto size = parseImageSize(stabilitySize);
         if (!size) return reportError(size.error());
