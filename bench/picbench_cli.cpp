@@ -270,7 +270,7 @@ int picbenchMain(int argc, char** argv) {
     sweep->add_option("--shade-spp", sweepParams.shadeSpp,
                       "subsamples per pixel shading from caches (default 2)")
         ->check(CLI::Range(1u, 4096u));
-    sweep->add_option("--repeat", sweepParams.repeat, "timed updates per backend (default 3)")
+    sweep->add_option("--repeat", sweepParams.repeat, "timed updates per backend (default 5)")
         ->check(CLI::Range(1, 1000));
     sweep->add_flag("!--no-gpu", sweepParams.gpu, "time the CPU twin only");
     addDeviceOption(*sweep, sweepParams.device);

@@ -9,7 +9,7 @@
 # Usage: bash bench/run_accuracy.sh [build-dir]
 set -euo pipefail
 BUILD=${1:-build}
-OUT=${OUT:-accuracy}
+OUT=${OUT:-out/accuracy}
 SCENES="$BUILD/scenes"
 LIVING="$(dirname "$0")/../../shared/scenes/living_room_sh3d.glb"
 SUN_LAMP="$(dirname "$0")/lightsets/living_room_sun_lamp.json"

@@ -10,7 +10,7 @@
 # PICBENCH likewise (its compare subcommand measures). SPP (default 256) is the reference's.
 set -euo pipefail
 BUILD=${1:-build}
-OUT=${OUT:-texture_filtering}
+OUT=${OUT:-out/texture_filtering}
 SPP=${SPP:-256}
 PICBAKE=${PICBAKE:-$BUILD/bake/picbake}
 PICREF=${PICREF:-$BUILD/bake/ref/picref}

@@ -36,7 +36,7 @@ struct SweepParams {
     uint32_t spp = 256;               ///< reference samples per pixel (two halves, seeds 1, 2)
     uint32_t probeSamples = 256;      ///< directions per ideal cache
     uint32_t shadeSpp = 2;            ///< subsamples per pixel shading from caches
-    int repeat = 3;                   ///< timed updates per backend; medians
+    int repeat = 5;                   ///< timed updates per backend; medians
     bool gpu = true;                  ///< also time the GPU backend (Vulkan; lavapipe here)
     std::string device;               ///< Vulkan device name substring
     std::string outDir;               ///< empty: out/sweep/<scene>
