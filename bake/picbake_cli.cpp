@@ -11,9 +11,11 @@
 
 #include "bake/bake.h"
 #include "bake/bake_options_cli.h"
+#include "bake/target_error.h"
 #include "core/bake_file.h"
 #include "core/cli.h"
 #include "core/gltf_loader.h"
+#include "core/image.h"
 #include "core/parallel.h"
 
 namespace pic {
@@ -34,9 +36,52 @@ std::string humanBytes(uint64_t bytes) {
 /// Stage timings live beside the bake, so the bake itself stays byte-identical across runs.
 std::string timingsPath(const std::string& bakePath) { return bakePath + ".timings.json"; }
 
+/// So does the --target-error pilot's prediction, which `info --json` shows under "target".
+std::string targetPath(const std::string& bakePath) { return bakePath + ".target.json"; }
+
+/// Writes `json` to `path` through a temporary file; a warning if it cannot.
+void writeBeside(const Json& json, const std::string& path) {
+    const std::string tmp = path + ".tmp";
+    std::ofstream out(tmp);
+    out << json.dump(2) << "\n";
+    out.close();
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (!out || ec) std::fprintf(stderr, "picbake: warning: could not write %s\n", path.c_str());
+}
+
 int reportError(const Error& error) { return pic::reportError("picbake", error); }
 
-int runBakeCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options) {
+/// Prints the pilot's ladder and what it chose, and why.
+void printTarget(const TargetChoice& choice, const TargetErrorParams& params) {
+    fmt::print("  target          {} relative RMSE {}{} against path tracing; pilot {}x{} at {} spp "
+               "(its own noise {:.3f}), {:.1f} s, on {}\n",
+               choice.component, params.error,
+               params.budgetMs ? fmt::format(" within {} ms per update", *params.budgetMs) : "",
+               params.size.x, params.size.y, params.spp, choice.noise, choice.pilotSeconds,
+               fmt::join(choice.views, "; "));
+    for (size_t i = 0; i < choice.rungs.size(); ++i) {
+        const TargetRung& r = choice.rungs[i];
+        fmt::print("    {} {:<9} nS {:>7} nL {:>4} lY {} lC {} cell {:.3g} m texel {:.3g} m: {:>6} caches, "
+                   "error {:.4f}, {:.1f} ms per update\n",
+                   i == choice.chosen ? "->" : "  ", r.name, r.params.surfels, r.params.linksPerCache,
+                   r.params.bandsY, r.params.bandsC, r.params.gridCell, r.params.lightmapTexel, r.caches, r.error,
+                   r.updateMs);
+    }
+    const TargetRung& chosen = choice.rungs[choice.chosen];
+    if (choice.met)
+        fmt::print("  chose           '{}': the cheapest rung whose predicted error {:.4f} is within {} x {} = {:.4f}\n",
+                   chosen.name, chosen.error, params.safety, params.error, params.safety * params.error);
+    else
+        std::fprintf(stderr,
+                     "picbake: warning: no rung reached %.4f (%.2f x the target %g)%s; wrote '%s', the most "
+                     "accurate within the budget (predicted error %.4f)\n",
+                     params.safety * params.error, params.safety, params.error,
+                     params.budgetMs ? " within the budget" : "", chosen.name.c_str(), chosen.error);
+}
+
+int runBakeCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options,
+                   const std::optional<TargetErrorParams>& target) {
     using Clock = std::chrono::steady_clock;
     auto start = Clock::now();
     auto loaded = loadScene(scenePath);
@@ -45,9 +90,23 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     double loadSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
     BakeReport report;
-    report.seconds.emplace_back("load", loadSeconds);
-    auto bake = runBake(scene, options, report);
-    if (!bake) return reportError(bake.error());
+    std::optional<TargetChoice> choice;
+    Result<BakeData> bake = fail(ErrorCode::Internal, "not baked");
+    if (target) {
+        auto chosen = chooseBakeForTarget(scene, options, *target);
+        if (!chosen) return reportError(chosen.error());
+        choice = std::move(*chosen);
+        report = choice->report;
+        bake = std::move(choice->bake);
+        // The pilot's own time: what it spent beyond the chosen rung's bake stages.
+        double stages = 0.0;
+        for (const auto& [stage, seconds] : report.seconds) stages += seconds;
+        report.seconds.insert(report.seconds.begin(), {"pilot", std::max(choice->pilotSeconds - stages, 0.0)});
+    } else {
+        bake = runBake(scene, options, report);
+        if (!bake) return reportError(bake.error());
+    }
+    report.seconds.insert(report.seconds.begin(), {"load", loadSeconds});
 
     auto writeStart = Clock::now();
     if (auto written = writeBakeFile(outPath, *bake); !written) return reportError(written.error());
@@ -63,15 +122,12 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     timings["seconds_total"] = total;
     timings["peak_memory_bytes"] = report.peakMemoryBytes;
     timings["threads"] = workerCount();
-    {
-        std::string tmp = timingsPath(outPath) + ".tmp";
-        std::ofstream out(tmp);
-        out << timings.dump(2) << "\n";
-        out.close();
-        std::error_code ec;
-        std::filesystem::rename(tmp, timingsPath(outPath), ec);
-        if (!out || ec) std::fprintf(stderr, "picbake: warning: could not write %s\n", timingsPath(outPath).c_str());
-    }
+    writeBeside(timings, timingsPath(outPath));
+    std::error_code ec;
+    if (choice)
+        writeBeside(targetJson(*choice, *target), targetPath(outPath));
+    else
+        std::filesystem::remove(targetPath(outPath), ec);  // a stale prediction of another bake
 
     auto info = inspectBakeFile(outPath);
     if (!info) return reportError(info.error());
@@ -135,6 +191,7 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
         stages += fmt::format("{}{} {:.2f}", stages.empty() ? "" : ", ", stage, s);
     fmt::print("  seconds         {} (total {:.2f}) on {} threads\n", stages, total, workerCount());
     fmt::print("  peak memory     {}\n", humanBytes(report.peakMemoryBytes));
+    if (choice) printTarget(*choice, *target);
     if (report.links.clampedCoefficients)
         fmt::print("  warning         {} SH link coefficients exceeded the half-float range and were clamped\n",
                    report.links.clampedCoefficients);
@@ -163,6 +220,10 @@ int runInfoCommand(const std::string& bakePath, bool json) {
     for (const auto& [name, bytes] : info->sectionBytes) out["bytes"][name] = bytes;
     out["file_bytes"] = info->fileSize;
     out["seconds"] = seconds;
+    if (std::ifstream in(targetPath(bakePath)); in) {
+        Json target = Json::parse(in, nullptr, false);
+        if (!target.is_discarded()) out["target"] = target;
+    }
     out["params"] = {{"grid_cell", p.gridCell},
                      {"lightmap_texel", p.lightmapTexel},
                      {"hierarchy", hierarchyName(p.hierarchy)},
@@ -207,6 +268,20 @@ int picbakeMain(int argc, char** argv) {
     bakeCommand->add_option("scene", scenePath, "scene file (.gltf or .glb)")->required();
     bakeCommand->add_option("-o,--out", outPath, "bake file to write (.pic)")->required();
     bakeFlags.addTo(*bakeCommand);
+    TargetErrorParams target;
+    std::string pilotSize = "64x48";
+    CLI::Option* targetOption = bakeCommand->add_option(
+        "--target-error", target.error,
+        "the cheapest settings predicted to meet this relative RMSE of the indirect light (the full "
+        "image where surfaces emit) against path tracing, from a pilot on the scene itself; bake "
+        "flags given too set the ladder's default rung");
+    CLI::Option* budgetOption = bakeCommand->add_option(
+        "--budget-ms", "with --target-error: most CPU twin ms per update on this machine")
+        ->check(CLI::Number);
+    bakeCommand->add_option("--lights", target.lightsPath, "with --target-error: the light set the pilot relights with (default: the scene's)");
+    bakeCommand->add_option("--pilot-size", pilotSize, "with --target-error: pilot image size (default 64x48)");
+    bakeCommand->add_option("--pilot-spp", target.spp, "with --target-error: pilot reference samples per pixel (default 256)")
+        ->check(CLI::Range(2u, 1u << 20));
 
     CLI::App* infoCommand = app.add_subcommand("info", "describe a bake file");
     std::string infoPath;
@@ -216,7 +291,17 @@ int picbakeMain(int argc, char** argv) {
 
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (bakeCommand->parsed()) {
-        return runBakeCommand(scenePath, outPath, bakeFlags.toOptions());
+        std::optional<TargetErrorParams> targeted;
+        if (*targetOption) {
+            auto size = parseImageSize(pilotSize);
+            if (!size) return reportError(size.error());
+            target.size = *size;
+            if (*budgetOption) target.budgetMs = budgetOption->as<double>();
+            targeted = target;
+        } else if (*budgetOption) {
+            return reportError(Error{ErrorCode::InvalidInput, "--budget-ms needs --target-error"});
+        }
+        return runBakeCommand(scenePath, outPath, bakeFlags.toOptions(), targeted);
     }
     return runInfoCommand(infoPath, json);
 }

@@ -143,4 +143,41 @@ TEST_F(PicbakeCli, BadUsageExitsWith2) {
     EXPECT_NE(r.err.find("12"), std::string::npos) << r.err;
 }
 
+TEST_F(PicbakeCli, TargetErrorPrintsItsChoiceAndInfoShowsIt) {
+    const std::string bake = (mDir / "target.pic").string();
+    test::CommandResult baked = run("bake " + scene("cornell") + " -o " + bake +
+                                    " --surfels 4096 --links 64 --target-error 0.6 --pilot-size 32x24 "
+                                    "--pilot-spp 32");
+    ASSERT_EQ(baked.exitCode, 0) << baked.err;
+    EXPECT_NE(baked.out.find("chose           'cheapest'"), std::string::npos) << baked.out;
+    test::CommandResult info = run("info --json " + bake);
+    ASSERT_EQ(info.exitCode, 0) << info.err;
+    const nlohmann::json json = nlohmann::json::parse(info.out);
+    const nlohmann::json& target = json.at("target");
+    EXPECT_EQ(target.at("error").get<double>(), 0.6);
+    EXPECT_EQ(target.at("met"), true);
+    EXPECT_LE(target.at("predicted_error").get<double>(), 0.85 * 0.6);
+    EXPECT_EQ(target.at("chosen"), "cheapest");
+    EXPECT_LT(json.at("links_per_cache").get<int>(), 64);
+    EXPECT_GT(target.at("pilot").at("reference_noise").get<double>(), 0.0);
+    // Baking the same file again without a target leaves no stale prediction behind.
+    ASSERT_EQ(run(smallBake("cornell", bake)).exitCode, 0);
+    EXPECT_FALSE(nlohmann::json::parse(run("info --json " + bake).out).contains("target"));
+}
+
+TEST_F(PicbakeCli, TargetErrorFlagsAreChecked) {
+    const std::string out = (mDir / "x.pic").string();
+    test::CommandResult r = run("bake " + scene("cornell") + " -o " + out + " --budget-ms 5");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("--budget-ms needs --target-error"), std::string::npos) << r.err;
+    r = run("bake " + scene("cornell") + " -o " + out + " --target-error -1");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("-1"), std::string::npos) << r.err;
+    r = run("bake " + scene("cornell") + " -o " + out + " --target-error 0.1 --budget-ms fast");
+    EXPECT_EQ(r.exitCode, 2);
+    r = run("bake " + scene("cornell") + " -o " + out + " --target-error 0.1 --pilot-size 0x9");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
