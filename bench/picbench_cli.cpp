@@ -36,6 +36,56 @@ void addSettingOption(CLI::App& command, std::string& setting) {
         ->check(CLI::IsMember({"moderate", "high"}));
 }
 
+/// The flags of `picbench sweep` and `picbench autotune`.
+struct SweepFlags {
+    SweepParams params;
+    ViewFlags view;
+    BakeOptionFlags bake;
+
+    void addTo(CLI::App& command) {
+        addSceneOption(command, params.scenePath);
+        addLightsOption(command, params.lightsPath);
+        view.addTo(command, {.size = "96x72", .sceneCamera = 0});
+        command.add_option("--scene-cameras", params.sceneCameras,
+                           "views: these scene cameras, each measured and the errors averaged (default: "
+                           "--scene-camera's)");
+        command.add_option("--grid", params.grid,
+                           "settings grid: coarse (each parameter alone at 1-3 levels around the scene's "
+                           "defaults, plus two cheaper diagonals; about 22 bakes) or fine (more levels "
+                           "and a dearer diagonal; for a bigger machine) (default coarse)")
+            ->check(CLI::IsMember({"coarse", "fine"}));
+        command.add_option("--baselines", params.baselines,
+                           "methods to compare with: ideal, traced, lpv (default: all three)")
+            ->check(CLI::IsMember({"ideal", "traced", "lpv"}));
+        command.add_option("--spp", params.spp, "reference samples per pixel (default 256)")
+            ->check(CLI::Range(2u, 1u << 20));
+        command.add_option("--probe-samples", params.probeSamples, "directions per ideal cache (default 256)")
+            ->check(CLI::Range(4u, 1u << 20));
+        command.add_option("--shade-spp", params.shadeSpp, "subsamples per pixel shading from caches (default 2)")
+            ->check(CLI::Range(1u, 4096u));
+        command.add_option("--repeat", params.repeat, "timed updates per backend (default 5)")
+            ->check(CLI::Range(1, 1000));
+        command.add_flag("!--no-gpu", params.gpu, "time the CPU twin only");
+        addDeviceOption(command, params.device);
+        command.add_option("--out-dir", params.outDir,
+                           "folder of the sweep: references, finished points, CSV, JSON, charts; a "
+                           "killed sweep resumes from it (default out/sweep/<scene>)");
+        command.add_option("--picbake", params.picbake, "picbake binary (default: the build tree's)");
+        command.add_option("--max-points", params.maxPoints,
+                           "measure only the first N settings of the grid (default: all)");
+        command.add_flag("--keep-bakes", params.keepBakes, "keep every setting's .pic file");
+        bake.addTo(command);
+    }
+
+    /// The parameters after parsing.
+    Result<SweepParams> toParams() {
+        PIC_TRY_ASSIGN(params.view, view.toView());
+        if (params.sceneCameras.empty()) params.sceneCameras = {params.view.sceneCameraIndex};
+        params.baseBakeArgs = bake.toArgs();
+        return params;
+    }
+};
+
 }  // namespace
 
 int picbenchMain(int argc, char** argv) {
@@ -246,54 +296,30 @@ int picbenchMain(int argc, char** argv) {
         "sweep", "bake and relight a scene over a grid of settings and the methods users would run "
                  "instead; error against the path-traced reference, update ms, memory, bytes; CSV, "
                  "JSON and Pareto charts");
-    SweepParams sweepParams;
-    addSceneOption(*sweep, sweepParams.scenePath);
-    addLightsOption(*sweep, sweepParams.lightsPath);
-    ViewFlags sweepView;
-    sweepView.addTo(*sweep, {.size = "96x72", .sceneCamera = 0});
-    sweep->add_option("--scene-cameras", sweepParams.sceneCameras,
-                      "views: these scene cameras, each measured and the errors averaged (default: "
-                      "--scene-camera's)");
-    sweep->add_option("--grid", sweepParams.grid,
-                      "settings grid: coarse (each parameter alone at 1-3 levels around the scene's "
-                      "defaults, plus two cheaper diagonals; about 22 bakes) or fine (more levels "
-                      "and a dearer diagonal; for a bigger machine) (default coarse)")
-        ->check(CLI::IsMember({"coarse", "fine"}));
-    sweep->add_option("--baselines", sweepParams.baselines,
-                      "methods to compare with: ideal, traced, lpv (default: all three)")
-        ->check(CLI::IsMember({"ideal", "traced", "lpv"}));
-    sweep->add_option("--spp", sweepParams.spp, "reference samples per pixel (default 256)")
-        ->check(CLI::Range(2u, 1u << 20));
-    sweep->add_option("--probe-samples", sweepParams.probeSamples,
-                      "directions per ideal cache (default 256)")
-        ->check(CLI::Range(4u, 1u << 20));
-    sweep->add_option("--shade-spp", sweepParams.shadeSpp,
-                      "subsamples per pixel shading from caches (default 2)")
-        ->check(CLI::Range(1u, 4096u));
-    sweep->add_option("--repeat", sweepParams.repeat, "timed updates per backend (default 5)")
-        ->check(CLI::Range(1, 1000));
-    sweep->add_flag("!--no-gpu", sweepParams.gpu, "time the CPU twin only");
-    addDeviceOption(*sweep, sweepParams.device);
-    sweep->add_option("--out-dir", sweepParams.outDir,
-                      "folder of the sweep: references, finished points, CSV, JSON, charts; a "
-                      "killed sweep resumes from it (default out/sweep/<scene>)");
-    sweep->add_option("--picbake", sweepParams.picbake, "picbake binary (default: the build tree's)");
-    sweep->add_option("--max-points", sweepParams.maxPoints,
-                      "measure only the first N settings of the grid (default: all)");
-    sweep->add_flag("--keep-bakes", sweepParams.keepBakes, "keep every setting's .pic file");
-    BakeOptionFlags sweepBakeFlags;
-    sweepBakeFlags.addTo(*sweep);
+    SweepFlags sweepFlags;
+    sweepFlags.addTo(*sweep);
+    sweep->add_option("--target-errors", sweepFlags.params.targetErrors,
+                      "also bake with picbake --target-error E for each E and check each choice "
+                      "against the grid (as autotune does)")
+        ->check(CLI::Range(1e-6, 10.0));
+    CLI::App* autotune = app.add_subcommand(
+        "autotune", "the sweep, then picbake --target-error E for each E, each choice measured and "
+                    "checked: its error against the truth at most E, its update at most 1.1 x the "
+                    "cheapest swept point's that meets E");
+    SweepFlags autotuneFlags;
+    autotuneFlags.addTo(*autotune);
+    autotune->add_option("--target-errors", autotuneFlags.params.targetErrors, "targets E to check")
+        ->required()
+        ->check(CLI::Range(1e-6, 10.0));
 
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (compare->parsed()) return runImageCompare(compareParams);
-    if (sweep->parsed()) {
-        auto view = sweepView.toView();
-        if (!view) return reportError(view.error());
-        sweepParams.view = *view;
-        if (sweepParams.sceneCameras.empty()) sweepParams.sceneCameras = {view->sceneCameraIndex};
-        sweepParams.baseBakeArgs = sweepBakeFlags.toArgs();
-        return runSweepBenchmark(sweepParams);
-    }
+    for (SweepFlags* flags : {&sweepFlags, &autotuneFlags})
+        if ((flags == &sweepFlags ? sweep : autotune)->parsed()) {
+            auto params = flags->toParams();
+            if (!params) return reportError(params.error());
+            return runSweepBenchmark(*params);
+        }
     if (stability->parsed()) {
         auto size = parseImageSize(stabilitySize);
         if (!size) return reportError(size.error());

@@ -480,10 +480,12 @@ Result<Json> measureSetting(const SweepContext& context, const SweepSetting& set
     PIC_TRY_ASSIGN(std::vector<Image> ideal, idealImages(context, bake, context.params.probeSamples, probeMs));
     PIC_TRY_ASSIGN(Accuracy accuracy, measureAccuracy(context, bake, runtime.settled, &ideal));
     point["accuracy"] = accuracyJson(accuracy);
+    if (auto target = readJson(bakePath.string() + ".target.json")) point["target"] = std::move(*target);
     if (!keep && !context.params.keepBakes) {
         std::error_code ec;
         fs::remove(bakePath, ec);
         fs::remove(bakePath.string() + ".timings.json", ec);
+        fs::remove(bakePath.string() + ".target.json", ec);
     }
     return point;
 }
@@ -646,6 +648,48 @@ const char* chartedComponent(const Scene& scene) {
     return "indirect";
 }
 
+/// The autotune check of every `picbake --target-error` point against the grid: its error
+/// against the truth at most E, and its update against the cheapest grid point that meets E
+/// (CPU twin ms, and links read per update, caches × nL, which no busy spell of the machine
+/// moves).
+Json autotuneChecks(const std::vector<Json>& points, const std::string& component) {
+    Json checks = Json::array();
+    const std::string key = component + "_rmse_vs_truth";
+    for (const Json& t : points) {
+        if (t["method"] != "target") continue;
+        const double target = t["target_error"].get<double>();
+        const double error = t["accuracy"][key].get<double>();
+        const Json* cheapest = nullptr;
+        for (const Json& p : points)
+            if (p["method"] == "pic" && p["accuracy"][key].get<double>() <= target &&
+                (!cheapest || p["settle_ms"].get<double>() < (*cheapest)["settle_ms"].get<double>()))
+                cheapest = &p;
+        auto linkReads = [](const Json& p) {
+            return double(p["params"]["caches"].get<uint64_t>()) * p["params"]["links"].get<double>();
+        };
+        Json check{{"target_error", target},
+                   {"error", error},
+                   {"meets", error <= target},
+                   {"chosen", t.contains("target") ? t["target"]["chosen"] : Json(nullptr)},
+                   {"predicted_error", t.contains("target") ? t["target"]["predicted_error"] : Json(nullptr)},
+                   {"update_ms", t["settle_ms"]},
+                   {"link_reads", linkReads(t)}};
+        if (cheapest) {
+            check["cheapest_swept"] = {{"name", (*cheapest)["name"]},
+                                       {"error", (*cheapest)["accuracy"][key]},
+                                       {"update_ms", (*cheapest)["settle_ms"]},
+                                       {"link_reads", linkReads(*cheapest)}};
+            check["cost_ratio"] = t["settle_ms"].get<double>() / (*cheapest)["settle_ms"].get<double>();
+            check["link_reads_ratio"] = linkReads(t) / linkReads(*cheapest);
+            check["within_10_percent"] = check["cost_ratio"].get<double>() <= 1.1;
+        } else {
+            check["cheapest_swept"] = nullptr;
+        }
+        checks.push_back(check);
+    }
+    return checks;
+}
+
 /// One row of the CSV per point.
 void writeCsv(const std::vector<Json>& points, const fs::path& path) {
     std::ofstream out(path);
@@ -683,6 +727,7 @@ glm::vec3 methodColor(const std::string& method) {
     if (method == "pic") return {0.12f, 0.40f, 0.80f};
     if (method == "ideal") return {0.35f, 0.35f, 0.35f};
     if (method == "traced_probes") return {0.85f, 0.45f, 0.10f};
+    if (method == "target") return {0.80f, 0.10f, 0.10f};
     return {0.20f, 0.60f, 0.25f};
 }
 
@@ -690,6 +735,7 @@ const char* methodName(const std::string& method) {
     if (method == "pic") return "pic (one bake per setting)";
     if (method == "ideal") return "ideal caches (path-traced probes)";
     if (method == "traced_probes") return "ray-traced probes at runtime";
+    if (method == "target") return "picbake --target-error";
     return "light propagation volume";
 }
 
@@ -941,6 +987,19 @@ int runSweepBenchmark(const SweepParams& params) {
                                [&] { return measureBaseline(context, baseline, *bake, *floorImages); });
             !ok)
             return reportError(ok.error());
+    for (const double target : params.targetErrors) {
+        const SweepSetting setting{fmt::format("target {}", flagNumber(target)), "target",
+                                   {"--target-error", flagNumber(target)}, "rays"};
+        if (auto ok = runPoint(setting.key(), index++, total + params.targetErrors.size(), setting.name,
+                               [&]() -> Result<Json> {
+                                   PIC_TRY_ASSIGN(Json point, measureSetting(context, setting, false));
+                                   point["method"] = "target";
+                                   point["target_error"] = target;
+                                   return point;
+                               });
+            !ok)
+            return reportError(ok.error());
+    }
 
     // The whole sweep: JSON, CSV and the charts.
     Json json;
@@ -953,6 +1012,8 @@ int runSweepBenchmark(const SweepParams& params) {
     json["reference_noise"] = noise;
     addErrorAgainstTruth(points, context.views);
     json["points"] = points;
+    const Json checks = autotuneChecks(points, component);
+    if (!checks.empty()) json["autotune"] = checks;
     const fs::path jsonPath = context.dir / "sweep.json";
     if (auto written = writeJsonAtomically(json, jsonPath); !written) return reportError(written.error());
     writeCsv(points, context.dir / "sweep.csv");
@@ -973,6 +1034,21 @@ int runSweepBenchmark(const SweepParams& params) {
     }
     std::printf("reference noise (%s, relative RMSE of the reference itself): %.4f\n", component.c_str(),
                 noise.empty() ? 0.0 : noise[0][component].get<double>());
+    for (const Json& c : checks) {
+        const bool swept = !c["cheapest_swept"].is_null();
+        std::printf("--target-error %g: chose '%s' (predicted %.4f); %s error against the truth %.4f: %s; %.1f ms "
+                    "per update%s\n",
+                    c["target_error"].get<double>(), c["chosen"].is_null() ? "?" : c["chosen"].get<std::string>().c_str(),
+                    c["predicted_error"].is_null() ? 0.0 : c["predicted_error"].get<double>(), component.c_str(),
+                    c["error"].get<double>(), c["meets"].get<bool>() ? "meets it" : "MISSES it", c["update_ms"].get<double>(),
+                    swept ? fmt::format(", {:.2f} x the cheapest swept point that meets it ('{}', {:.1f} ms; link reads "
+                                        "{:.2f} x): {}",
+                                        c["cost_ratio"].get<double>(), c["cheapest_swept"]["name"].get<std::string>(),
+                                        c["cheapest_swept"]["update_ms"].get<double>(), c["link_reads_ratio"].get<double>(),
+                                        c["within_10_percent"].get<bool>() ? "within 10 %" : "NOT within 10 %")
+                                .c_str()
+                          : "; no swept point meets it");
+    }
     std::printf("wrote %s, %s, %s\n", jsonPath.c_str(), (context.dir / "sweep.csv").c_str(), chartPath.c_str());
     return 0;
 }

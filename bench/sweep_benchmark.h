@@ -43,6 +43,10 @@ struct SweepParams {
     std::string picbake;              ///< empty: the build tree's picbake
     uint32_t maxPoints = 0;           ///< > 0: only the first N settings (tests, trials)
     bool keepBakes = false;           ///< keep each setting's .pic file
+    /// Targets E to bake with `picbake --target-error E` after the grid (`picbench autotune`):
+    /// each bake measured as a point and checked against the grid: its error against the
+    /// truth at most E, its update at most 1.1 × the cheapest grid point's that meets E.
+    std::vector<double> targetErrors;
 };
 
 /// One setting of the sweep: the bake flags it passes to picbake and the GPU backend's
