@@ -20,29 +20,6 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// The component the error is measured on: the indirect light, unless surfaces emit. The
-/// caches then carry the emitters' light, whose first reflection the path tracer counts as
-/// direct (PathTraceParams::Component), so only the full images compare.
-bool surfacesEmit(const Scene& scene) {
-    for (const Material& m : scene.materials)
-        if (glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) return true;
-    return false;
-}
-
-/// Relative RMSE of the mean of two independent estimates a, b against the truth: RMS(a − b)/2
-/// over the mean (their difference has twice the variance of either, their mean half of it).
-double halvesNoise(const Image& a, const Image& b) {
-    double sum = 0.0, level = 0.0;
-    for (size_t i = 0; i < a.pixels.size(); ++i) {
-        const glm::dvec3 d = glm::dvec3(a.pixels[i]) - glm::dvec3(b.pixels[i]);
-        sum += glm::dot(d, d);
-        level += 0.5 * double(a.pixels[i].r + a.pixels[i].g + a.pixels[i].b + b.pixels[i].r +
-                              b.pixels[i].g + b.pixels[i].b);
-    }
-    const double n = 3.0 * double(a.pixels.size());
-    return level > 0.0 ? std::sqrt(sum / n) / 2.0 / (level / n) : 0.0;
-}
-
 double median3(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
@@ -56,6 +33,25 @@ struct PilotReference {
 };
 
 }  // namespace
+
+bool surfacesEmit(const Scene& scene) {
+    for (const Material& m : scene.materials)
+        if (glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) return true;
+    return false;
+}
+
+double halvesNoise(const Image& a, const Image& b) {
+    PIC_CHECK(a.pixels.size() == b.pixels.size());
+    double sum = 0.0, level = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const glm::dvec3 d = glm::dvec3(a.pixels[i]) - glm::dvec3(b.pixels[i]);
+        sum += glm::dot(d, d);
+        level += 0.5 * double(a.pixels[i].r + a.pixels[i].g + a.pixels[i].b + b.pixels[i].r +
+                              b.pixels[i].g + b.pixels[i].b);
+    }
+    const double n = 3.0 * double(a.pixels.size());
+    return level > 0.0 ? std::sqrt(sum / n) / 2.0 / (level / n) : 0.0;
+}
 
 std::vector<std::pair<std::string, BakeOptions>> targetLadder(const Scene& scene, const BakeOptions& base) {
     std::map<std::string, std::string> unused;

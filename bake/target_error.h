@@ -18,6 +18,7 @@
 #include "bake/bake.h"
 #include "core/bake_data.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
 
@@ -63,6 +64,16 @@ struct TargetChoice {
     std::vector<std::string> views;  ///< how each view was found
     double pilotSeconds = 0.0;
 };
+
+/// Whether any material emits: then the caches carry the emitters' light, whose first
+/// reflection the path tracer counts as direct (PathTraceParams::Component), so only full
+/// images compare with a reference; otherwise the indirect light does.
+bool surfacesEmit(const Scene& scene);
+
+/// The relative RMSE against the truth of the mean of two independent estimates `a` and `b`
+/// of the same image: RMS(a − b)/2 over the mean's level (their difference has twice the
+/// variance of either, their mean half of it). Same sizes required.
+double halvesNoise(const Image& a, const Image& b);
 
 /// The ladder of settings the pilot climbs, cheapest first, around `base` (the user's bake
 /// flags; unset values are the scene's defaults): each rung scales nS and nL, coarsens the

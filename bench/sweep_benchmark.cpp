@@ -19,6 +19,7 @@
 
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
+#include "bake/target_error.h"
 #include "bench/bench_common.h"
 #include "bench/chart.h"
 #include "bench/light_propagation_volume.h"
@@ -119,21 +120,6 @@ struct ViewReference {
     double fullNoise = 0.0;
 };
 
-/// Relative RMSE of the mean of two independent estimates a, b: RMS(a − b)/2 over the mean
-/// of the reference (the two share the truth; their difference has twice the variance of
-/// either, the mean half of it).
-double halvesNoise(const Image& a, const Image& b, const Image& mean) {
-    double sum = 0.0, level = 0.0;
-    for (size_t i = 0; i < a.pixels.size(); ++i) {
-        const glm::dvec3 d = glm::dvec3(a.pixels[i]) - glm::dvec3(b.pixels[i]);
-        sum += glm::dot(d, d);
-        level += double(mean.pixels[i].r + mean.pixels[i].g + mean.pixels[i].b);
-    }
-    const double n = 3.0 * double(a.pixels.size());
-    level /= n;
-    return level > 0.0 ? std::sqrt(sum / n) / 2.0 / level : 0.0;
-}
-
 Image meanOf(const Image& a, const Image& b) {
     Image out(a.width, a.height);
     for (size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
@@ -194,7 +180,7 @@ Result<void> loadOrTraceReferences(SweepContext& context) {
                 PIC_TRY(writeImage(path.string(), halves[h]));
             }
             Image mean = meanOf(halves[0], halves[1]);
-            (indirect ? view.indirectNoise : view.fullNoise) = halvesNoise(halves[0], halves[1], mean);
+            (indirect ? view.indirectNoise : view.fullNoise) = halvesNoise(halves[0], halves[1]);
             (indirect ? view.indirect : view.full) = std::move(mean);
         }
         context.views.push_back(std::move(view));
@@ -639,14 +625,8 @@ void addErrorAgainstTruth(std::vector<Json>& points, const std::vector<ViewRefer
         }
 }
 
-/// The component the charts hold against the truth: the indirect light, unless surfaces emit.
-/// The caches then carry the emitters' light, whose first reflection the path tracer counts
-/// as direct light (PathTraceParams::Component), so only the full images compare.
-const char* chartedComponent(const Scene& scene) {
-    for (const Material& m : scene.materials)
-        if (glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) return "full";
-    return "indirect";
-}
+/// The component the charts hold against the truth (surfacesEmit).
+const char* chartedComponent(const Scene& scene) { return surfacesEmit(scene) ? "full" : "indirect"; }
 
 /// The autotune check of every `picbake --target-error` point against the grid: its error
 /// against the truth at most E, and its update against the cheapest grid point that meets E
