@@ -47,10 +47,7 @@ double msSince(Clock::time_point start) {
 }
 
 /// "12.5" for a float flag, without trailing zeros.
-std::string flagNumber(double value) {
-    std::string text = fmt::format("{:.6g}", value);
-    return text;
-}
+std::string flagNumber(double value) { return fmt::format("{:.6g}", value); }
 
 /// Writes `json` to `path` through a temporary file and a rename, so that a killed sweep
 /// never leaves half a result behind.
@@ -191,6 +188,7 @@ Result<void> loadOrTraceReferences(SweepContext& context) {
 /// The inputs every figure of an output folder depends on; a folder holding another sweep's
 /// figures is refused rather than mixed.
 Json inputsSignature(const SweepContext& context) {
+    const std::string lights = toJson(context.lights);
     const SweepParams& params = context.params;
     Json views = Json::array();
     for (size_t v = 0; v < viewCount(params); ++v) {
@@ -201,8 +199,7 @@ Json inputsSignature(const SweepContext& context) {
     }
     return {{"scene", fs::path(params.scenePath).filename().string()},
             {"scene_hash", fmt::format("{:016x}", context.scene.hash)},
-            {"lights_hash", fmt::format("{:016x}", hashBytes(toJson(context.lights).data(),
-                                                             toJson(context.lights).size()))},
+            {"lights_hash", fmt::format("{:016x}", hashBytes(lights.data(), lights.size()))},
             {"size", fmt::format("{}x{}", params.view.size.x, params.view.size.y)},
             {"views", views},
             {"base_bake_args", params.baseBakeArgs},

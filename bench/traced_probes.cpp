@@ -12,6 +12,7 @@
 #include "core/parallel.h"
 #include "core/sampling.h"
 #include "core/sh.h"
+#include "render/runtime.h"
 
 namespace pic {
 
@@ -55,20 +56,14 @@ Result<std::unique_ptr<TracedProbes>> TracedProbes::create(const Scene& scene,
     if (params.subsets == 0 || params.subsets > kMaxSubsets)
         return fail(ErrorCode::InvalidInput, "subsets must be in [1, {}], got {}", kMaxSubsets,
                     params.subsets);
-    if (bake.sceneHash != scene.hash)
-        return fail(ErrorCode::InvalidInput,
-                    "the bake was made for scene hash {:016x}, scene '{}' has hash {:016x}",
-                    bake.sceneHash, scene.sourcePath, scene.hash);
+    // The bake's own checks, as every runtime backend makes them: its scene, bands, surfels.
+    PIC_TRY(checkRuntimeBake(scene, bake));
     if (rays.scene().hash != scene.hash)
         return fail(ErrorCode::InvalidInput,
                     "the Embree scene was built for scene hash {:016x}, scene '{}' has hash "
                     "{:016x}",
                     rays.scene().hash, scene.sourcePath, scene.hash);
     const uint32_t bandsY = bake.params.bandsY, bandsC = bake.params.bandsC;
-    if (bandsY < 1 || bandsY > uint32_t(kMaxShBands) || bandsC < 1 || bandsC > bandsY)
-        return fail(ErrorCode::InvalidInput,
-                    "bake band counts y {} c {} are outside 1 <= c <= y <= {}", bandsY, bandsC,
-                    kMaxShBands);
 
     std::unique_ptr<TracedProbes> probes(new TracedProbes(scene, rays, bake, params));
     const size_t cacheCount = bake.caches.size();
