@@ -13,6 +13,7 @@
 #include "bake/bake_options_cli.h"
 #include "bake/target_error.h"
 #include "core/bake_file.h"
+#include "core/camera.h"
 #include "core/cli.h"
 #include "core/gltf_loader.h"
 #include "core/image.h"
@@ -52,7 +53,7 @@ void writeBeside(const Json& json, const std::string& path) {
 
 int reportError(const Error& error) { return pic::reportError("picbake", error); }
 
-/// Prints the pilot's ladder and what it chose, and why.
+/// Prints what the pilot measured, what it chose and why.
 void printTarget(const TargetChoice& choice, const TargetErrorParams& params) {
     fmt::print("  target          {} relative RMSE {}{} against path tracing; pilot {}x{} at {} spp "
                "(its own noise {:.3f}), {:.1f} s, on {}\n",
@@ -62,20 +63,25 @@ void printTarget(const TargetChoice& choice, const TargetErrorParams& params) {
                fmt::join(choice.views, "; "));
     for (size_t i = 0; i < choice.rungs.size(); ++i) {
         const TargetRung& r = choice.rungs[i];
-        fmt::print("    {} {:<9} nS {:>7} nL {:>4} lY {} lC {} cell {:.3g} m texel {:.3g} m: {:>6} caches, "
-                   "error {:.4f}, {:.1f} ms per update\n",
-                   i == choice.chosen ? "->" : "  ", r.name, r.params.surfels, r.params.linksPerCache,
-                   r.params.bandsY, r.params.bandsC, r.params.gridCell, r.params.lightmapTexel, r.caches, r.error,
-                   r.updateMs);
+        fmt::print("    {} {:<6} nS {:>7} nL {:>4} lY {} lC {} cell {:.3g} m texel {:.3g} m: {:>6} caches, error {:.4f}{}, "
+                   "{:.1f} ms per update (modelled {:.1f}){}: {}\n",
+                   i == choice.chosen ? "->" : "  ", r.kind, r.params.surfels, r.params.linksPerCache, r.params.bandsY,
+                   r.params.bandsC, r.params.gridCell, r.params.lightmapTexel, r.caches, r.error,
+                   r.predictedError ? fmt::format(" (predicted {:.4f})", *r.predictedError) : "", r.updateMs,
+                   r.predictedMs, r.cached ? ", kept" : "", r.name);
     }
     const TargetRung& chosen = choice.rungs[choice.chosen];
+    fmt::print("  models          {} combinations ranked; cost {:.3g} ms per 1000 link reads, {:.3g} per 1000 link "
+               "read coefficients, {:.3g} per 1000 surfels, {:.3g} per update; error sums scaled by {:.2f}\n",
+               choice.combinations, 1e3 * choice.cost.coefficients[0], 1e3 * choice.cost.coefficients[1],
+               1e3 * choice.cost.coefficients[2], choice.cost.coefficients[3], choice.errorScale);
     if (choice.met)
-        fmt::print("  chose           '{}': the cheapest rung whose predicted error {:.4f} is within {} x {} = {:.4f}\n",
-                   chosen.name, chosen.error, params.safety, params.error, params.safety * params.error);
+        fmt::print("  chose           '{}': the cheapest bake measured within {} x {} = {:.4f} (error {:.4f})\n",
+                   chosen.name, params.safety, params.error, params.safety * params.error, chosen.error);
     else
         std::fprintf(stderr,
-                     "picbake: warning: no rung reached %.4f (%.2f x the target %g)%s; wrote '%s', the most "
-                     "accurate within the budget (predicted error %.4f)\n",
+                     "picbake: warning: no bake reached %.4f (%.2f x the target %g)%s; wrote '%s', the most "
+                     "accurate within the budget (error %.4f)\n",
                      params.safety * params.error, params.safety, params.error,
                      params.budgetMs ? " within the budget" : "", chosen.name.c_str(), chosen.error);
 }
@@ -269,7 +275,8 @@ int picbakeMain(int argc, char** argv) {
     bakeCommand->add_option("-o,--out", outPath, "bake file to write (.pic)")->required();
     bakeFlags.addTo(*bakeCommand);
     TargetErrorParams target;
-    std::string pilotSize = "64x48";
+    std::string pilotSize = "96x72", pilotCache = defaultCacheDir();
+    std::vector<std::string> pilotCameras;
     CLI::Option* targetOption = bakeCommand->add_option(
         "--target-error", target.error,
         "the cheapest settings predicted to meet this relative RMSE of the indirect light (the full "
@@ -279,7 +286,13 @@ int picbakeMain(int argc, char** argv) {
         "--budget-ms", "with --target-error: most CPU twin ms per update on this machine")
         ->check(CLI::Number);
     bakeCommand->add_option("--lights", target.lightsPath, "with --target-error: the light set the pilot relights with (default: the scene's)");
-    bakeCommand->add_option("--pilot-size", pilotSize, "with --target-error: pilot image size (default 64x48)");
+    bakeCommand->add_option("--pilot-size", pilotSize, "with --target-error: pilot image size (default 96x72)");
+    bakeCommand->add_option("--pilot-camera", pilotCameras,
+                            "with --target-error: a view the pilot measures, ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy "
+                            "(repeatable; default: the scene's first two cameras, else two from its middle)");
+    bakeCommand->add_option("--pilot-cache", pilotCache,
+                            "with --target-error: folder where the pilot keeps its measurements for the next "
+                            "target on the same scene, or 'none' (default: " + defaultCacheDir() + ")");
     bakeCommand->add_option("--pilot-spp", target.spp, "with --target-error: pilot reference samples per pixel (default 256)")
         ->check(CLI::Range(2u, 1u << 20));
 
@@ -296,6 +309,12 @@ int picbakeMain(int argc, char** argv) {
             auto size = parseImageSize(pilotSize);
             if (!size) return reportError(size.error());
             target.size = *size;
+            for (const std::string& text : pilotCameras) {
+                auto camera = parseCamera(text);
+                if (!camera) return reportError(Error{camera.error().code, "--pilot-camera: " + camera.error().message});
+                target.cameras.push_back(*camera);
+            }
+            target.cacheDir = pilotCache == "none" ? "" : pilotCache;
             if (*budgetOption) target.budgetMs = budgetOption->as<double>();
             targeted = target;
         } else if (*budgetOption) {

@@ -1,12 +1,26 @@
 #pragma once
 /// `picbake bake --target-error E`: the cheapest bake predicted to meet an error target, found
-/// by a pilot on the scene itself. The pilot path-traces the scene's views small (two
-/// independent halves, whose difference gives the reference's own noise n), then bakes a
-/// ladder of settings from the cheapest up, relights each with the CPU twin, shades it at the
-/// same views and takes its error against the truth as √(e² − n²), e the measured relative
-/// RMSE. The first rung whose error is at most the target times a safety factor (and whose
-/// update fits the budget) is the choice; nothing is looked up from other scenes.
+/// by a pilot on the scene itself; nothing is looked up from other scenes.
+///
+/// The pilot path-traces the scene's views small, in two independent halves whose difference
+/// gives the reference's own noise n, so that a bake's error against the truth is √(e² − n²)
+/// with e its measured relative RMSE. It bakes the user's settings (the base) and each setting
+/// alone up to three steps cheaper (nS, nL ×½, ×¼ and ×⅛; lY − 1; each lC below the base; grid
+/// cell and light-map texel ×2 and ×4; 4 link samples) and every setting at its cheapest at
+/// once (the corner) — and, where the base misses the target, each setting a step dearer —
+/// relights each with the CPU twin, times its update and measures its error.
+///
+/// Two models then rank every combination of those levels. Error: independent approximations
+/// add their squared errors, e²(combination) = e²(base) + Σ (e²(setting alone) − e²(base)).
+/// Cost: the update's CPU ms as a non-negative fit of link reads (caches · nL), link reads
+/// times SH coefficients, surfels and a constant to the measured bakes. The cheapest
+/// combination predicted within safety · E is baked and measured; if it misses, the error
+/// model's sum is scaled up by what the miss shows, every combination no dearer on any setting
+/// is struck out, and the next is tried. Measurements are kept in a cache keyed by the scene,
+/// its base settings, lights and pilot, so a second target on the same scene bakes only what
+/// it has not measured.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -30,38 +44,82 @@ struct TargetErrorParams {
                                     ///< the full image where surfaces emit)
     std::optional<double> budgetMs; ///< M: most CPU twin ms per update on this machine
     std::string lightsPath;         ///< the light set the pilot relights with ("": the scene's)
-    glm::uvec2 size{64, 48};        ///< pilot image size
+    std::vector<Camera> cameras;    ///< the pilot's views (empty: pilotViews)
+    glm::uvec2 size{96, 72};        ///< pilot image size
     uint32_t spp = 256;             ///< reference samples per pixel (two halves)
     uint32_t shadeSpp = 2;          ///< subsamples per pixel shading from the caches
-    /// The choice's predicted error must be at most safety × E: the pilot's images are
-    /// small and its views are not every view a user will look from.
-    double safety = 0.85;
+    /// The choice's measured error must be at most safety × E: the pilot's images are small
+    /// and its views are not every view a user will look from.
+    double safety = 0.9;
+    uint32_t maxChecks = 4;         ///< combinations baked to check the models, at most
+    std::string cacheDir;           ///< where measurements are kept ("": nowhere)
 };
 
-/// One rung of the ladder as the pilot measured it.
+/// The settings the pilot varies, each over a few levels ordered from cheapest to dearest.
+enum class TargetAxis { Surfels, Links, BandsY, BandsC, GridCell, Texel, LinkSamples };
+inline constexpr size_t kTargetAxes = 7;
+
+/// The levels of one setting: values (counts, bands or metres), cheapest first, and the base's.
+struct TargetAxisLevels {
+    TargetAxis axis;
+    std::vector<double> values;
+    size_t base = 0;
+};
+
+/// A combination of levels: one index per axis into TargetAxisLevels::values.
+using TargetLevels = std::array<uint8_t, kTargetAxes>;
+
+/// The axes and levels around `base` (the user's bake flags; unset values are the scene's
+/// defaults); empty when the base does not resolve.
+std::vector<TargetAxisLevels> targetAxes(const Scene& scene, const BakeOptions& base);
+
+/// `base` with the values of `levels` put in.
+BakeOptions targetOptions(const BakeOptions& base, const std::vector<TargetAxisLevels>& axes,
+                          const TargetLevels& levels);
+
+/// What differs from the base, as the sweep names settings ("nL 32, grid cell x2"), or "base".
+std::string targetLevelsName(const std::vector<TargetAxisLevels>& axes, const TargetLevels& levels);
+
+/// One bake the pilot measured.
 struct TargetRung {
     std::string name;
-    BakeOptions options;
+    std::string kind;        ///< "base", "single" (one setting moved), "corner" (every setting at its
+                             ///< cheapest) or "check" (a combination the models chose)
+    TargetLevels levels{};
     BakeParams params;       ///< as resolved by the bake
     size_t caches = 0;
     double bakeSeconds = 0.0;
-    double updateMs = 0.0;   ///< CPU twin, median of 3 updates
+    double updateMs = 0.0;   ///< CPU twin, median of 5 updates
     double measured = 0.0;   ///< relative RMSE against the pilot reference (mean over views)
     double error = 0.0;      ///< against the truth: √max(e² − n², 0), mean over views
+    std::optional<double> predictedError;  ///< checks: what the models predicted before baking
+    double predictedMs = 0.0;  ///< the cost model's update ms
     bool meets = false;      ///< error ≤ safety × E and within the budget
+    bool cached = false;     ///< measured by an earlier pilot (kept in the cache)
+};
+
+/// The fitted cost: ms ≈ Σ coefficient · feature (link reads, link reads · SH coefficients,
+/// surfels, 1).
+struct TargetCostModel {
+    std::array<double, 4> coefficients{};
+    double predict(double caches, double links, double coefficientsPerCache, double surfels) const;
 };
 
 /// The pilot's outcome: the chosen bake and what led to it.
 struct TargetChoice {
     BakeData bake;           ///< the chosen rung's bake, ready to write
     BakeReport report;       ///< its bake report
-    std::vector<TargetRung> rungs;  ///< every rung measured, cheapest first
+    std::vector<TargetRung> rungs;  ///< every bake measured, in the order measured
     size_t chosen = 0;       ///< index into rungs
     bool met = false;        ///< a rung met the target; otherwise the most accurate one within
                              ///< the budget (or the cheapest, if none fits it) was chosen
     std::string component;   ///< "indirect" or "full"
     double noise = 0.0;      ///< the pilot reference's own relative RMSE (mean over views)
     std::vector<std::string> views;  ///< how each view was found
+    TargetCostModel cost;
+    double errorScale = 1.0; ///< the error model's sum as the checks corrected it
+    size_t combinations = 0; ///< combinations the models ranked
+    std::string cachePath;   ///< the cache file ("" without one)
     double pilotSeconds = 0.0;
 };
 
@@ -75,14 +133,9 @@ bool surfacesEmit(const Scene& scene);
 /// variance of either, their mean half of it). Same sizes required.
 double halvesNoise(const Image& a, const Image& b);
 
-/// The ladder of settings the pilot climbs, cheapest first, around `base` (the user's bake
-/// flags; unset values are the scene's defaults): each rung scales nS and nL, coarsens the
-/// grid cell and the light-map texel, and lowers lC and the link samples less the higher it
-/// stands; the top rungs are `base` itself and one dearer than it.
-std::vector<std::pair<std::string, BakeOptions>> targetLadder(const Scene& scene, const BakeOptions& base);
-
-/// The views the pilot measures: the scene's cameras (at most 2), else one from the centre of
-/// the bounds along their longest horizontal side. `how` receives a description of each.
+/// The views the pilot measures: the scene's cameras (at most 2), else two from the centre of
+/// the bounds, a little above it, looking both ways along their longest horizontal side.
+/// `how` receives a description of each.
 std::vector<Camera> pilotViews(const Scene& scene, std::vector<std::string>& how);
 
 /// Runs the pilot, one line per step on stderr. InvalidInput for E not in (0, 10], a budget

@@ -816,6 +816,12 @@ SweepDefaults defaultsOf(const BakeData& bake) {
 std::string SweepSetting::key() const {
     std::string key;
     for (size_t i = 0; i < bakeArgs.size(); ++i) {
+        // Where the pilot keeps its measurements and the sweep's lights (in its signature)
+        // do not tell settings apart.
+        if (bakeArgs[i] == "--pilot-cache" || bakeArgs[i] == "--lights") {
+            ++i;
+            continue;
+        }
         std::string part = bakeArgs[i];
         if (part.starts_with("--")) part = (key.empty() ? "" : "_") + part.substr(2);
         for (char& c : part)
@@ -969,8 +975,15 @@ int runSweepBenchmark(const SweepParams& params) {
             !ok)
             return reportError(ok.error());
     for (const double target : params.targetErrors) {
-        const SweepSetting setting{fmt::format("target {}", flagNumber(target)), "target",
-                                   {"--target-error", flagNumber(target)}, "rays"};
+        // The pilot measures as the sweep does (image size, reference samples, lights) but
+        // from its own views, and keeps its measurements in the sweep's folder for the next
+        // target.
+        SweepSetting setting{fmt::format("target {}", flagNumber(target)), "target",
+                             {"--target-error", flagNumber(target), "--pilot-size",
+                              fmt::format("{}x{}", params.view.size.x, params.view.size.y), "--pilot-spp",
+                              std::to_string(params.spp), "--pilot-cache", (context.dir / "pilot").string()},
+                             "rays"};
+        if (!params.lightsPath.empty()) setting.bakeArgs.insert(setting.bakeArgs.end(), {"--lights", params.lightsPath});
         if (auto ok = runPoint(setting.key(), index++, total + params.targetErrors.size(), setting.name,
                                [&]() -> Result<Json> {
                                    PIC_TRY_ASSIGN(Json point, measureSetting(context, setting, false));

@@ -397,12 +397,4 @@ ClientLayout clientLayoutOf(const ClientScene& scene) {
     return layout;
 }
 
-std::string defaultCacheDir() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-        return (fs::path(xdg) / "pic").string();
-    if (const char* home = std::getenv("HOME"); home && *home)
-        return (fs::path(home) / ".cache" / "pic").string();
-    return "/tmp/pic-cache";
-}
-
 }  // namespace pic

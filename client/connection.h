@@ -129,8 +129,4 @@ Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame&
 /// The renderer's layout (render/renderer.h) of a downloaded scene.
 ClientLayout clientLayoutOf(const ClientScene& scene);
 
-/// The default folder for downloaded scenes: $XDG_CACHE_HOME/pic, else ~/.cache/pic, else
-/// /tmp/pic-cache.
-std::string defaultCacheDir();
-
 }  // namespace pic

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "core/camera.h"
@@ -35,6 +36,14 @@ void addGlobalFlags(CLI::App& app) {
 int reportError(std::string_view program, const Error& error) {
     fmt::print(stderr, "{}: error: {}\n", program, error.message);
     return exitCode(error);
+}
+
+std::string defaultCacheDir() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+        return (std::filesystem::path(xdg) / "pic").string();
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return (std::filesystem::path(home) / ".cache" / "pic").string();
+    return "/tmp/pic-cache";
 }
 
 CLI::Option* addDeviceOption(CLI::App& command, std::string& name) {

@@ -31,6 +31,10 @@ void addGlobalFlags(CLI::App& app);
 /// Prints "PROGRAM: error: MESSAGE" on stderr; returns the error's exit code (1 or 2).
 int reportError(std::string_view program, const Error& error);
 
+/// pic's cache folder (downloaded scenes, the --target-error pilot's measurements):
+/// $XDG_CACHE_HOME/pic, else ~/.cache/pic, else /tmp/pic-cache.
+std::string defaultCacheDir();
+
 /// Adds --device NAME: the Vulkan device whose name contains NAME (empty: a discrete GPU, else
 /// an integrated one, else lavapipe).
 CLI::Option* addDeviceOption(CLI::App& command, std::string& name);

@@ -1,18 +1,22 @@
 // picbake's --target-error pilot (bake/target_error.h) on cornell with small bakes and a small
-// pilot: its ladder, its views, the choice for a loose target and a tight budget, bad input.
+// pilot: its axes and levels, its views, the choice for a loose target, its cache, a budget
+// nothing fits, bad input.
 
 #include "bake/target_error.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 #include "tests/support/baked_scene.h"
 
 namespace {
 
+namespace fs = std::filesystem;
 namespace test = pic::test;
+using pic::TargetAxis;
 using pic::TargetErrorParams;
 
 /// A pilot small enough for a test.
@@ -25,40 +29,60 @@ TargetErrorParams smallPilot(double error) {
     return params;
 }
 
-TEST(TargetLadder, ClimbsFromCheapToTheDefaultAndOneDearer) {
+/// The base the tests start from: small, so that the pilot's bakes are quick.
+pic::BakeOptions smallBase() { return test::smallBakeOptions(2048, 32, 0.125f, 0.06f); }
+
+TEST(TargetAxes, LevelsRunFromCheapestToDearestAroundTheBase) {
     const pic::Scene scene = test::loadTestScene("cornell");
-    const pic::BakeOptions base = test::smallBakeOptions(4096, 64);
-    const auto ladder = pic::targetLadder(scene, base);
-    ASSERT_GE(ladder.size(), 4u);
+    const pic::BakeOptions base = smallBase();
+    const auto axes = pic::targetAxes(scene, base);
+    ASSERT_EQ(axes.size(), pic::kTargetAxes);
     std::map<std::string, std::string> unused;
-    auto defaults = pic::resolveBakeParams(scene, base, unused);
-    ASSERT_TRUE(defaults);
-    uint32_t surfels = 0, links = 0;
-    float texel = std::numeric_limits<float>::max();
-    bool sawDefault = false;
-    for (const auto& [name, options] : ladder) {
-        SCOPED_TRACE(name);
-        auto resolved = pic::resolveBakeParams(scene, options, unused);
-        ASSERT_TRUE(resolved) << resolved.error().message;
-        // Every rung costs at least what the one below it does.
-        EXPECT_GE(resolved->surfels, surfels);
-        EXPECT_GE(resolved->linksPerCache, links);
-        EXPECT_LE(resolved->lightmapTexel, texel);
-        EXPECT_LE(resolved->bandsC, resolved->bandsY);
-        // lY is never lowered: two bands lose the irradiance's l = 2 band.
-        EXPECT_EQ(resolved->bandsY, defaults->bandsY);
-        surfels = resolved->surfels, links = resolved->linksPerCache, texel = resolved->lightmapTexel;
-        if (name == "default") {
-            sawDefault = true;
-            EXPECT_EQ(resolved->surfels, 4096u);
-            EXPECT_EQ(resolved->linksPerCache, 64u);
-        }
+    auto d = pic::resolveBakeParams(scene, base, unused);
+    ASSERT_TRUE(d);
+    for (const pic::TargetAxisLevels& axis : axes) {
+        ASSERT_LT(axis.base, axis.values.size());
+        const bool coarserIsCheaper = axis.axis == TargetAxis::GridCell || axis.axis == TargetAxis::Texel;
+        for (size_t l = 1; l < axis.values.size(); ++l)
+            if (coarserIsCheaper)
+                EXPECT_GT(axis.values[l - 1], axis.values[l]);
+            else
+                EXPECT_LT(axis.values[l - 1], axis.values[l]);
     }
-    EXPECT_TRUE(sawDefault);
-    EXPECT_LT(pic::resolveBakeParams(scene, ladder.front().second, unused)->linksPerCache, 64u);
+    auto levelOf = [&](TargetAxis a) { return axes[size_t(a)]; };
+    EXPECT_EQ(levelOf(TargetAxis::Surfels).values[levelOf(TargetAxis::Surfels).base], 2048.0);
+    EXPECT_EQ(levelOf(TargetAxis::Links).values[levelOf(TargetAxis::Links).base], 32.0);
+    EXPECT_EQ(levelOf(TargetAxis::Links).values.front(), 8.0) << "nL ×⅛ is clamped to 8";
+    EXPECT_EQ(levelOf(TargetAxis::BandsY).values.front(), double(d->bandsY - 1));
+    EXPECT_EQ(levelOf(TargetAxis::BandsC).values.front(), 1.0);
+    EXPECT_LE(levelOf(TargetAxis::BandsC).values.back(), double(d->bandsY));
+    EXPECT_FLOAT_EQ(float(levelOf(TargetAxis::GridCell).values.front()), 4.0f * d->gridCell);
+    EXPECT_EQ(levelOf(TargetAxis::LinkSamples).values.front(), 4.0);
 }
 
-TEST(TargetLadder, ViewsAreTheScenesCamerasElseOneFromItsMiddle) {
+TEST(TargetAxes, OptionsAndNamesFollowTheLevels) {
+    const pic::Scene scene = test::loadTestScene("cornell");
+    const pic::BakeOptions base = smallBase();
+    const auto axes = pic::targetAxes(scene, base);
+    pic::TargetLevels levels{};
+    for (size_t a = 0; a < axes.size(); ++a) levels[a] = uint8_t(axes[a].base);
+    EXPECT_EQ(pic::targetLevelsName(axes, levels), "base");
+    pic::BakeOptions o = pic::targetOptions(base, axes, levels);
+    EXPECT_EQ(o.surfels, 2048u);
+    EXPECT_EQ(o.links, 32u);
+    levels[size_t(TargetAxis::Links)] = 0;
+    levels[size_t(TargetAxis::GridCell)] = 0;
+    EXPECT_EQ(pic::targetLevelsName(axes, levels), "nL 8, grid cell x4");
+    o = pic::targetOptions(base, axes, levels);
+    EXPECT_EQ(o.links, 8u);
+    // lC never exceeds lY, whatever the levels say.
+    levels[size_t(TargetAxis::BandsY)] = 0;
+    levels[size_t(TargetAxis::BandsC)] = uint8_t(axes[size_t(TargetAxis::BandsC)].values.size() - 1);
+    o = pic::targetOptions(base, axes, levels);
+    EXPECT_LE(*o.bandsC, *o.bandsY);
+}
+
+TEST(TargetAxes, ViewsAreTheScenesCamerasElseTwoFromItsMiddle) {
     const pic::Scene cornell = test::loadTestScene("cornell");
     std::vector<std::string> how;
     auto views = pic::pilotViews(cornell, how);
@@ -69,52 +93,95 @@ TEST(TargetLadder, ViewsAreTheScenesCamerasElseOneFromItsMiddle) {
     noCamera.cameras.clear();
     how.clear();
     views = pic::pilotViews(noCamera, how);
-    ASSERT_EQ(views.size(), 1u);
+    ASSERT_EQ(views.size(), 2u);
     EXPECT_NE(how[0].find("no camera"), std::string::npos);
-    // The generated eye is inside the bounds and looks along a horizontal side.
+    // Both eyes are inside the bounds; the two look opposite ways.
     const pic::Aabb& b = cornell.bounds;
-    EXPECT_TRUE(glm::all(glm::greaterThanEqual(views[0].eye, b.min)) && glm::all(glm::lessThanEqual(views[0].eye, b.max)));
-    EXPECT_GT(glm::length(views[0].target - views[0].eye), 0.0f);
+    for (const pic::Camera& v : views)
+        EXPECT_TRUE(glm::all(glm::greaterThanEqual(v.eye, b.min)) && glm::all(glm::lessThanEqual(v.eye, b.max)));
+    EXPECT_LT(glm::dot(views[0].target - views[0].eye, views[1].target - views[1].eye), 0.0f);
 }
 
-TEST(TargetError, ALooseTargetTakesTheCheapestRungThatMeetsIt) {
+TEST(TargetError, ALooseTargetTakesACheaperBakeAndASecondTargetReusesThePilot) {
     const pic::Scene scene = test::loadTestScene("cornell");
-    const pic::BakeOptions base = test::smallBakeOptions(4096, 64);
-    auto choice = pic::chooseBakeForTarget(scene, base, smallPilot(0.6));
+    const fs::path dir = fs::path(::testing::TempDir()) / "pic_target_error_cache";
+    fs::remove_all(dir);
+    TargetErrorParams params = smallPilot(0.6);
+    params.cacheDir = dir.string();
+    auto choice = pic::chooseBakeForTarget(scene, smallBase(), params);
     ASSERT_TRUE(choice) << choice.error().message;
     EXPECT_TRUE(choice->met);
     EXPECT_EQ(choice->component, "indirect");
-    // The first rung meets a target this loose: one bake, cheaper than the default rung.
-    ASSERT_EQ(choice->rungs.size(), 1u);
-    EXPECT_EQ(choice->chosen, 0u);
-    const pic::TargetRung& chosen = choice->rungs[0];
-    EXPECT_TRUE(chosen.meets);
-    EXPECT_LE(chosen.error, 0.85 * 0.6);
-    EXPECT_GE(chosen.error, 0.0);
-    EXPECT_GT(chosen.measured, chosen.error - 1e-12) << "the truth's error is the measured one less the noise";
-    EXPECT_LT(choice->bake.params.linksPerCache, 64u);
-    EXPECT_LT(choice->bake.params.surfels, 4096u);
-    EXPECT_EQ(choice->bake.params.surfels, chosen.params.surfels);
     EXPECT_GT(choice->noise, 0.0);
-    EXPECT_GT(chosen.updateMs, 0.0);
-    const auto json = pic::targetJson(*choice, smallPilot(0.6));
-    EXPECT_EQ(json.at("chosen"), "cheapest");
+    // The base first, then single settings, the corner, and any checks.
+    ASSERT_GE(choice->rungs.size(), 10u);
+    EXPECT_EQ(choice->rungs[0].kind, "base");
+    EXPECT_EQ(choice->rungs[0].name, "base");
+    EXPECT_EQ(choice->rungs[0].params.surfels, 2048u);
+    size_t singles = 0, corners = 0;
+    for (const pic::TargetRung& r : choice->rungs) {
+        SCOPED_TRACE(r.name);
+        singles += r.kind == "single";
+        corners += r.kind == "corner";
+        EXPECT_GE(r.error, 0.0);
+        EXPECT_GE(r.measured, r.error - 1e-12) << "the truth's error is the measured one less the noise";
+        EXPECT_GT(r.updateMs, 0.0);
+        EXPECT_GT(r.predictedMs, 0.0);
+        EXPECT_EQ(r.meets, r.error <= params.safety * params.error);
+        EXPECT_FALSE(r.cached);
+        if (r.kind == "check") {
+            EXPECT_TRUE(r.predictedError.has_value());
+        }
+    }
+    EXPECT_GE(singles, 9u);
+    EXPECT_EQ(corners, 1u);
+    for (double c : choice->cost.coefficients) EXPECT_GE(c, 0.0);
+    EXPECT_GT(choice->combinations, singles);
+    // The choice: within the goal, the cheapest such rung by the cost model, cheaper than the
+    // base, and the bake handed back is its bake.
+    const pic::TargetRung& chosen = choice->rungs[choice->chosen];
+    EXPECT_TRUE(chosen.meets);
+    for (const pic::TargetRung& r : choice->rungs)
+        if (r.meets) {
+            EXPECT_GE(r.predictedMs, chosen.predictedMs) << r.name;
+        }
+    EXPECT_LT(chosen.predictedMs, choice->rungs[0].predictedMs);
+    EXPECT_EQ(choice->bake.params.surfels, chosen.params.surfels);
+    EXPECT_EQ(choice->bake.params.linksPerCache, chosen.params.linksPerCache);
+    EXPECT_EQ(choice->bake.caches.size(), chosen.caches);
+    const auto json = pic::targetJson(*choice, params);
+    EXPECT_EQ(json.at("chosen"), chosen.name);
     EXPECT_EQ(json.at("met"), true);
-    EXPECT_EQ(json.at("rungs").size(), 1u);
+    EXPECT_EQ(json.at("rungs").size(), choice->rungs.size());
+    EXPECT_EQ(json.at("pilot").at("cache"), choice->cachePath);
+    ASSERT_TRUE(fs::exists(choice->cachePath));
+
+    // A second target on the same scene bakes nothing the first measured.
+    params.error = 0.8;
+    auto again = pic::chooseBakeForTarget(scene, smallBase(), params);
+    ASSERT_TRUE(again) << again.error().message;
+    for (size_t i = 0; i < choice->rungs.size() && i < again->rungs.size(); ++i) {
+        if (again->rungs[i].kind == "check") break;
+        EXPECT_TRUE(again->rungs[i].cached) << again->rungs[i].name;
+        EXPECT_EQ(again->rungs[i].error, choice->rungs[i].error);
+    }
+    EXPECT_LE(again->rungs[again->chosen].predictedMs, chosen.predictedMs + 1e-9) << "a looser target costs no more";
+    fs::remove_all(dir);
 }
 
-TEST(TargetError, OverTheBudgetItStopsAndSaysSo) {
+TEST(TargetError, WhenNothingFitsTheBudgetItTakesTheCheapestAndSaysSo) {
     const pic::Scene scene = test::loadTestScene("cornell");
     TargetErrorParams params = smallPilot(0.6);
     params.budgetMs = 1e-6;  // no update is this fast
-    auto choice = pic::chooseBakeForTarget(scene, test::smallBakeOptions(4096, 64), params);
+    auto choice = pic::chooseBakeForTarget(scene, smallBase(), params);
     ASSERT_TRUE(choice) << choice.error().message;
     EXPECT_FALSE(choice->met);
-    // The first rung is over the budget; dearer rungs cost more still, so the pilot stops and
-    // keeps the cheapest.
-    EXPECT_EQ(choice->rungs.size(), 1u);
-    EXPECT_EQ(choice->chosen, 0u);
-    EXPECT_FALSE(choice->rungs[0].meets);
+    for (const pic::TargetRung& r : choice->rungs) {
+        EXPECT_FALSE(r.meets) << r.name;
+        EXPECT_NE(r.kind, "check") << "no combination is predicted within the budget";
+        EXPECT_GE(r.predictedMs, choice->rungs[choice->chosen].predictedMs) << r.name;
+    }
+    EXPECT_TRUE(choice->cachePath.empty());
 }
 
 TEST(TargetError, RefusesTargetsAndBudgetsOutOfRange) {
