@@ -55,9 +55,9 @@ int reportError(const Error& error) { return pic::reportError("picbake", error);
 
 /// Prints what the pilot measured, what it chose and why.
 void printTarget(const TargetChoice& choice, const TargetErrorParams& params) {
-    fmt::print("  target          {} relative RMSE {}{} against path tracing; pilot {}x{} at {} spp "
+    fmt::print("  target          indirect relative RMSE {}{} against path tracing; pilot {}x{} at {} spp "
                "(its own noise {:.3f}), {:.1f} s, on {}\n",
-               choice.component, params.error,
+               params.error,
                params.budgetMs ? fmt::format(" within {} ms per update", *params.budgetMs) : "",
                params.size.x, params.size.y, params.spp, choice.noise, choice.pilotSeconds,
                fmt::join(choice.views, "; "));
@@ -279,9 +279,9 @@ int picbakeMain(int argc, char** argv) {
     std::vector<std::string> pilotCameras;
     CLI::Option* targetOption = bakeCommand->add_option(
         "--target-error", target.error,
-        "the cheapest settings predicted to meet this relative RMSE of the indirect light (the full "
-        "image where surfaces emit) against path tracing, from a pilot on the scene itself; bake "
-        "flags given too set the ladder's default rung");
+        "the cheapest settings predicted to meet this relative RMSE of the indirect light (with "
+        "emitting surfaces, their first reflection too: what the caches carry) against path "
+        "tracing, from a pilot on the scene itself; bake flags given too set the pilot's base");
     CLI::Option* budgetOption = bakeCommand->add_option(
         "--budget-ms", "with --target-error: most CPU twin ms per update on this machine")
         ->check(CLI::Number);

@@ -157,11 +157,11 @@ std::string rungKey(const BakeOptions& o) {
 class PilotCache {
 public:
     PilotCache(const std::string& dir, const Scene& scene, const BakeOptions& base, const LightSet& lights,
-               const std::vector<Camera>& views, const TargetErrorParams& params, bool full) {
+               const std::vector<Camera>& views, const TargetErrorParams& params) {
         if (dir.empty()) return;
         std::string what = fmt::format(
-            "pic pilot 1|{}|{}|{}x{} {} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
-            params.size.x, params.size.y, params.spp, params.shadeSpp, full, base.surfels.value_or(0),
+            "pic pilot 1|{}|{}|{}x{} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
+            params.size.x, params.size.y, params.spp, params.shadeSpp, base.surfels.value_or(0),
             base.links.value_or(0), base.bandsY.value_or(0), base.bandsC.value_or(0), base.gridCell.value_or(0.0f),
             base.lightmapTexel.value_or(0.0f), uint32_t(base.linkMode), uint32_t(base.hierarchy), base.linkSamples,
             base.linkFinalSamples, base.exposureRays, uint32_t(base.linkReads), uint32_t(base.linkCut));
@@ -274,12 +274,6 @@ double TargetCostModel::predict(double caches, double links, double coefficients
     return ms;
 }
 
-bool surfacesEmit(const Scene& scene) {
-    for (const Material& m : scene.materials)
-        if (glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) return true;
-    return false;
-}
-
 double halvesNoise(const Image& a, const Image& b) {
     PIC_CHECK(a.pixels.size() == b.pixels.size());
     double sum = 0.0, level = 0.0;
@@ -390,8 +384,6 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         return fail(ErrorCode::InvalidInput, "the bake settings of scene '{}' do not resolve", scene.sourcePath);
     }
     TargetChoice choice;
-    const bool full = surfacesEmit(scene);
-    choice.component = full ? "full" : "indirect";
     const double goal = params.safety * params.error;
 
     std::vector<Camera> cameras = params.cameras;
@@ -399,7 +391,7 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         cameras = pilotViews(scene, choice.views);
     else
         for (size_t i = 0; i < cameras.size(); ++i) choice.views.push_back(fmt::format("--pilot-camera {}", i));
-    PilotCache cache(params.cacheDir, scene, base, lights, cameras, params, full);
+    PilotCache cache(params.cacheDir, scene, base, lights, cameras, params);
     choice.cachePath = cache.path();
 
     // The pilot's references, each traced in two independent halves.
@@ -413,7 +405,7 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             trace.width = params.size.x;
             trace.height = params.size.y;
             trace.spp = std::max(params.spp / 2, 1u);
-            trace.component = full ? PathTraceParams::Component::Full : PathTraceParams::Component::Indirect;
+            trace.component = PathTraceParams::Component::Cached;
             std::fprintf(stderr, "picbake: target: path tracing the pilot reference of %s (%ux%u, %u spp) …\n",
                          choice.views[v].c_str(), params.size.x, params.size.y, params.spp);
             trace.seed = 1;
@@ -432,12 +424,43 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     shade.width = params.size.x;
     shade.height = params.size.y;
     shade.samplesPerPixel = params.shadeSpp;
-    shade.component = full ? ShadeComponent::Full : ShadeComponent::Indirect;
+    shade.component = ShadeComponent::Indirect;
     auto inBudget = [&](double ms) { return !params.budgetMs || ms <= *params.budgetMs; };
+
+    TargetLevels baseLevels{};
+    for (size_t a = 0; a < axes.size(); ++a) baseLevels[a] = uint8_t(axes[a].base);
+    // The base's bake and runtime: every other rung's updates are timed in turns with the
+    // base's, so that a busy spell of the machine slows both and their ratio stands.
+    struct TimingBase {
+        std::unique_ptr<BakeData> bake;
+        BakeReport report;
+        std::unique_ptr<Runtime> runtime;
+        double ms = 0.0;  ///< median of 5 updates
+    };
+    std::optional<TimingBase> timingBase;
+    auto timeUpdate = [&](Runtime& runtime) -> Result<double> {
+        const Clock::time_point update = Clock::now();
+        PIC_TRY(runtime.setLights(lights));
+        return 1e3 * secondsSince(update);
+    };
+    auto makeTimingBase = [&]() -> Result<void> {
+        TimingBase t;
+        t.bake = std::make_unique<BakeData>();
+        PIC_TRY_ASSIGN(*t.bake, runBake(scene, targetOptions(base, axes, baseLevels), t.report));
+        PIC_TRY_ASSIGN(t.runtime, createCpuRuntime(scene, *rays, *t.bake, BounceParams{}));
+        std::vector<double> ms;
+        for (int k = 0; k < 5; ++k) {
+            PIC_TRY_ASSIGN(double m, timeUpdate(*t.runtime));
+            ms.push_back(m);
+        }
+        t.ms = median(ms);
+        timingBase = std::move(t);
+        return {};
+    };
 
     // Measures one combination (from the cache where it was measured before); keeps the bake
     // of the latest one baked in `lastBake`.
-    std::optional<std::pair<TargetLevels, BakeData>> lastBake;
+    std::optional<std::pair<TargetLevels, std::unique_ptr<BakeData>>> lastBake;
     BakeReport lastReport;
     auto measure = [&](const TargetLevels& levels, const char* kind) -> Result<TargetRung> {
         const BakeOptions options = targetOptions(base, axes, levels);
@@ -447,31 +470,50 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             rung = *kept;
         } else {
             std::fprintf(stderr, "picbake: target: baking %s …\n", targetLevelsName(axes, levels).c_str());
-            BakeReport report;
-            const Clock::time_point start = Clock::now();
-            PIC_TRY_ASSIGN(BakeData bake, runBake(scene, options, report));
-            rung.bakeSeconds = secondsSince(start);
-            rung.params = bake.params;
-            rung.caches = bake.caches.size();
-            PIC_TRY_ASSIGN(auto runtime, createCpuRuntime(scene, *rays, bake, BounceParams{}));
-            std::vector<double> ms;
-            const CacheValues* values = nullptr;
-            for (int k = 0; k < 5; ++k) {
-                const Clock::time_point update = Clock::now();
-                PIC_TRY_ASSIGN(values, runtime->setLights(lights));
-                ms.push_back(1e3 * secondsSince(update));
+            if (!timingBase) {
+                const Clock::time_point start = Clock::now();
+                PIC_TRY(makeTimingBase());
+                if (levels == baseLevels) rung.bakeSeconds = secondsSince(start);
             }
-            rung.updateMs = median(ms);
+            const BakeData* bake = timingBase->bake.get();
+            Runtime* runtime = timingBase->runtime.get();
+            std::unique_ptr<BakeData> own;
+            std::unique_ptr<Runtime> ownRuntime;
+            BakeReport report;
+            if (levels == baseLevels) {
+                rung.updateMs = timingBase->ms;
+            } else {
+                const Clock::time_point start = Clock::now();
+                own = std::make_unique<BakeData>();
+                PIC_TRY_ASSIGN(*own, runBake(scene, options, report));
+                rung.bakeSeconds = secondsSince(start);
+                PIC_TRY_ASSIGN(ownRuntime, createCpuRuntime(scene, *rays, *own, BounceParams{}));
+                bake = own.get();
+                runtime = ownRuntime.get();
+                std::vector<double> ratios;
+                for (int k = 0; k < 5; ++k) {
+                    PIC_TRY_ASSIGN(double baseMs, timeUpdate(*timingBase->runtime));
+                    PIC_TRY_ASSIGN(double ms, timeUpdate(*runtime));
+                    ratios.push_back(ms / std::max(baseMs, 1e-6));
+                }
+                rung.updateMs = median(ratios) * timingBase->ms;
+            }
+            rung.params = bake->params;
+            rung.caches = bake->caches.size();
+            PIC_TRY_ASSIGN(const CacheValues* values, runtime->setLights(lights));
             for (const PilotReference& reference : references) {
-                PIC_TRY_ASSIGN(Image image, shadeFromCaches(scene, *rays, bake, *values, lights, reference.camera, shade));
+                PIC_TRY_ASSIGN(Image image, shadeFromCaches(scene, *rays, *bake, *values, lights, reference.camera, shade));
                 PIC_TRY_ASSIGN(ImageError e, compareImages(image, reference.image));
                 rung.measured += e.relativeRmse / double(references.size());
                 rung.error += std::sqrt(std::max(e.relativeRmse * e.relativeRmse - reference.noise * reference.noise, 0.0)) /
                               double(references.size());
             }
             cache.storeRung(key, rung);
-            lastBake.emplace(levels, std::move(bake));
-            lastReport = std::move(report);
+            if (own) {
+                ownRuntime.reset();
+                lastBake.emplace(levels, std::move(own));
+                lastReport = std::move(report);
+            }
         }
         rung.name = targetLevelsName(axes, levels);
         rung.kind = kind;
@@ -486,8 +528,6 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
 
     // The base, then each setting alone a step or two cheaper, and a step dearer where the
     // base misses the goal.
-    TargetLevels baseLevels{};
-    for (size_t a = 0; a < axes.size(); ++a) baseLevels[a] = uint8_t(axes[a].base);
     PIC_TRY_ASSIGN(TargetRung baseRung, measure(baseLevels, "base"));
     choice.rungs.push_back(baseRung);
     const bool dearer = baseRung.error > goal;
@@ -618,8 +658,12 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     }
     const TargetRung& chosen = choice.rungs[choice.chosen];
     if (lastBake && lastBake->first == chosen.levels) {
-        choice.bake = std::move(lastBake->second);
+        choice.bake = std::move(*lastBake->second);
         choice.report = std::move(lastReport);
+    } else if (timingBase && chosen.levels == baseLevels) {
+        timingBase->runtime.reset();
+        choice.bake = std::move(*timingBase->bake);
+        choice.report = std::move(timingBase->report);
     } else {
         std::fprintf(stderr, "picbake: target: baking the choice, %s …\n", chosen.name.c_str());
         PIC_TRY_ASSIGN(BakeData bake, runBake(scene, targetOptions(base, axes, chosen.levels), choice.report));
@@ -654,7 +698,7 @@ nlohmann::ordered_json targetJson(const TargetChoice& choice, const TargetErrorP
     const TargetRung& chosen = choice.rungs[choice.chosen];
     return {{"error", params.error},
             {"budget_ms", params.budgetMs ? nlohmann::ordered_json(*params.budgetMs) : nlohmann::ordered_json(nullptr)},
-            {"component", choice.component},
+            {"component", "indirect"},
             {"met", choice.met},
             {"chosen", chosen.name},
             {"predicted_error", chosen.error},

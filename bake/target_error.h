@@ -40,8 +40,8 @@ namespace pic {
 
 /// What the pilot aims for and how it measures.
 struct TargetErrorParams {
-    double error = 0.0;             ///< E: relative RMSE against path tracing (indirect light;
-                                    ///< the full image where surfaces emit)
+    double error = 0.0;             ///< E: relative RMSE of the indirect light against path tracing
+                                    ///< (what the caches carry: PathTraceParams::Component::Cached)
     std::optional<double> budgetMs; ///< M: most CPU twin ms per update on this machine
     std::string lightsPath;         ///< the light set the pilot relights with ("": the scene's)
     std::vector<Camera> cameras;    ///< the pilot's views (empty: pilotViews)
@@ -89,7 +89,8 @@ struct TargetRung {
     BakeParams params;       ///< as resolved by the bake
     size_t caches = 0;
     double bakeSeconds = 0.0;
-    double updateMs = 0.0;   ///< CPU twin, median of 5 updates
+    double updateMs = 0.0;   ///< CPU twin: the base's median of 5 updates; another rung's, the
+                             ///< median ratio of 5 updates timed in turns with the base's, times it
     double measured = 0.0;   ///< relative RMSE against the pilot reference (mean over views)
     double error = 0.0;      ///< against the truth: √max(e² − n², 0), mean over views
     std::optional<double> predictedError;  ///< checks: what the models predicted before baking
@@ -113,7 +114,6 @@ struct TargetChoice {
     size_t chosen = 0;       ///< index into rungs
     bool met = false;        ///< a rung met the target; otherwise the most accurate one within
                              ///< the budget (or the cheapest, if none fits it) was chosen
-    std::string component;   ///< "indirect" or "full"
     double noise = 0.0;      ///< the pilot reference's own relative RMSE (mean over views)
     std::vector<std::string> views;  ///< how each view was found
     TargetCostModel cost;
@@ -122,11 +122,6 @@ struct TargetChoice {
     std::string cachePath;   ///< the cache file ("" without one)
     double pilotSeconds = 0.0;
 };
-
-/// Whether any material emits: then the caches carry the emitters' light, whose first
-/// reflection the path tracer counts as direct (PathTraceParams::Component), so only full
-/// images compare with a reference; otherwise the indirect light does.
-bool surfacesEmit(const Scene& scene);
 
 /// The relative RMSE against the truth of the mean of two independent estimates `a` and `b`
 /// of the same image: RMS(a − b)/2 over the mean's level (their difference has twice the

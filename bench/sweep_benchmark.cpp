@@ -170,7 +170,9 @@ Result<void> loadOrTraceReferences(SweepContext& context) {
                 trace.height = params.view.size.y;
                 trace.spp = std::max(params.spp / 2, 1u);
                 trace.seed = uint64_t(h + 1);
-                trace.component = indirect ? PathTraceParams::Component::Indirect
+                // The indirect reference holds what pic's caches carry: with emitting surfaces,
+                // their first reflection too.
+                trace.component = indirect ? PathTraceParams::Component::Cached
                                            : PathTraceParams::Component::Full;
                 PIC_TRY_ASSIGN(halves[h], pathTrace(context.scene, *context.rays, context.lights,
                                                     view.camera, trace));
@@ -622,8 +624,9 @@ void addErrorAgainstTruth(std::vector<Json>& points, const std::vector<ViewRefer
         }
 }
 
-/// The component the charts hold against the truth (surfacesEmit).
-const char* chartedComponent(const Scene& scene) { return surfacesEmit(scene) ? "full" : "indirect"; }
+/// The component the charts hold against the truth: what the settings change (the direct
+/// light of punctual lights is exact whatever the bake).
+constexpr const char* kChartedComponent = "indirect";
 
 /// The autotune check of every `picbake --target-error` point against the grid: its error
 /// against the truth at most E, and its update against the cheapest grid point that meets E
@@ -775,10 +778,10 @@ Chart costPanel(const std::vector<Json>& points, const std::string& component, c
 }
 
 Result<void> writeSweepCharts(const std::vector<Json>& points, const SweepContext& context, const fs::path& path) {
-    const std::string component = chartedComponent(context.scene);
+    const std::string component = kChartedComponent;
     double noise = 0.0;
     for (const ViewReference& v : context.views)
-        noise += (component == "full" ? v.fullNoise : v.indirectNoise) / double(context.views.size());
+        noise += v.indirectNoise / double(context.views.size());
     const std::string scene = fs::path(context.params.scenePath).stem().string();
     auto number = [](const Json& p, const char* key) -> std::optional<double> {
         if (!p.contains(key) || p[key].is_null()) return std::nullopt;
@@ -999,7 +1002,7 @@ int runSweepBenchmark(const SweepParams& params) {
     Json json;
     json["inputs"] = signature;
     json["grid"] = params.grid;
-    const std::string component = chartedComponent(context.scene);
+    const std::string component = kChartedComponent;
     json["charted_component"] = component;
     Json noise = Json::array();
     for (const ViewReference& v : context.views) noise.push_back({{"indirect", v.indirectNoise}, {"full", v.fullNoise}});

@@ -196,14 +196,14 @@ glm::vec3 PathTracer::connectLightVertex(const glm::vec3& position, const glm::v
 }
 
 glm::vec3 PathTracer::directLight(const glm::vec3& position, const glm::vec3& normal,
-                                  float bsdfAreaPdf, Rng& rng) const {
+                                  float bsdfAreaPdf, Rng& rng, bool punctual) const {
     const float epsilon = mRays->epsilon();
     const glm::vec3 shadowOrigin = position + epsilon * normal;
     glm::vec3 direct(0.0f);
 
     // Punctual lights are deltas: each one is evaluated exactly, with one shadow ray. When this
     // point was reached from a surface, the light-vertex strategy samples the same path too.
-    for (size_t l = 0; l < mLights.lights.size(); ++l) {
+    for (size_t l = 0; punctual && l < mLights.lights.size(); ++l) {
         glm::vec3 toLight;
         float distance = kInfinity;
         glm::vec3 irradiance =
@@ -253,7 +253,9 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
                                     Rng& rng) const {
     using Component = PathTraceParams::Component;
     // Paths of k reflections count for k in [minK, maxK]; maxK < 0 means unlimited.
-    const int minK = component == Component::Full ? 0 : component == Component::Direct ? 1 : 2;
+    const int minK = component == Component::Full ? 0
+                     : component == Component::Direct || component == Component::Cached ? 1
+                                                                                          : 2;
     int maxK = maxReflections < 0 ? -1 : maxReflections;
     if (component == Component::Direct) maxK = maxK < 0 ? 1 : std::min(maxK, 1);
     const bool unlimited = maxK < 0;
@@ -300,8 +302,10 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
         if (k > 0)
             bsdfAreaPdf = bsdfPdf * std::abs(glm::dot(hit->geometricNormal, rayDirection)) /
                           (hit->t * hit->t);
+        // Cached paths leave out the punctual lights reflected once: pic lights those exactly.
         if (k + 1 >= minK)
-            radiance += throughput * albedo * directLight(position, normal, bsdfAreaPdf, rng);
+            radiance += throughput * albedo *
+                        directLight(position, normal, bsdfAreaPdf, rng, component != Component::Cached || k > 0);
         if (lightVertex && k + 2 >= minK && (unlimited || k + 2 <= maxK))
             radiance += throughput * albedo * connectLightVertex(position, normal, *lightVertex);
         // Without emitters the continuation can only add longer paths than allowed.

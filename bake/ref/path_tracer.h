@@ -27,8 +27,11 @@ namespace pic {
 /// What a path-traced image holds and how it is sampled.
 struct PathTraceParams {
     /// Which paths count: Full = k ≥ 0 reflections (directly visible emitters included),
-    /// Direct = exactly one reflection, Indirect = k ≥ 2 reflections.
-    enum class Component { Full, Direct, Indirect };
+    /// Direct = exactly one reflection, Indirect = k ≥ 2 reflections, Cached = k ≥ 1
+    /// reflections less the punctual lights' single reflection: what pic's caches carry (the
+    /// indirect light and the emitting surfaces' first reflection, paper 000 §4.4), equal to
+    /// Indirect where no surface emits.
+    enum class Component { Full, Direct, Indirect, Cached };
 
     uint32_t width = 0;
     uint32_t height = 0;
@@ -97,8 +100,9 @@ private:
     /// per unit albedo: ∫ L_light cosθ / π. `bsdfAreaPdf` is the density per m² with which the
     /// previous vertex's BSDF sampling found this point, or negative when the point was not
     /// reached from a surface (no light-vertex strategy competes for its paths then).
+    /// Without `punctual`, the emitters' part alone.
     glm::vec3 directLight(const glm::vec3& position, const glm::vec3& normal, float bsdfAreaPdf,
-                          Rng& rng) const;
+                          Rng& rng, bool punctual = true) const;
     /// Light reflected once at `vertex` towards a surface point, per unit albedo of the point:
     /// the light-vertex strategy's MIS-weighted estimate.
     glm::vec3 connectLightVertex(const glm::vec3& position, const glm::vec3& normal,

@@ -91,6 +91,7 @@ int runRender(const RenderArgs& args) {
     params.bounces = args.bounces;
     params.component = args.component == "direct"     ? PathTraceParams::Component::Direct
                        : args.component == "indirect" ? PathTraceParams::Component::Indirect
+                       : args.component == "cached"   ? PathTraceParams::Component::Cached
                                                       : PathTraceParams::Component::Full;
     params.seed = args.seed;
     PathTraceStats stats;
@@ -226,8 +227,10 @@ int picrefMain(int argc, char** argv) {
         app.add_option("--spp", render.spp, "samples per pixel"),
         app.add_option("--bounces", render.bounces,
                        "indirect bounces B: 0 = direct light only, -1 = unlimited (default)"),
-        app.add_option("--component", render.component, "full (default), direct or indirect")
-            ->check(CLI::IsMember({"full", "direct", "indirect"})),
+        app.add_option("--component", render.component,
+                       "full (default), direct, indirect, or cached (what pic's caches carry: the "
+                       "indirect light and the emitting surfaces' first reflection)")
+            ->check(CLI::IsMember({"full", "direct", "indirect", "cached"})),
         addLightsOption(app, render.lightsPath),
         app.add_option("--seed", render.seed, "random seed (default 1)"),
         app.get_option("--exposure"),

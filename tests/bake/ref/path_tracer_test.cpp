@@ -214,6 +214,33 @@ TEST_F(PathTracerTest, WhiteFurnaceComponentsSplitByReflectionCount) {
     expectConverged(pixelStatistics(indirect), expected, 0.01, "indirect");
 }
 
+TEST_F(PathTracerTest, CachedIsWhatTheCachesCarryTheEmittersFirstReflectionAndTheRest) {
+    // In the furnace every light is an emitting surface: Cached keeps paths of k ≥ 1
+    // reflections, L_e/(1 − ρ) − L_e = ρ·L_e/(1 − ρ).
+    Scene scene = furnaceScene();
+    Image cached = render(scene, LightSet{}, furnaceCamera(), params(32, 64, Component::Cached));
+    expectConverged(pixelStatistics(cached), furnaceRadianceTotal() - glm::dvec3(kFurnaceEmission), 0.005,
+                    "cached");
+}
+
+TEST_F(PathTracerTest, CachedLeavesOutThePunctualLightsReflectedOnce) {
+    // Where no surface emits, Cached and Indirect are the same paths, sampled alike: the same
+    // image to the bit. A plane under a lamp reflects nothing back onto itself: black.
+    Scene scene = furnaceScene();
+    for (Material& m : scene.materials) m.emission = glm::vec3(0.0f);
+    LightSet lights;
+    lights.lights.push_back(test::pointLight({0.1f, 0.2f, 0.0f}, 2.0f, glm::vec3(1.0f)));
+    Image cached = render(scene, lights, furnaceCamera(), params(8, 16, Component::Cached));
+    Image indirect = render(scene, lights, furnaceCamera(), params(8, 16, Component::Indirect));
+    ASSERT_EQ(cached.pixels.size(), indirect.pixels.size());
+    double sum = 0.0;
+    for (size_t i = 0; i < cached.pixels.size(); ++i) {
+        EXPECT_EQ(cached.pixels[i], indirect.pixels[i]) << i;
+        sum += cached.pixels[i].r;
+    }
+    EXPECT_GT(sum, 0.0);
+}
+
 TEST_F(PathTracerTest, BounceLimitKeepsPathsOfAtMostBPlusOneReflections) {
     // --bounces B: the camera-visible surface's reflection plus up to B more.
     Scene scene = furnaceScene();
