@@ -160,7 +160,7 @@ public:
                const std::vector<Camera>& views, const TargetErrorParams& params) {
         if (dir.empty()) return;
         std::string what = fmt::format(
-            "pic pilot 1|{}|{}|{}x{} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
+            "pic pilot 2|{}|{}|{}x{} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
             params.size.x, params.size.y, params.spp, params.shadeSpp, base.surfels.value_or(0),
             base.links.value_or(0), base.bandsY.value_or(0), base.bandsC.value_or(0), base.gridCell.value_or(0.0f),
             base.lightmapTexel.value_or(0.0f), uint32_t(base.linkMode), uint32_t(base.hierarchy), base.linkSamples,
@@ -224,8 +224,9 @@ public:
         r.updateMs = j.value("update_ms", 0.0);
         r.measured = j.value("measured_rmse", 0.0);
         r.error = j.value("error", 0.0);
+        r.viewErrors = j.value("view_errors", std::vector<double>{});
         r.cached = true;
-        if (r.params.surfels == 0 || r.caches == 0) return std::nullopt;
+        if (r.params.surfels == 0 || r.caches == 0 || r.viewErrors.empty()) return std::nullopt;
         return r;
     }
 
@@ -236,7 +237,8 @@ public:
                                {"grid_cell", r.params.gridCell},      {"lightmap_texel", r.params.lightmapTexel},
                                {"link_samples", r.params.linkSamples}, {"caches", r.caches},
                                {"bake_seconds", r.bakeSeconds},       {"update_ms", r.updateMs},
-                               {"measured_rmse", r.measured},         {"error", r.error}};
+                               {"measured_rmse", r.measured},         {"error", r.error},
+                               {"view_errors", r.viewErrors}};
         save();
     }
 
@@ -343,27 +345,87 @@ std::string targetLevelsName(const std::vector<TargetAxisLevels>& axes, const Ta
     return parts.empty() ? "base" : fmt::format("{}", fmt::join(parts, ", "));
 }
 
-std::vector<Camera> pilotViews(const Scene& scene, std::vector<std::string>& how) {
+namespace {
+
+/// Whether a view can measure a relative error: its eye is not inside a solid (most rays
+/// from it reach front faces) and a small cached-light image of it is not black.
+Result<bool> seesIndirectLight(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
+                               const Camera& camera) {
+    uint32_t hits = 0, backFaces = 0;
+    for (uint32_t i = 0; i < 64; ++i) {
+        // Fibonacci directions over the sphere.
+        const float z = 1.0f - (2.0f * float(i) + 1.0f) / 64.0f, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        const float phi = 2.39996323f * float(i);
+        if (auto hit = rays.intersect(camera.eye, {r * std::cos(phi), z, r * std::sin(phi)}, 0.0f,
+                                      std::numeric_limits<float>::infinity())) {
+            ++hits;
+            backFaces += hit->backFace;
+        }
+    }
+    if (hits > 0 && 2 * backFaces > hits) return false;
+    PathTraceParams trace;
+    trace.width = 16;
+    trace.height = 12;
+    trace.spp = 16;
+    trace.component = PathTraceParams::Component::Cached;
+    PIC_TRY_ASSIGN(Image image, pathTrace(scene, rays, lights, camera, trace));
+    double sum = 0.0;
+    for (const glm::vec3& p : image.pixels) sum += double(p.r + p.g + p.b);
+    return sum > 0.0;
+}
+
+}  // namespace
+
+Result<std::vector<Camera>> pilotViews(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
+                                       std::vector<std::string>& how) {
     std::vector<Camera> views;
+    std::vector<std::string> skipped;
     for (size_t i = 0; i < scene.cameras.size() && views.size() < 2; ++i) {
+        const std::string name =
+            fmt::format("scene camera {}{}", i, scene.cameras[i].name.empty() ? "" : " (" + scene.cameras[i].name + ")");
+        PIC_TRY_ASSIGN(bool sees, seesIndirectLight(scene, rays, lights, scene.cameras[i]));
+        if (!sees) {
+            skipped.push_back(name);
+            continue;
+        }
         views.push_back(scene.cameras[i]);
-        how.push_back(fmt::format("scene camera {}{}", i, scene.cameras[i].name.empty() ? "" : " (" + scene.cameras[i].name + ")"));
+        how.push_back(name);
     }
     if (!views.empty()) return views;
-    // No camera: from the middle of the bounds, a little above, both ways along the longest
-    // horizontal side, where a person standing in the scene would look.
+    // No camera that sees indirect light: a person standing in the scene and turning round,
+    // at the middle of the bounds, then at each lamp, then in the lower and upper half of the
+    // bounds; the first four views that see indirect light.
     const glm::vec3 centre = scene.bounds.center(), extent = scene.bounds.extent();
-    const bool alongX = extent.x >= extent.z;
-    const glm::vec3 along = alongX ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 0.0f, 1.0f);
-    for (float sign : {1.0f, -1.0f}) {
-        Camera camera;
-        camera.eye = centre;
-        camera.target = centre + sign * along * std::max(extent.x, extent.z) * 0.5f - glm::vec3(0.0f, 0.1f * extent.y, 0.0f);
-        camera.fovyDegrees = 70.0f;
-        views.push_back(camera);
-        how.push_back(fmt::format("from the centre of the bounds along {}{} (the scene has no camera)",
-                                  sign > 0.0f ? "+" : "-", alongX ? "x" : "z"));
+    std::vector<std::pair<glm::vec3, std::string>> eyes{{centre, "the centre of the bounds"}};
+    for (const Light& light : lights.lights)
+        if (light.type != LightType::Directional)
+            eyes.emplace_back(light.position, fmt::format("light '{}'", light.id));
+    eyes.emplace_back(centre - glm::vec3(0.0f, 0.25f * extent.y, 0.0f), "the lower half of the bounds");
+    eyes.emplace_back(centre + glm::vec3(0.0f, 0.25f * extent.y, 0.0f), "the upper half of the bounds");
+    const std::string note = scene.cameras.empty()
+                                 ? " (the scene has no camera)"
+                                 : fmt::format(" ({} see{} no indirect light)", fmt::join(skipped, ", "),
+                                               skipped.size() == 1 ? "s" : "");
+    const std::pair<glm::vec3, const char*> turns[] = {
+        {{1.0f, 0.0f, 0.0f}, "+x"}, {{-1.0f, 0.0f, 0.0f}, "-x"}, {{0.0f, 0.0f, 1.0f}, "+z"}, {{0.0f, 0.0f, -1.0f}, "-z"}};
+    for (const auto& [eye, where] : eyes) {
+        for (const auto& [direction, name] : turns) {
+            if (views.size() == 4) return views;
+            Camera camera;
+            camera.eye = eye;
+            camera.target = eye + direction * std::max(extent.x, extent.z) * 0.5f - glm::vec3(0.0f, 0.1f * extent.y, 0.0f);
+            camera.fovyDegrees = 70.0f;
+            PIC_TRY_ASSIGN(bool sees, seesIndirectLight(scene, rays, lights, camera));
+            if (!sees) continue;
+            views.push_back(camera);
+            how.push_back(fmt::format("from {} along {}{}", where, name, note));
+        }
     }
+    if (views.empty())
+        return fail(ErrorCode::InvalidInput,
+                    "no view of scene '{}' sees indirect light under these lights (tried its cameras, its middle and "
+                    "its lamps): give the pilot one with --pilot-camera",
+                    scene.sourcePath);
     return views;
 }
 
@@ -387,9 +449,9 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     const double goal = params.safety * params.error;
 
     std::vector<Camera> cameras = params.cameras;
-    if (cameras.empty())
-        cameras = pilotViews(scene, choice.views);
-    else
+    if (cameras.empty()) {
+        PIC_TRY_ASSIGN(cameras, pilotViews(scene, *rays, lights, choice.views));
+    } else
         for (size_t i = 0; i < cameras.size(); ++i) choice.views.push_back(fmt::format("--pilot-camera {}", i));
     PilotCache cache(params.cacheDir, scene, base, lights, cameras, params);
     choice.cachePath = cache.path();
@@ -504,9 +566,10 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             for (const PilotReference& reference : references) {
                 PIC_TRY_ASSIGN(Image image, shadeFromCaches(scene, *rays, *bake, *values, lights, reference.camera, shade));
                 PIC_TRY_ASSIGN(ImageError e, compareImages(image, reference.image));
-                rung.measured += e.relativeRmse / double(references.size());
-                rung.error += std::sqrt(std::max(e.relativeRmse * e.relativeRmse - reference.noise * reference.noise, 0.0)) /
-                              double(references.size());
+                const double truth =
+                    std::sqrt(std::max(e.relativeRmse * e.relativeRmse - reference.noise * reference.noise, 0.0));
+                rung.viewErrors.push_back(truth);
+                if (truth >= rung.error) rung.error = truth, rung.measured = e.relativeRmse;
             }
             cache.storeRung(key, rung);
             if (own) {
@@ -526,8 +589,8 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         return rung;
     };
 
-    // The base, then each setting alone a step or two cheaper, and a step dearer where the
-    // base misses the goal.
+    // The base, then each setting alone at each of its cheaper levels, and at its dearer ones
+    // where the base misses the goal.
     PIC_TRY_ASSIGN(TargetRung baseRung, measure(baseLevels, "base"));
     choice.rungs.push_back(baseRung);
     const bool dearer = baseRung.error > goal;
@@ -555,11 +618,14 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     }
     choice.cost = fitCost(choice.rungs);
 
-    // The models over every combination of measured levels.
-    const double e0 = baseRung.error * baseRung.error;
+    // The models over every combination of measured levels, view by view.
+    const size_t views = references.size();
+    std::vector<double> e0(views);
+    for (size_t v = 0; v < views; ++v) e0[v] = baseRung.viewErrors[v] * baseRung.viewErrors[v];
     struct Candidate {
         TargetLevels levels;
-        double gain = 0.0, loss = 0.0;  // Σ of the settings' squared-error changes below and above 0
+        // Per view, Σ of the settings' squared-error changes below and above 0.
+        std::vector<double> gain, loss;
         double ms = 0.0;
         bool struck = false;
     };
@@ -570,16 +636,18 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     TargetLevels levels{};
     std::function<void(size_t)> enumerate = [&](size_t a) {
         if (a == axes.size()) {
-            Candidate c{levels};
+            Candidate c{levels, std::vector<double>(views, 0.0), std::vector<double>(views, 0.0)};
             double caches = double(baseRung.caches);
             for (size_t k = 0; k < axes.size(); ++k) {
                 const TargetRung& s = choice.rungs[*single[k][levels[k]]];
-                const double delta = s.error * s.error - e0;
-                // A cheaper setting cannot help and a dearer one cannot hurt, but for noise.
-                if (levels[k] < axes[k].base)
-                    c.loss += std::max(delta, 0.0);
-                else
-                    c.gain += std::min(delta, 0.0);
+                for (size_t v = 0; v < views; ++v) {
+                    const double delta = s.viewErrors[v] * s.viewErrors[v] - e0[v];
+                    // A cheaper setting cannot help and a dearer one cannot hurt, but for noise.
+                    if (levels[k] < axes[k].base)
+                        c.loss[v] += std::max(delta, 0.0);
+                    else
+                        c.gain[v] += std::min(delta, 0.0);
+                }
                 if (axes[k].axis == TargetAxis::GridCell || axes[k].axis == TargetAxis::Texel)
                     caches += double(s.caches) - double(baseRung.caches);
             }
@@ -598,12 +666,18 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     };
     enumerate(0);
     choice.combinations = candidates.size();
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    // The worst view's predicted error.
+    auto predicted = [&](const Candidate& c) {
+        double worst = 0.0;
+        for (size_t v = 0; v < views; ++v)
+            worst = std::max(worst, std::sqrt(std::max(e0[v] + choice.errorScale * c.loss[v] + c.gain[v], 0.0)));
+        return worst;
+    };
+    std::sort(candidates.begin(), candidates.end(), [&](const Candidate& x, const Candidate& y) {
         if (x.ms != y.ms) return x.ms < y.ms;
-        return x.loss + x.gain < y.loss + y.gain;
+        return predicted(x) < predicted(y);
     });
     for (TargetRung& r : choice.rungs) r.predictedMs = predictMs(r.params, double(r.caches));
-    auto predicted = [&](const Candidate& c) { return std::sqrt(std::max(e0 + choice.errorScale * c.loss + c.gain, 0.0)); };
     auto measuredIndex = [&](const TargetLevels& l) -> std::optional<size_t> {
         for (size_t i = 0; i < choice.rungs.size(); ++i)
             if (choice.rungs[i].levels == l) return i;
@@ -633,8 +707,11 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         if (rung.meets) continue;  // the next round finds it the cheapest measured
         // A miss: the settings' losses add up to more than they did alone, by this much at
         // least, and no combination cheaper on every setting can do better.
-        if (candidate.loss > 0.0)
-            choice.errorScale = std::max(choice.errorScale, (rung.error * rung.error - e0 - candidate.gain) / candidate.loss);
+        for (size_t v = 0; v < views; ++v)
+            if (candidate.loss[v] > 0.0)
+                choice.errorScale =
+                    std::max(choice.errorScale,
+                             (rung.viewErrors[v] * rung.viewErrors[v] - e0[v] - candidate.gain[v]) / candidate.loss[v]);
         for (Candidate& c : candidates) {
             bool cheaperEverywhere = true;
             for (size_t a = 0; a < axes.size(); ++a) cheaperEverywhere = cheaperEverywhere && c.levels[a] <= candidate.levels[a];

@@ -4,21 +4,22 @@
 ///
 /// The pilot path-traces the scene's views small, in two independent halves whose difference
 /// gives the reference's own noise n, so that a bake's error against the truth is √(e² − n²)
-/// with e its measured relative RMSE. It bakes the user's settings (the base) and each setting
-/// alone up to three steps cheaper (nS, nL ×½, ×¼ and ×⅛; lY − 1; each lC below the base; grid
-/// cell and light-map texel ×2 and ×4; 4 link samples) and every setting at its cheapest at
-/// once (the corner) — and, where the base misses the target, each setting a step dearer —
-/// relights each with the CPU twin, times its update and measures its error.
+/// with e its measured relative RMSE; a bake's error is its worst view's. It bakes the user's
+/// settings (the base) and each setting alone up to three steps cheaper (nS, nL ×½, ×¼ and ×⅛;
+/// lY − 1; each lC below the base; grid cell and light-map texel ×2 and ×4; 4 link samples)
+/// and every setting at its cheapest at once (the corner) — and, where the base misses the
+/// target, each setting a step dearer — relights each with the CPU twin, times its updates in
+/// turns with the base's and measures its error.
 ///
 /// Two models then rank every combination of those levels. Error: independent approximations
-/// add their squared errors, e²(combination) = e²(base) + Σ (e²(setting alone) − e²(base)).
-/// Cost: the update's CPU ms as a non-negative fit of link reads (caches · nL), link reads
-/// times SH coefficients, surfels and a constant to the measured bakes. The cheapest
+/// add their squared errors, view by view: e²(combination) = e²(base) + Σ (e²(setting alone) −
+/// e²(base)). Cost: the update's CPU ms as a non-negative fit of link reads (caches · nL), link
+/// reads times SH coefficients, surfels and a constant to the measured bakes. The cheapest
 /// combination predicted within safety · E is baked and measured; if it misses, the error
-/// model's sum is scaled up by what the miss shows, every combination no dearer on any setting
-/// is struck out, and the next is tried. Measurements are kept in a cache keyed by the scene,
-/// its base settings, lights and pilot, so a second target on the same scene bakes only what
-/// it has not measured.
+/// model's sums are scaled up by what the miss shows, every combination no dearer on any
+/// setting is struck out, and the next is tried. Measurements are kept in a cache keyed by the
+/// scene, its base settings, lights, views and pilot, so a second target on the same scene
+/// bakes only what it has not measured.
 
 #include <array>
 #include <cstdint>
@@ -35,6 +36,7 @@
 #include "core/image.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "rays/embree_scene.h"
 
 namespace pic {
 
@@ -91,9 +93,11 @@ struct TargetRung {
     double bakeSeconds = 0.0;
     double updateMs = 0.0;   ///< CPU twin: the base's median of 5 updates; another rung's, the
                              ///< median ratio of 5 updates timed in turns with the base's, times it
-    double measured = 0.0;   ///< relative RMSE against the pilot reference (mean over views)
-    double error = 0.0;      ///< against the truth: √max(e² − n², 0), mean over views
-    std::optional<double> predictedError;  ///< checks: what the models predicted before baking
+    std::vector<double> viewErrors;  ///< per view, against the truth: √max(e² − n², 0)
+    double error = 0.0;      ///< the worst view's error against the truth
+    double measured = 0.0;   ///< that view's relative RMSE e against the pilot reference
+    std::optional<double> predictedError;  ///< checks: what the models predicted for the worst
+                                           ///< view before baking
     double predictedMs = 0.0;  ///< the cost model's update ms
     bool meets = false;      ///< error ≤ safety × E and within the budget
     bool cached = false;     ///< measured by an earlier pilot (kept in the cache)
@@ -128,10 +132,14 @@ struct TargetChoice {
 /// variance of either, their mean half of it). Same sizes required.
 double halvesNoise(const Image& a, const Image& b);
 
-/// The views the pilot measures: the scene's cameras (at most 2), else two from the centre of
-/// the bounds, a little above it, looking both ways along their longest horizontal side.
-/// `how` receives a description of each.
-std::vector<Camera> pilotViews(const Scene& scene, std::vector<std::string>& how);
+/// The views the pilot measures: the scene's cameras (at most 2) that see indirect light under
+/// `lights`; without any, the first four that do of: the middle of the bounds, each lamp, the
+/// lower and the upper half of the bounds, each looking along +x, −x, +z and −z (a person
+/// turning round). A view sees indirect light when its eye is not inside a solid and a small
+/// path-traced image of the cached component is not black (a relative error needs light).
+/// `how` receives a description of each. InvalidInput when no view sees any.
+Result<std::vector<Camera>> pilotViews(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
+                                       std::vector<std::string>& how);
 
 /// Runs the pilot, one line per step on stderr. InvalidInput for E not in (0, 10], a budget
 /// ≤ 0 or a bad light set.

@@ -82,24 +82,62 @@ TEST(TargetAxes, OptionsAndNamesFollowTheLevels) {
     EXPECT_LE(*o.bandsC, *o.bandsY);
 }
 
-TEST(TargetAxes, ViewsAreTheScenesCamerasElseTwoFromItsMiddle) {
+/// The pilot's views of `scene` under its own lights.
+pic::Result<std::vector<pic::Camera>> viewsOf(const pic::Scene& scene, std::vector<std::string>& how) {
+    auto rays = pic::EmbreeScene::create(scene);
+    if (!rays) return std::unexpected(rays.error());
+    auto lights = pic::loadLightSet("", scene);
+    if (!lights) return std::unexpected(lights.error());
+    return pic::pilotViews(scene, **rays, *lights, how);
+}
+
+TEST(TargetAxes, ViewsAreTheScenesCamerasElseFourFromItsMiddle) {
     const pic::Scene cornell = test::loadTestScene("cornell");
     std::vector<std::string> how;
-    auto views = pic::pilotViews(cornell, how);
-    ASSERT_EQ(views.size(), std::min<size_t>(cornell.cameras.size(), 2));
-    ASSERT_EQ(how.size(), views.size());
+    auto views = viewsOf(cornell, how);
+    ASSERT_TRUE(views) << views.error().message;
+    ASSERT_EQ(views->size(), std::min<size_t>(cornell.cameras.size(), 2));
+    ASSERT_EQ(how.size(), views->size());
     EXPECT_NE(how[0].find("scene camera 0"), std::string::npos);
     pic::Scene noCamera = cornell;
     noCamera.cameras.clear();
     how.clear();
-    views = pic::pilotViews(noCamera, how);
-    ASSERT_EQ(views.size(), 2u);
+    views = viewsOf(noCamera, how);
+    ASSERT_TRUE(views) << views.error().message;
+    ASSERT_EQ(views->size(), 4u);
+    EXPECT_NE(how[0].find("the centre of the bounds"), std::string::npos) << how[0];
     EXPECT_NE(how[0].find("no camera"), std::string::npos);
-    // Both eyes are inside the bounds; the two look opposite ways.
+    // Every eye is inside the bounds; the views turn round: opposite ways, then across.
     const pic::Aabb& b = cornell.bounds;
-    for (const pic::Camera& v : views)
+    for (const pic::Camera& v : *views)
         EXPECT_TRUE(glm::all(glm::greaterThanEqual(v.eye, b.min)) && glm::all(glm::lessThanEqual(v.eye, b.max)));
-    EXPECT_LT(glm::dot(views[0].target - views[0].eye, views[1].target - views[1].eye), 0.0f);
+    auto look = [&](size_t i) { return glm::normalize((*views)[i].target - (*views)[i].eye); };
+    EXPECT_LT(glm::dot(look(0), look(1)), 0.0f);
+    EXPECT_NEAR(glm::dot(look(0), look(2)), 0.0f, 0.2f);
+}
+
+TEST(TargetAxes, ViewsThatSeeNoIndirectLightAreSkipped) {
+    // two_floors' camera looks into the upper room, which no light reaches, and the middle of
+    // its bounds is inside the slab: the pilot looks from its lamp in the lower room instead.
+    const pic::Scene scene = test::loadTestScene("two_floors");
+    ASSERT_FALSE(scene.cameras.empty());
+    std::vector<std::string> how;
+    auto views = viewsOf(scene, how);
+    ASSERT_TRUE(views) << views.error().message;
+    ASSERT_FALSE(views->empty());
+    for (size_t i = 0; i < views->size(); ++i) {
+        EXPECT_EQ(how[i].rfind("from ", 0), 0u) << how[i];
+        EXPECT_NE(how[i].find("sees no indirect light"), std::string::npos) << how[i];
+        EXPECT_LT((*views)[i].eye.y, scene.bounds.center().y) << how[i];
+    }
+    // A scene no light reaches at all: no view can measure a relative error.
+    std::vector<std::string> none;
+    auto rays = pic::EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    auto dark = pic::pilotViews(scene, **rays, pic::LightSet{}, none);
+    ASSERT_FALSE(dark);
+    EXPECT_EQ(dark.error().code, pic::ErrorCode::InvalidInput);
+    EXPECT_NE(dark.error().message.find("--pilot-camera"), std::string::npos);
 }
 
 TEST(TargetError, ALooseTargetTakesACheaperBakeAndASecondTargetReusesThePilot) {
@@ -124,6 +162,8 @@ TEST(TargetError, ALooseTargetTakesACheaperBakeAndASecondTargetReusesThePilot) {
         corners += r.kind == "corner";
         EXPECT_GE(r.error, 0.0);
         EXPECT_GE(r.measured, r.error - 1e-12) << "the truth's error is the measured one less the noise";
+        ASSERT_EQ(r.viewErrors.size(), 1u) << "cornell's one camera";
+        EXPECT_EQ(r.error, r.viewErrors[0]);
         EXPECT_GT(r.updateMs, 0.0);
         EXPECT_GT(r.predictedMs, 0.0);
         EXPECT_EQ(r.meets, r.error <= params.safety * params.error);
