@@ -160,7 +160,7 @@ public:
                const std::vector<Camera>& views, const TargetErrorParams& params) {
         if (dir.empty()) return;
         std::string what = fmt::format(
-            "pic pilot 2|{}|{}|{}x{} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
+            "pic pilot 3|{}|{}|{}x{} {} {}|{} {} {} {} {} {} {} {} {} {} {} {} {}", scene.hash, toJson(lights),
             params.size.x, params.size.y, params.spp, params.shadeSpp, base.surfels.value_or(0),
             base.links.value_or(0), base.bandsY.value_or(0), base.bandsC.value_or(0), base.gridCell.value_or(0.0f),
             base.lightmapTexel.value_or(0.0f), uint32_t(base.linkMode), uint32_t(base.hierarchy), base.linkSamples,
@@ -563,14 +563,18 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             rung.params = bake->params;
             rung.caches = bake->caches.size();
             PIC_TRY_ASSIGN(const CacheValues* values, runtime->setLights(lights));
+            // Over the views: the root mean square of their errors, the relative RMSE of all
+            // their pixels together where their levels are alike.
             for (const PilotReference& reference : references) {
                 PIC_TRY_ASSIGN(Image image, shadeFromCaches(scene, *rays, *bake, *values, lights, reference.camera, shade));
                 PIC_TRY_ASSIGN(ImageError e, compareImages(image, reference.image));
-                const double truth =
-                    std::sqrt(std::max(e.relativeRmse * e.relativeRmse - reference.noise * reference.noise, 0.0));
-                rung.viewErrors.push_back(truth);
-                if (truth >= rung.error) rung.error = truth, rung.measured = e.relativeRmse;
+                const double truth2 = std::max(e.relativeRmse * e.relativeRmse - reference.noise * reference.noise, 0.0);
+                rung.viewErrors.push_back(std::sqrt(truth2));
+                rung.error += truth2 / double(references.size());
+                rung.measured += e.relativeRmse * e.relativeRmse / double(references.size());
             }
+            rung.error = std::sqrt(rung.error);
+            rung.measured = std::sqrt(rung.measured);
             cache.storeRung(key, rung);
             if (own) {
                 ownRuntime.reset();
@@ -666,12 +670,11 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     };
     enumerate(0);
     choice.combinations = candidates.size();
-    // The worst view's predicted error.
+    // The predicted error over the views, as the measured one is taken.
     auto predicted = [&](const Candidate& c) {
-        double worst = 0.0;
-        for (size_t v = 0; v < views; ++v)
-            worst = std::max(worst, std::sqrt(std::max(e0[v] + choice.errorScale * c.loss[v] + c.gain[v], 0.0)));
-        return worst;
+        double sum = 0.0;
+        for (size_t v = 0; v < views; ++v) sum += std::max(e0[v] + choice.errorScale * c.loss[v] + c.gain[v], 0.0);
+        return std::sqrt(sum / double(views));
     };
     std::sort(candidates.begin(), candidates.end(), [&](const Candidate& x, const Candidate& y) {
         if (x.ms != y.ms) return x.ms < y.ms;
@@ -707,11 +710,12 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         if (rung.meets) continue;  // the next round finds it the cheapest measured
         // A miss: the settings' losses add up to more than they did alone, by this much at
         // least, and no combination cheaper on every setting can do better.
-        for (size_t v = 0; v < views; ++v)
-            if (candidate.loss[v] > 0.0)
-                choice.errorScale =
-                    std::max(choice.errorScale,
-                             (rung.viewErrors[v] * rung.viewErrors[v] - e0[v] - candidate.gain[v]) / candidate.loss[v]);
+        double loss = 0.0, rest = 0.0;
+        for (size_t v = 0; v < views; ++v) {
+            loss += candidate.loss[v];
+            rest += rung.viewErrors[v] * rung.viewErrors[v] - e0[v] - candidate.gain[v];
+        }
+        if (loss > 0.0) choice.errorScale = std::max(choice.errorScale, rest / loss);
         for (Candidate& c : candidates) {
             bool cheaperEverywhere = true;
             for (size_t a = 0; a < axes.size(); ++a) cheaperEverywhere = cheaperEverywhere && c.levels[a] <= candidate.levels[a];

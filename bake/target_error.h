@@ -4,7 +4,7 @@
 ///
 /// The pilot path-traces the scene's views small, in two independent halves whose difference
 /// gives the reference's own noise n, so that a bake's error against the truth is √(e² − n²)
-/// with e its measured relative RMSE; a bake's error is its worst view's. It bakes the user's
+/// with e its measured relative RMSE, and over the views the root mean square of theirs. It bakes the user's
 /// settings (the base) and each setting alone up to three steps cheaper (nS, nL ×½, ×¼ and ×⅛;
 /// lY − 1; each lC below the base; grid cell and light-map texel ×2 and ×4; 4 link samples)
 /// and every setting at its cheapest at once (the corner) — and, where the base misses the
@@ -50,9 +50,10 @@ struct TargetErrorParams {
     glm::uvec2 size{96, 72};        ///< pilot image size
     uint32_t spp = 256;             ///< reference samples per pixel (two halves)
     uint32_t shadeSpp = 2;          ///< subsamples per pixel shading from the caches
-    /// The choice's measured error must be at most safety × E: the pilot's images are small
-    /// and its views are not every view a user will look from.
-    double safety = 0.9;
+    /// The choice's measured error must be at most safety × E: the pilot's estimate of the
+    /// error against the truth scatters by 1–2 % (its reference's own noise), its images are
+    /// small and its views are not every view a user will look from.
+    double safety = 0.95;
     uint32_t maxChecks = 4;         ///< combinations baked to check the models, at most
     std::string cacheDir;           ///< where measurements are kept ("": nowhere)
 };
@@ -94,10 +95,9 @@ struct TargetRung {
     double updateMs = 0.0;   ///< CPU twin: the base's median of 5 updates; another rung's, the
                              ///< median ratio of 5 updates timed in turns with the base's, times it
     std::vector<double> viewErrors;  ///< per view, against the truth: √max(e² − n², 0)
-    double error = 0.0;      ///< the worst view's error against the truth
-    double measured = 0.0;   ///< that view's relative RMSE e against the pilot reference
-    std::optional<double> predictedError;  ///< checks: what the models predicted for the worst
-                                           ///< view before baking
+    double error = 0.0;      ///< against the truth over the views: √(mean of their squares)
+    double measured = 0.0;   ///< relative RMSE against the pilot reference, likewise
+    std::optional<double> predictedError;  ///< checks: what the models predicted before baking
     double predictedMs = 0.0;  ///< the cost model's update ms
     bool meets = false;      ///< error ≤ safety × E and within the budget
     bool cached = false;     ///< measured by an earlier pilot (kept in the cache)

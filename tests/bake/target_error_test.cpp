@@ -163,7 +163,7 @@ TEST(TargetError, ALooseTargetTakesACheaperBakeAndASecondTargetReusesThePilot) {
         EXPECT_GE(r.error, 0.0);
         EXPECT_GE(r.measured, r.error - 1e-12) << "the truth's error is the measured one less the noise";
         ASSERT_EQ(r.viewErrors.size(), 1u) << "cornell's one camera";
-        EXPECT_EQ(r.error, r.viewErrors[0]);
+        EXPECT_DOUBLE_EQ(r.error, r.viewErrors[0]);
         EXPECT_GT(r.updateMs, 0.0);
         EXPECT_GT(r.predictedMs, 0.0);
         EXPECT_EQ(r.meets, r.error <= params.safety * params.error);

@@ -122,7 +122,7 @@ TEST_F(PicbenchSweep, AutotuneChecksEachTargetAgainstTheGrid) {
     EXPECT_EQ(check.at("target_error").get<double>(), 0.9);
     // A target this loose: a bake cheaper than the base, within it, and some grid point meets it.
     EXPECT_NE(check.at("chosen"), "base");
-    EXPECT_LE(check.at("predicted_error").get<double>(), 0.9 * 0.9);
+    EXPECT_LE(check.at("predicted_error").get<double>(), 0.95 * 0.9);
     EXPECT_TRUE(std::isfinite(check.at("error").get<double>()));
     EXPECT_EQ(check.at("meets").get<bool>(), check.at("error").get<double>() <= 0.9);
     ASSERT_FALSE(check.at("cheapest_swept").is_null());
