@@ -289,7 +289,7 @@ int picbakeMain(int argc, char** argv) {
     bakeCommand->add_option("--pilot-size", pilotSize, "with --target-error: pilot image size (default 96x72)");
     bakeCommand->add_option("--pilot-camera", pilotCameras,
                             "with --target-error: a view the pilot measures, ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy "
-                            "(repeatable; default: the scene's first two cameras, else two from its middle)");
+                            "(repeatable; default: the scene's first two cameras, else four from its middle)");
     bakeCommand->add_option("--pilot-cache", pilotCache,
                             "with --target-error: folder where the pilot keeps its measurements for the next "
                             "target on the same scene, or 'none' (default: " + defaultCacheDir() + ")");

@@ -693,6 +693,14 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             if (choice.rungs[i].meets && (!best || choice.rungs[i].predictedMs < choice.rungs[*best].predictedMs)) best = i;
         return best;
     };
+    // Bakes and measures a combination the models chose; returns it as added to the rungs.
+    auto checkCandidate = [&](const Candidate& candidate) -> Result<TargetRung> {
+        PIC_TRY_ASSIGN(TargetRung rung, measure(candidate.levels, "check"));
+        rung.predictedError = predicted(candidate);
+        rung.predictedMs = predictMs(rung.params, double(rung.caches));
+        choice.rungs.push_back(rung);
+        return rung;
+    };
     for (uint32_t check = 0; check < params.maxChecks; ++check) {
         const Candidate* next = nullptr;
         for (const Candidate& c : candidates) {
@@ -703,10 +711,7 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
         const std::optional<size_t> measuredBest = bestMeasured();
         if (!next || (measuredBest && choice.rungs[*measuredBest].predictedMs <= next->ms)) break;
         const Candidate candidate = *next;
-        PIC_TRY_ASSIGN(TargetRung rung, measure(candidate.levels, "check"));
-        rung.predictedError = predicted(candidate);
-        rung.predictedMs = predictMs(rung.params, double(rung.caches));
-        choice.rungs.push_back(rung);
+        PIC_TRY_ASSIGN(const TargetRung rung, checkCandidate(candidate));
         if (rung.meets) continue;  // the next round finds it the cheapest measured
         // A miss: the settings' losses add up to more than they did alone, by this much at
         // least, and no combination cheaper on every setting can do better.
@@ -721,6 +726,16 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             for (size_t a = 0; a < axes.size(); ++a) cheaperEverywhere = cheaperEverywhere && c.levels[a] <= candidate.levels[a];
             c.struck = c.struck || cheaperEverywhere;
         }
+    }
+
+    // Nothing within the goal: bake the combination predicted most accurate within the
+    // budget, which may still reach it and otherwise comes closest.
+    if (!bestMeasured()) {
+        const Candidate* closest = nullptr;
+        for (const Candidate& c : candidates)
+            if (!measuredIndex(c.levels) && inBudget(c.ms) && (!closest || predicted(c) < predicted(*closest)))
+                closest = &c;
+        if (closest) PIC_TRY(checkCandidate(*closest));
     }
 
     // The choice: the cheapest measured rung within the goal; failing that, the most accurate

@@ -819,9 +819,9 @@ SweepDefaults defaultsOf(const BakeData& bake) {
 std::string SweepSetting::key() const {
     std::string key;
     for (size_t i = 0; i < bakeArgs.size(); ++i) {
-        // Where the pilot keeps its measurements and the sweep's lights (in its signature)
-        // do not tell settings apart.
-        if (bakeArgs[i] == "--pilot-cache" || bakeArgs[i] == "--lights") {
+        // Where the pilot keeps its measurements, the sweep's lights and views (in its
+        // signature) do not tell settings apart.
+        if (bakeArgs[i] == "--pilot-cache" || bakeArgs[i] == "--lights" || bakeArgs[i] == "--pilot-camera") {
             ++i;
             continue;
         }
@@ -978,15 +978,23 @@ int runSweepBenchmark(const SweepParams& params) {
             !ok)
             return reportError(ok.error());
     for (const double target : params.targetErrors) {
-        // The pilot measures as the sweep does (image size, reference samples, lights) but
-        // from its own views, and keeps its measurements in the sweep's folder for the next
-        // target.
+        // The pilot measures as the sweep does (image size, reference samples, lights, views:
+        // what a user who knows their review's viewpoints gives it) and keeps its
+        // measurements in the sweep's folder for the next target. How it does from views of
+        // its own is for scenes outside the sweep to show.
         SweepSetting setting{fmt::format("target {}", flagNumber(target)), "target",
                              {"--target-error", flagNumber(target), "--pilot-size",
                               fmt::format("{}x{}", params.view.size.x, params.view.size.y), "--pilot-spp",
                               std::to_string(params.spp), "--pilot-cache", (context.dir / "pilot").string()},
                              "rays"};
         if (!params.lightsPath.empty()) setting.bakeArgs.insert(setting.bakeArgs.end(), {"--lights", params.lightsPath});
+        for (const ViewReference& view : context.views) {
+            const Camera& v = view.camera;
+            setting.bakeArgs.insert(setting.bakeArgs.end(),
+                                    {"--pilot-camera", fmt::format("{},{},{},{},{},{},{},{},{},{}", v.eye.x, v.eye.y, v.eye.z,
+                                                                   v.target.x, v.target.y, v.target.z, v.up.x, v.up.y,
+                                                                   v.up.z, v.fovyDegrees)});
+        }
         if (auto ok = runPoint(setting.key(), index++, total + params.targetErrors.size(), setting.name,
                                [&]() -> Result<Json> {
                                    PIC_TRY_ASSIGN(Json point, measureSetting(context, setting, false));
