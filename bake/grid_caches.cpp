@@ -38,7 +38,8 @@ bool triangleOverlapsBox(glm::vec3 a, glm::vec3 b, glm::vec3 c, const glm::vec3&
     return std::abs(glm::dot(n, a)) <= r;
 }
 
-/// Unit directions spread evenly over the sphere (Fibonacci lattice).
+}  // namespace
+
 std::vector<glm::vec3> sphereDirections(uint32_t n) {
     std::vector<glm::vec3> dirs(n);
     for (uint32_t i = 0; i < n; ++i) {
@@ -50,7 +51,19 @@ std::vector<glm::vec3> sphereDirections(uint32_t n) {
     return dirs;
 }
 
-}  // namespace
+bool insideSolid(const Scene& scene, const EmbreeScene& rays, const glm::vec3& p,
+                 std::span<const glm::vec3> directions) {
+    size_t back = 0, front = 0;
+    for (const glm::vec3& d : directions) {
+        auto hit = rays.intersect(p, d, 0.0f, std::numeric_limits<float>::infinity());
+        if (!hit) continue;
+        if (hit->backFace && !scene.materials[scene.triangles[hit->triangle].material].doubleSided)
+            ++back;
+        else
+            ++front;
+    }
+    return back * 4 > directions.size() || front == 0;
+}
 
 Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays,
                                      uint32_t firstCacheIndex, const GridCacheParams& params) {
@@ -137,18 +150,9 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
             uint64_t v = candidates[i];
             glm::uvec3 c(v % grid.dims.x, (v / grid.dims.x) % grid.dims.y, v / (uint64_t(grid.dims.x) * grid.dims.y));
             glm::vec3 p = grid.origin + glm::vec3(c) * cell;
-            uint32_t back = 0, front = 0;
-            for (const glm::vec3& d : dirs) {
-                auto hit = rays.intersect(p, d, 0.0f, std::numeric_limits<float>::infinity());
-                if (!hit) continue;
-                if (hit->backFace && !scene.materials[scene.triangles[hit->triangle].material].doubleSided)
-                    ++back;
-                else
-                    ++front;
-            }
             // Inside when more than a quarter of the sphere shows back faces, and useless when
             // no front face is in sight (e.g. outside a closed room).
-            inside[i] = back * 4 > dirs.size() || front == 0;
+            inside[i] = insideSolid(scene, rays, p, dirs);
             if ((i & 1023) == 0) progress.advance(std::min<size_t>(1024, candidates.size() - i));
         }, 64);
     }

@@ -3,6 +3,7 @@
 /// cells that contain or touch geometry, dilated by one cell, never inside solid geometry.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/bake_data.h"
@@ -25,6 +26,15 @@ struct GridCacheSet {
     uint32_t insideSolid = 0;      ///< needed vertices found inside geometry
     uint32_t duplicates = 0;       ///< inside vertices that copy a neighbour's cache
 };
+
+/// Unit directions spread evenly over the sphere (Fibonacci lattice).
+std::vector<glm::vec3> sphereDirections(uint32_t n);
+
+/// Whether point `p` is inside closed geometry (or behind single-sided walls): more than a
+/// quarter of the rays along `directions` meet back faces of single-sided materials first, or
+/// none meets a front face (e.g. outside a closed room: nothing to see from there).
+bool insideSolid(const Scene& scene, const EmbreeScene& rays, const glm::vec3& p,
+                 std::span<const glm::vec3> directions);
 
 /// Places grid caches; their indices start at `firstCacheIndex`.
 Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays,

@@ -10,9 +10,11 @@
 #include <limits>
 #include <map>
 
+#include "bake/grid_caches.h"
 #include "bake/ref/path_tracer.h"
 #include "core/hash.h"
 #include "core/image.h"
+#include "core/sh.h"
 #include "render/cpu/cache_shading.h"
 #include "render/cpu_runtime.h"
 
@@ -67,7 +69,7 @@ TargetAxisLevels makeAxis(TargetAxis axis, std::vector<double> values, double ba
 
 /// SH coefficients a cache holds: lY² of luminance and lC² of each chroma channel.
 double coefficientsPerCache(const BakeParams& p) {
-    return double(p.bandsY * p.bandsY + 2 * p.bandsC * p.bandsC);
+    return double(shCount(int(p.bandsY)) + 2 * shCount(int(p.bandsC)));
 }
 
 /// The cost model's features: link reads, link reads · coefficients, surfels, 1.
@@ -276,6 +278,13 @@ double TargetCostModel::predict(double caches, double links, double coefficients
     return ms;
 }
 
+Image meanOfHalves(const Image& a, const Image& b) {
+    PIC_CHECK(a.pixels.size() == b.pixels.size());
+    Image mean(a.width, a.height);
+    for (size_t i = 0; i < mean.pixels.size(); ++i) mean.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
+    return mean;
+}
+
 double halvesNoise(const Image& a, const Image& b) {
     PIC_CHECK(a.pixels.size() == b.pixels.size());
     double sum = 0.0, level = 0.0;
@@ -347,22 +356,12 @@ std::string targetLevelsName(const std::vector<TargetAxisLevels>& axes, const Ta
 
 namespace {
 
-/// Whether a view can measure a relative error: its eye is not inside a solid (most rays
-/// from it reach front faces) and a small cached-light image of it is not black.
+/// Whether a view can measure a relative error: its eye is not inside a solid (as the grid's
+/// caches test it) and a small cached-light image of it is not black.
 Result<bool> seesIndirectLight(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
                                const Camera& camera) {
-    uint32_t hits = 0, backFaces = 0;
-    for (uint32_t i = 0; i < 64; ++i) {
-        // Fibonacci directions over the sphere.
-        const float z = 1.0f - (2.0f * float(i) + 1.0f) / 64.0f, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-        const float phi = 2.39996323f * float(i);
-        if (auto hit = rays.intersect(camera.eye, {r * std::cos(phi), z, r * std::sin(phi)}, 0.0f,
-                                      std::numeric_limits<float>::infinity())) {
-            ++hits;
-            backFaces += hit->backFace;
-        }
-    }
-    if (hits > 0 && 2 * backFaces > hits) return false;
+    static const std::vector<glm::vec3> directions = sphereDirections(64);
+    if (insideSolid(scene, rays, camera.eye, directions)) return false;
     PathTraceParams trace;
     trace.width = 16;
     trace.height = 12;
@@ -474,9 +473,7 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             PIC_TRY_ASSIGN(Image a, pathTrace(scene, *rays, lights, cameras[v], trace));
             trace.seed = 2;
             PIC_TRY_ASSIGN(Image b, pathTrace(scene, *rays, lights, cameras[v], trace));
-            PilotReference reference{cameras[v], Image(a.width, a.height), halvesNoise(a, b)};
-            for (size_t i = 0; i < a.pixels.size(); ++i) reference.image.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
-            references.push_back(std::move(reference));
+            references.push_back({cameras[v], meanOfHalves(a, b), halvesNoise(a, b)});
         }
         cache.storeReferences(references);
     }

@@ -127,6 +127,9 @@ struct TargetChoice {
     double pilotSeconds = 0.0;
 };
 
+/// The mean of two independent estimates `a` and `b` of the same image (same sizes required).
+Image meanOfHalves(const Image& a, const Image& b);
+
 /// The relative RMSE against the truth of the mean of two independent estimates `a` and `b`
 /// of the same image: RMS(a − b)/2 over the mean's level (their difference has twice the
 /// variance of either, their mean half of it). Same sizes required.

@@ -117,11 +117,6 @@ struct ViewReference {
     double fullNoise = 0.0;
 };
 
-Image meanOf(const Image& a, const Image& b) {
-    Image out(a.width, a.height);
-    for (size_t i = 0; i < out.pixels.size(); ++i) out.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
-    return out;
-}
 
 /// Everything the sweep holds while it runs.
 struct SweepContext {
@@ -178,7 +173,7 @@ Result<void> loadOrTraceReferences(SweepContext& context) {
                                                     view.camera, trace));
                 PIC_TRY(writeImage(path.string(), halves[h]));
             }
-            Image mean = meanOf(halves[0], halves[1]);
+            Image mean = meanOfHalves(halves[0], halves[1]);
             (indirect ? view.indirectNoise : view.fullNoise) = halvesNoise(halves[0], halves[1]);
             (indirect ? view.indirect : view.full) = std::move(mean);
         }
