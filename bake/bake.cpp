@@ -149,6 +149,8 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     if (!(p.gridCell > 0.0f) || !std::isfinite(p.gridCell))
         return fail(ErrorCode::InvalidInput, "--grid-cell must be a positive number of metres, got {}", p.gridCell);
 
+    p.gridCaches = options.gridCaches;
+
     if (options.lightmapTexel) {
         p.lightmapTexel = *options.lightmapTexel;
     } else {
@@ -226,32 +228,46 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     bake.levelOffsets = std::move(hierarchy.levelOffsets);
     hierarchyTimer.stop();
 
-    StageTimer gridTimer(report, "grid_caches");
-    GridCacheParams gridParams;
-    gridParams.cellSize = p.gridCell;
-    PIC_TRY_ASSIGN(GridCacheSet grid, placeGridCaches(scene, *rays, 0, gridParams));
-    bake.grid = std::move(grid.layout);
-    bake.caches = std::move(grid.caches);
-    report.gridInsideSolid = grid.insideSolid;
-    report.gridDuplicates = grid.duplicates;
-    gridTimer.stop();
-
+    // The light map first: its charts decide which triangles are shaded from the grid. The
+    // grid's caches still come first in the cache list.
     StageTimer lightmapTimer(report, "lightmap");
     LightmapChartParams chartParams;
     chartParams.texelSize = p.lightmapTexel;
     PIC_TRY_ASSIGN(LightmapCharts charts, buildLightmapCharts(scene, chartParams));
     LightmapCacheParams lightmapParams;
     lightmapParams.texelSize = p.lightmapTexel;
-    PIC_TRY_ASSIGN(LightmapCacheSet lightmap,
-                   placeLightmapCaches(scene, *rays, std::move(charts),
-                                       static_cast<uint32_t>(bake.caches.size()), lightmapParams));
-    bake.lightmap = std::move(lightmap.layout);
-    bake.caches.insert(bake.caches.end(), lightmap.caches.begin(), lightmap.caches.end());
+    PIC_TRY_ASSIGN(LightmapCacheSet lightmap, placeLightmapCaches(scene, *rays, std::move(charts), 0, lightmapParams));
     report.lightmapDuplicates = lightmap.duplicateTexels;
     report.lightmapRelocated = lightmap.relocated;
     report.lightmapRejected = lightmap.rejected;
     report.lightmapGridShaded = lightmap.gridShadedTriangles;
     lightmapTimer.stop();
+
+    StageTimer gridTimer(report, "grid_caches");
+    GridCacheParams gridParams;
+    gridParams.cellSize = p.gridCell;
+    gridParams.mode = p.gridCaches;
+    if (p.gridCaches == GridCaches::Surfaces) {
+        gridParams.gridShaded.resize(scene.triangles.size());
+        for (size_t t = 0; t < scene.triangles.size(); ++t)
+            gridParams.gridShaded[t] = lightmap.layout.triangleUvs[3 * t].x == kNotLightmapped;
+    }
+    PIC_TRY_ASSIGN(GridCacheSet grid, placeGridCaches(scene, *rays, 0, gridParams));
+    bake.grid = std::move(grid.layout);
+    bake.caches = std::move(grid.caches);
+    report.gridInsideSolid = grid.insideSolid;
+    report.gridDuplicates = grid.duplicates;
+    report.gridUnread = grid.unread;
+    gridTimer.stop();
+
+    const auto gridCount = static_cast<uint32_t>(bake.caches.size());
+    if (uint64_t{gridCount} + lightmap.caches.size() >= kNoCache)
+        return fail(ErrorCode::InvalidInput, "{} grid and {} light-map caches are too many", gridCount,
+                    lightmap.caches.size());
+    bake.lightmap = std::move(lightmap.layout);
+    for (uint32_t& index : bake.lightmap.cacheIndex)
+        if (index != kNoCache) index += gridCount;
+    bake.caches.insert(bake.caches.end(), lightmap.caches.begin(), lightmap.caches.end());
 
     // The links' flux weights (bake/surfel_exposure.h), surfels in leaf order.
     std::vector<float> weights;

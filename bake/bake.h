@@ -21,6 +21,7 @@ struct BakeOptions {
     std::optional<uint32_t> bandsY;
     std::optional<uint32_t> bandsC;
     std::optional<float> gridCell;
+    GridCaches gridCaches = GridCaches::Surfaces;
     std::optional<float> lightmapTexel;
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Visible;
@@ -39,6 +40,7 @@ struct BakeReport {
     LinkStats links;
     uint32_t gridInsideSolid = 0;
     uint32_t gridDuplicates = 0;
+    uint32_t gridUnread = 0;          ///< GridCaches::Surfaces: volume caches no surface reads
     uint32_t lightmapDuplicates = 0;
     uint32_t lightmapRelocated = 0;
     uint32_t lightmapRejected = 0;

@@ -9,6 +9,11 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     mBandsOption = command.add_option("--bands", mBands, "SH bands for luma lY, 1-8 (default 3)");
     mChromaOption = command.add_option("--chroma-bands", mChromaBands, "SH bands for chroma lC <= lY (default 2)");
     mGridOption = command.add_option("--grid-cell", mGridCell, "grid cell size in metres (default: largest extent / 16)");
+    command.add_option("--grid-caches", mGridCaches,
+                       "where grid caches go: surfaces (only where surfaces too small for the "
+                       "light map read them) or volume (everywhere near geometry, for dynamic "
+                       "objects; default surfaces)")
+        ->check(CLI::IsMember({"surfaces", "volume"}));
     mTexelOption = command.add_option("--lightmap-texel", mLightmapTexel,
                                       "light-map texel size in metres (default: about 8k texels over the scene's area)");
     command.add_option("--link-mode", mLinkMode, "sh or rtp (default rtp)")->check(CLI::IsMember({"sh", "rtp"}));
@@ -57,6 +62,7 @@ BakeOptions BakeOptionFlags::toOptions() const {
     if (*mChromaOption) options.bandsC = mChromaBands;
     if (*mGridOption) options.gridCell = mGridCell;
     if (*mTexelOption) options.lightmapTexel = mLightmapTexel;
+    options.gridCaches = mGridCaches == "volume" ? GridCaches::Volume : GridCaches::Surfaces;
     options.linkMode = mLinkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
     options.hierarchy = mHierarchy == "kdtree"          ? HierarchyMethod::KdTree
                         : mHierarchy == "agglomerative" ? HierarchyMethod::Agglomerative

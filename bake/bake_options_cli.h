@@ -28,7 +28,7 @@ private:
     uint32_t mSurfels = 0, mLinks = 0, mBands = 0, mChromaBands = 0;
     float mGridCell = 0.0f, mLightmapTexel = 0.0f;
     std::string mLinkMode = "rtp", mHierarchy = "visible", mLinkReads = "visible",
-                mLinkCut = "error";
+                mLinkCut = "error", mGridCaches = "surfaces";
     CLI::Option* mSurfelsOption = nullptr;
     CLI::Option* mLinksOption = nullptr;
     CLI::Option* mBandsOption = nullptr;

@@ -38,6 +38,38 @@ bool triangleOverlapsBox(glm::vec3 a, glm::vec3 b, glm::vec3 c, const glm::vec3&
     return std::abs(glm::dot(n, a)) <= r;
 }
 
+/// GridCaches::Surfaces: keeps the caches that the corners of the `read` cells hold (a point
+/// in a cell interpolates its 8 corners), numbered again from `firstCacheIndex` in order;
+/// every other vertex gets kNoCache.
+void keepReadCaches(GridCacheSet& set, const std::vector<std::atomic<uint8_t>>& read,
+                    glm::uvec3 cells, uint32_t firstCacheIndex) {
+    GridLayout& grid = set.layout;
+    std::vector<uint8_t> vertexRead(grid.cacheIndex.size(), 0);
+    for (uint32_t z = 0; z < cells.z; ++z)
+        for (uint32_t y = 0; y < cells.y; ++y)
+            for (uint32_t x = 0; x < cells.x; ++x) {
+                if (!read[x + cells.x * (y + uint64_t(cells.y) * z)].load(std::memory_order_relaxed)) continue;
+                for (uint32_t corner = 0; corner < 8; ++corner)
+                    vertexRead[(x + (corner & 1)) +
+                               grid.dims.x * ((y + ((corner >> 1) & 1)) + uint64_t(grid.dims.y) * (z + (corner >> 2)))] = 1;
+            }
+    std::vector<uint32_t> remap(set.caches.size(), kNoCache);
+    for (size_t v = 0; v < vertexRead.size(); ++v)
+        if (vertexRead[v] && grid.cacheIndex[v] != kNoCache) remap[grid.cacheIndex[v] - firstCacheIndex] = 0;
+    uint32_t kept = 0;
+    for (size_t c = 0; c < set.caches.size(); ++c) {
+        if (remap[c] == kNoCache) continue;
+        remap[c] = kept;
+        set.caches[kept++] = set.caches[c];
+    }
+    set.unread = static_cast<uint32_t>(set.caches.size() - kept);
+    set.caches.resize(kept);
+    for (size_t v = 0; v < vertexRead.size(); ++v) {
+        uint32_t& index = grid.cacheIndex[v];
+        index = vertexRead[v] && index != kNoCache ? firstCacheIndex + remap[index - firstCacheIndex] : kNoCache;
+    }
+}
+
 }  // namespace
 
 std::vector<glm::vec3> sphereDirections(uint32_t n) {
@@ -91,13 +123,20 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
 
     // 1. Cells containing or touching a triangle. Each triangle marks its own cells;
     //    writes of the value 1 from several threads are benign with relaxed atomics.
+    const bool surfaces = params.mode == GridCaches::Surfaces;
+    if (surfaces && params.gridShaded.size() != scene.triangles.size())
+        return fail(ErrorCode::InvalidInput, "grid-shaded flags for {} triangles, the scene has {}",
+                    params.gridShaded.size(), scene.triangles.size());
     std::vector<std::atomic<uint8_t>> occupied(uint64_t(cells.x) * cells.y * cells.z);
+    // Surfaces mode: cells holding a grid-shaded triangle, whose corners its points read.
+    std::vector<std::atomic<uint8_t>> read(surfaces ? occupied.size() : 0);
     const glm::vec3 half(0.5f * cell);
     {
         Progress progress("grid occupancy", scene.triangles.size());
         parallelForChunks(0, scene.triangles.size(), [&](size_t begin, size_t end) {
             for (size_t t = begin; t < end; ++t) {
                 const Triangle& tri = scene.triangles[t];
+                const bool shadedFromGrid = surfaces && params.gridShaded[t];
                 glm::vec3 p[3];
                 Aabb box;
                 for (int k = 0; k < 3; ++k) box.extend(p[k] = scene.vertices[tri.v[k]].position);
@@ -107,10 +146,13 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
                     for (uint32_t y = lo.y; y <= hi.y; ++y)
                         for (uint32_t x = lo.x; x <= hi.x; ++x) {
                             glm::vec3 centre = grid.origin + (glm::vec3(x, y, z) + 0.5f) * cell;
-                            auto& flag = occupied[cellIndex({x, y, z})];
-                            if (!flag.load(std::memory_order_relaxed) &&
-                                triangleOverlapsBox(p[0], p[1], p[2], centre, half))
-                                flag.store(1, std::memory_order_relaxed);
+                            const uint64_t index = cellIndex({x, y, z});
+                            auto& flag = occupied[index];
+                            const bool known = flag.load(std::memory_order_relaxed) &&
+                                               (!shadedFromGrid || read[index].load(std::memory_order_relaxed));
+                            if (known || !triangleOverlapsBox(p[0], p[1], p[2], centre, half)) continue;
+                            flag.store(1, std::memory_order_relaxed);
+                            if (shadedFromGrid) read[index].store(1, std::memory_order_relaxed);
                         }
             }
             progress.advance(end - begin);
@@ -204,6 +246,7 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
         }
     }
     grid.cacheIndex = std::move(filled);
+    if (surfaces) keepReadCaches(result, read, cells, firstCacheIndex);
     return result;
 }
 

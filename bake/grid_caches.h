@@ -1,6 +1,8 @@
 #pragma once
 /// Grid cache placement (paper 000 §4.4, paper 001 §5): caches at the vertices of grid
-/// cells that contain or touch geometry, dilated by one cell, never inside solid geometry.
+/// cells that contain or touch geometry, dilated by one cell, never inside solid geometry —
+/// the volume dynamic objects are shaded from — or only at the vertices that grid-shaded
+/// surfaces read, where nothing dynamic is shaded.
 
 #include <cstdint>
 #include <span>
@@ -15,6 +17,10 @@ namespace pic {
 
 struct GridCacheParams {
     float cellSize = 0.0f;        ///< metres
+    GridCaches mode = GridCaches::Volume;
+    /// GridCaches::Surfaces: per scene triangle, 1 where it is shaded from the grid (not
+    /// light-mapped). Only the caches its cells' corners read are kept.
+    std::vector<uint8_t> gridShaded;
     uint32_t insideRays = 16;     ///< rays per vertex for the inside-solid test
     uint64_t maxVertices = 64ull << 20;  ///< refuse grids larger than this
 };
@@ -25,6 +31,8 @@ struct GridCacheSet {
     std::vector<Cache> caches;     ///< unique grid caches, kind = grid
     uint32_t insideSolid = 0;      ///< needed vertices found inside geometry
     uint32_t duplicates = 0;       ///< inside vertices that copy a neighbour's cache
+    uint32_t unread = 0;           ///< GridCaches::Surfaces: volume caches no surface reads,
+                                   ///< not kept
 };
 
 /// Unit directions spread evenly over the sphere (Fibonacci lattice).

@@ -158,9 +158,13 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     fmt::print("  hierarchy       {}, {} nodes, {} levels\n", hierarchyName(p.hierarchy), bake->nodes.size(),
                bake->levelOffsets.size() - 1);
     fmt::print("  grid cell       {}\n", withDefault("grid_cell", fmt::format("{:.4g} m", p.gridCell)));
-    fmt::print("  grid caches     {} vertices of {}x{}x{}, {} inside solid geometry ({} copy a neighbour)\n",
-               info->gridCaches, bake->grid.dims.x, bake->grid.dims.y, bake->grid.dims.z,
-               report.gridInsideSolid, report.gridDuplicates);
+    fmt::print("  grid caches     {}: {} vertices of {}x{}x{}, {} inside solid geometry ({} copy a neighbour){}\n",
+               gridCachesName(p.gridCaches), info->gridCaches, bake->grid.dims.x, bake->grid.dims.y,
+               bake->grid.dims.z, report.gridInsideSolid, report.gridDuplicates,
+               p.gridCaches == GridCaches::Surfaces
+                   ? fmt::format(", {} that only dynamic objects would read left out (--grid-caches volume keeps them)",
+                                 report.gridUnread)
+                   : "");
     fmt::print("  lightmap texel  {}\n", withDefault("lightmap_texel", fmt::format("{:.4g} m", p.lightmapTexel)));
     fmt::print("  lightmap        {}x{} atlas, {} charts, {} texels with a cache ({} duplicates), "
                "{} caches relocated, {} rejected behind geometry, {} triangles too small for it "
@@ -231,6 +235,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
         if (!target.is_discarded()) out["target"] = target;
     }
     out["params"] = {{"grid_cell", p.gridCell},
+                     {"grid_caches", gridCachesName(p.gridCaches)},
                      {"lightmap_texel", p.lightmapTexel},
                      {"hierarchy", hierarchyName(p.hierarchy)},
                      {"link_samples", p.linkSamples},
@@ -253,8 +258,8 @@ int runInfoCommand(const std::string& bakePath, bool json) {
                info->gridCaches, info->lightmapCaches);
     fmt::print("  links: {} per cache, {}, bands y {} c {}\n", info->linksPerCache, toString(p.linkMode),
                p.bandsY, p.bandsC);
-    fmt::print("  grid cell {:.4g} m, light-map texel {:.4g} m, hierarchy {}, seed {}\n", p.gridCell,
-               p.lightmapTexel, hierarchyName(p.hierarchy), p.seed);
+    fmt::print("  grid cell {:.4g} m (caches at {}), light-map texel {:.4g} m, hierarchy {}, seed {}\n",
+               p.gridCell, gridCachesName(p.gridCaches), p.lightmapTexel, hierarchyName(p.hierarchy), p.seed);
     for (const auto& [name, bytes] : info->sectionBytes) fmt::print("  section {:<16} {}\n", name, humanBytes(bytes));
     fmt::print("  file {}\n", humanBytes(info->fileSize));
     for (const auto& [stage, s] : seconds.items()) fmt::print("  stage {:<14} {:.2f} s\n", stage, s.get<double>());

@@ -39,6 +39,7 @@ BakeOptions settingOptions(const std::string& setting, const std::string& linkMo
     options.bandsY = high ? 4u : 3u;
     options.bandsC = chromaBands;
     options.linkMode = linkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
+    options.gridCaches = GridCaches::Volume;  // the paper's grid fills the space around the scene
     return options;
 }
 

@@ -24,7 +24,8 @@ double median(std::vector<double> values);
 
 /// Paper 000 Table 2's settings as bake options: "moderate" (nS 32k, nL 128, lY 3) or
 /// "high" (nS 128k, nL 254, lY 4), with "rtp" or "sh" links and `chromaBands` lC (2 in the
-/// paper's settings; the bake refuses lC > lY).
+/// paper's settings; the bake refuses lC > lY), grid caches in the whole volume as the
+/// paper's.
 BakeOptions settingOptions(const std::string& setting, const std::string& linkMode,
                            uint32_t chromaBands = 2);
 

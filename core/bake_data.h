@@ -66,6 +66,19 @@ inline const char* linkCutName(LinkCut cut) {
     return cut == LinkCut::SolidAngle ? "solid-angle" : "error";
 }
 
+/// Where grid caches go (bake/grid_caches.h).
+enum class GridCaches : uint32_t {
+    Surfaces = 0,  ///< only at the vertices that grid-shaded surfaces read (triangles too
+                   ///< small for the light map): what a static scene's image needs
+    Volume = 1,    ///< at every free vertex near geometry: also for dynamic objects, which
+                   ///< are shaded from the grid wherever they are placed
+};
+
+/// The mode's name in the CLI, the bake file and reports.
+inline const char* gridCachesName(GridCaches mode) {
+    return mode == GridCaches::Volume ? "volume" : "surfaces";
+}
+
 /// The parameters a bake was made with, after defaults were resolved.
 struct BakeParams {
     uint32_t surfels = 0;            ///< nS
@@ -73,6 +86,7 @@ struct BakeParams {
     uint32_t bandsY = 3;             ///< lY
     uint32_t bandsC = 3;             ///< lC ≤ lY
     float gridCell = 0.0f;           ///< metres
+    GridCaches gridCaches = GridCaches::Surfaces;
     float lightmapTexel = 0.0f;      ///< metres
     LinkMode linkMode = LinkMode::Rtp;
     HierarchyMethod hierarchy = HierarchyMethod::Visible;

@@ -340,6 +340,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["bands_y"] = p.bandsY;
     json["bands_c"] = p.bandsC;
     json["grid_cell"] = shortestDouble(p.gridCell);
+    json["grid_caches"] = gridCachesName(p.gridCaches);
     json["lightmap_texel"] = shortestDouble(p.lightmapTexel);
     json["link_mode"] = linkModeName(p.linkMode);
     json["hierarchy"] = hierarchyName(p.hierarchy);
@@ -466,6 +467,11 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     PIC_TRY_ASSIGN(p.bandsY, reader.u32("bands_y"));
     PIC_TRY_ASSIGN(p.bandsC, reader.u32("bands_c"));
     PIC_TRY_ASSIGN(p.gridCell, reader.f32("grid_cell"));
+    // Bakes written before grid caches could be limited to what surfaces read filled the volume.
+    PIC_TRY_ASSIGN(const uint32_t gridCaches, reader.contains("grid_caches")
+                                                  ? reader.oneOf("grid_caches", {"surfaces", "volume"})
+                                                  : Result<uint32_t>(1u));
+    p.gridCaches = static_cast<GridCaches>(gridCaches);
     PIC_TRY_ASSIGN(p.lightmapTexel, reader.f32("lightmap_texel"));
     // The name lists follow the enumerators' values.
     PIC_TRY_ASSIGN(const uint32_t linkMode, reader.oneOf("link_mode", {"sh", "rtp"}));

@@ -233,6 +233,112 @@ TEST(GridCaches, NoCacheOutsideAClosedRoomAndAllNearGeometry) {
     EXPECT_GE(withCache, grid->caches.size());
 }
 
+TEST(GridCaches, SurfacesKeepExactlyTheCachesGridShadedTrianglesRead) {
+    Scene scene = test::loadTestScene("cornell");
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    GridCacheParams params;
+    params.cellSize = 0.15f;
+    auto volume = placeGridCaches(scene, **rays, 0, params);
+    ASSERT_TRUE(volume) << volume.error().message;
+
+    params.mode = GridCaches::Surfaces;
+    params.gridShaded.assign(scene.triangles.size(), 0);
+    auto none = placeGridCaches(scene, **rays, 0, params);
+    ASSERT_TRUE(none) << none.error().message;
+    EXPECT_TRUE(none->caches.empty());
+    EXPECT_EQ(none->unread, volume->caches.size());
+    for (uint32_t index : none->layout.cacheIndex) EXPECT_EQ(index, kNoCache);
+
+    // Two triangles of the tall block and one of a wall read the grid.
+    const std::vector<uint32_t> shaded = {0u, 7u, 20u};
+    for (uint32_t t : shaded) params.gridShaded.at(t) = 1;
+    constexpr uint32_t kFirst = 5;  // indices start where the caller says
+    auto some = placeGridCaches(scene, **rays, kFirst, params);
+    ASSERT_TRUE(some) << some.error().message;
+    ASSERT_FALSE(some->caches.empty());
+    EXPECT_EQ(some->caches.size() + some->unread, volume->caches.size());
+    EXPECT_EQ(some->layout.dims, volume->layout.dims);
+
+    // Every point of a grid-shaded triangle reads the same caches as from the volume.
+    const GridLayout& g = some->layout;
+    auto cacheAt = [](const GridCacheSet& set, uint32_t first, size_t vertex) -> const Cache* {
+        const uint32_t index = set.layout.cacheIndex[vertex];
+        return index == kNoCache ? nullptr : &set.caches.at(index - first);
+    };
+    std::vector<glm::vec3> points;
+    float spacing = 0.0f;
+    for (uint32_t t : shaded) {
+        glm::vec3 p[3];
+        for (int k = 0; k < 3; ++k) p[k] = scene.vertices[scene.triangles[t].v[k]].position;
+        constexpr int kSteps = 40;
+        spacing = std::max({spacing, glm::length(p[1] - p[0]) / kSteps, glm::length(p[2] - p[0]) / kSteps});
+        for (int i = 0; i <= kSteps; ++i)
+            for (int j = 0; i + j <= kSteps; ++j) {
+                const glm::vec3 q = p[0] + (p[1] - p[0]) * (float(i) / kSteps) + (p[2] - p[0]) * (float(j) / kSteps);
+                const glm::uvec3 lower(glm::floor((q - g.origin) / g.cellSize));
+                for (uint32_t corner = 0; corner < 8; ++corner) {
+                    const glm::uvec3 v = lower + glm::uvec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+                    const size_t vertex = v.x + g.dims.x * (v.y + size_t{g.dims.y} * v.z);
+                    const Cache* kept = cacheAt(*some, kFirst, vertex);
+                    const Cache* full = cacheAt(*volume, 0, vertex);
+                    ASSERT_EQ(kept == nullptr, full == nullptr) << vertex;
+                    if (kept) {
+                        EXPECT_EQ(kept->position, full->position) << vertex;
+                    }
+                }
+                points.push_back(q);
+            }
+    }
+    // And nothing else keeps a cache: every kept cache is held by a corner of a cell those
+    // triangles meet (touching counts), and each is held.
+    std::vector<uint8_t> held(some->caches.size(), 0);
+    for (size_t v = 0; v < g.cacheIndex.size(); ++v) {
+        if (g.cacheIndex[v] == kNoCache) continue;
+        const glm::vec3 corner = g.origin + g.cellSize * glm::vec3(v % g.dims.x, (v / g.dims.x) % g.dims.y,
+                                                                   v / (size_t{g.dims.x} * g.dims.y));
+        float nearest = std::numeric_limits<float>::infinity();
+        for (const glm::vec3& q : points) {
+            const glm::vec3 d = glm::abs(q - corner);
+            nearest = std::min(nearest, std::max({d.x, d.y, d.z}));
+        }
+        EXPECT_LE(nearest, g.cellSize * 1.001f + spacing) << v;
+        held.at(g.cacheIndex[v] - kFirst) = 1;
+    }
+    for (size_t c = 0; c < held.size(); ++c) EXPECT_TRUE(held[c]) << c;
+
+    params.gridShaded.pop_back();
+    auto wrong = placeGridCaches(scene, **rays, 0, params);
+    ASSERT_FALSE(wrong);
+    EXPECT_NE(wrong.error().message.find("grid-shaded flags for"), std::string::npos) << wrong.error().message;
+}
+
+TEST(Bake, GridCachesOnlyWhereSurfacesReadThemUnlessAVolumeIsAskedFor) {
+    // Every cornell triangle is light-mapped: no surface reads the grid.
+    BakeOptions options = test::smallBakeOptions(2048, 16, 0.2f, 0.1f);
+    options.gridCaches = GridCaches::Surfaces;
+    const test::BakedScene& surfaces = test::bakedScene("cornell", options);
+    const test::BakedScene& volume = test::bakedScene("cornell", test::smallBakeOptions(2048, 16, 0.2f, 0.1f));
+    ASSERT_TRUE(surfaces.ok && volume.ok);
+    EXPECT_EQ(surfaces.bake.params.gridCaches, GridCaches::Surfaces);
+    EXPECT_EQ(volume.bake.params.gridCaches, GridCaches::Volume);
+    size_t gridCaches = 0;
+    for (const Cache& c : volume.bake.caches) gridCaches += c.kind == gpu::kCacheKindGrid;
+    ASSERT_GT(gridCaches, 0u);
+    for (const Cache& c : surfaces.bake.caches) EXPECT_EQ(c.kind, gpu::kCacheKindLightmap);
+    for (uint32_t index : surfaces.bake.grid.cacheIndex) EXPECT_EQ(index, kNoCache);
+    // The light map is the same, its caches numbered after the grid's.
+    EXPECT_EQ(surfaces.bake.caches.size() + gridCaches, volume.bake.caches.size());
+    ASSERT_EQ(surfaces.bake.lightmap.cacheIndex.size(), volume.bake.lightmap.cacheIndex.size());
+    for (size_t t = 0; t < surfaces.bake.lightmap.cacheIndex.size(); ++t) {
+        const uint32_t a = surfaces.bake.lightmap.cacheIndex[t], b = volume.bake.lightmap.cacheIndex[t];
+        ASSERT_EQ(a == kNoCache, b == kNoCache) << t;
+        if (a != kNoCache) {
+            EXPECT_EQ(surfaces.bake.caches[a].position, volume.bake.caches[b].position) << t;
+        }
+    }
+}
+
 /// Visible solid angle summed over the links of each cache.
 std::vector<double> solidAnglePerCache(const LinkResult& links, size_t caches, uint32_t nL) {
     std::vector<double> sums(caches, 0.0);

@@ -54,6 +54,18 @@ TEST_F(PicbakeCli, BakeThenInfoJsonHasTheContractKeys) {
     EXPECT_TRUE(json["bands"].contains("y") && json["bands"].contains("c"));
     EXPECT_TRUE(json["seconds"].contains("links"));
     EXPECT_TRUE(json["bytes"].contains("surfels"));
+    // Every cornell surface is light-mapped, so by default no grid cache is kept.
+    EXPECT_EQ(json["caches"]["grid"], 0);
+    EXPECT_EQ(json["params"]["grid_caches"], "surfaces");
+    EXPECT_NE(baked.out.find("that only dynamic objects would read left out"), std::string::npos) << baked.out;
+
+    test::CommandResult volume = run(smallBake("cornell", bake) + " --grid-caches volume");
+    ASSERT_EQ(volume.exitCode, 0) << volume.err;
+    info = run("info " + bake + " --json");
+    json = nlohmann::json::parse(info.out);
+    EXPECT_GT(json["caches"]["grid"].get<int>(), 0);
+    EXPECT_EQ(json["params"]["grid_caches"], "volume");
+    EXPECT_NE(run(smallBake("cornell", bake) + " --grid-caches everywhere").exitCode, 0);
 }
 
 TEST_F(PicbakeCli, TooFewSurfelsForTheSurfacesIsANote) {

@@ -31,7 +31,7 @@ TEST_F(PicbenchLinks, FactorsTheLinkedOverTracedRatio) {
     const fs::path json = mDir / "links.json";
     std::string err;
     ASSERT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR + "/cornell.gltf --caches 40 "
-                  "--directions 256 --json " + json.string(), err), 0) << err;
+                  "--directions 256 --grid-caches volume --json " + json.string(), err), 0) << err;
     std::ifstream in(json);
     const nlohmann::json report = nlohmann::json::parse(in);
     for (const char* kind : {"all", "grid", "lightmap"}) {
@@ -78,7 +78,8 @@ TEST_F(PicbenchLinks, OneSidedTruthTakesTheBackFacesLightOut) {
         const fs::path json = mDir / name;
         std::string err;
         EXPECT_EQ(run(std::string("links --scene ") + PIC_TEST_SCENE_DIR +
-                          "/furnished_room.gltf --surfels 4096 --links 64 --caches 60 --directions 128 " + extra +
+                          "/furnished_room.gltf --surfels 4096 --links 64 --caches 60 --directions 128 "
+                          "--grid-caches volume " + extra +
                           " --json " + json.string(),
                       err),
                   0)

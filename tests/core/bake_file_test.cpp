@@ -371,6 +371,31 @@ TEST_F(BakeFile, ParamsWithoutALinkCutReadAsTheSolidAngleCut) {
     EXPECT_EQ(read->params.linkCut, LinkCut::SolidAngle);
 }
 
+TEST_F(BakeFile, ParamsWithoutGridCachesReadAsTheVolume) {
+    // Where grid caches go round-trips by name; bakes written before grid caches could be
+    // limited to what surfaces read placed them in the whole volume.
+    BakeData bake = makeBake(LinkMode::Rtp);
+    for (const GridCaches mode : {GridCaches::Surfaces, GridCaches::Volume}) {
+        bake.params.gridCaches = mode;
+        const auto [file, bytes] = written(bake);
+        const Result<BakeData> read = readBakeFile(file);
+        ASSERT_TRUE(read) << read.error().message;
+        EXPECT_EQ(read->params.gridCaches, mode);
+    }
+    bake.params.gridCaches = GridCaches::Surfaces;
+    auto [file, bytes] = written(bake);
+    std::string text(bytes.begin(), bytes.end());
+    const std::string field = R"("grid_caches": "surfaces",)";
+    const size_t at = text.find(field);
+    ASSERT_NE(at, std::string::npos);
+    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
+    resealSection(bytes, 0);
+    writeBytes(file, bytes);
+    const Result<BakeData> read = readBakeFile(file);
+    ASSERT_TRUE(read) << read.error().message;
+    EXPECT_EQ(read->params.gridCaches, GridCaches::Volume);
+}
+
 TEST_F(BakeFile, WritesByteIdenticalFiles) {
     const BakeData bake = makeBake(LinkMode::Sh);
     const auto [first, firstBytes] = written(bake, "a.pic");

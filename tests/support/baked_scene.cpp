@@ -21,7 +21,7 @@ namespace {
 using BakeKey =
     std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
                std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
-               std::optional<float>, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t,
+               std::optional<float>, GridCaches, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t,
                LinkReads, LinkCut, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
 
 BakeKey keyOf(const std::string& name, const BakeOptions& o,
@@ -33,6 +33,7 @@ BakeKey keyOf(const std::string& name, const BakeOptions& o,
             o.bandsC,
             o.gridCell,
             o.lightmapTexel,
+            o.gridCaches,
             o.linkMode,
             o.hierarchy,
             o.linkSamples,
@@ -95,6 +96,7 @@ BakeOptions smallBakeOptions(uint32_t surfels, uint32_t links, std::optional<flo
     options.links = links;
     options.gridCell = gridCell;
     options.lightmapTexel = lightmapTexel;
+    options.gridCaches = GridCaches::Volume;
     return options;
 }
 

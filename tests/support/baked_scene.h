@@ -23,8 +23,8 @@ std::string testScenePath(const std::string& name);
 Scene loadTestScene(const std::string& name);
 
 /// Bake options small enough for a test: `surfels` surfels, `links` links per cache, the grid
-/// cell and light-map texel in metres (unset: the bake's defaults for the scene), everything
-/// else at BakeOptions' defaults.
+/// cell and light-map texel in metres (unset: the bake's defaults for the scene), grid caches
+/// in the whole volume (the tests examine them), everything else at BakeOptions' defaults.
 BakeOptions smallBakeOptions(uint32_t surfels, uint32_t links,
                              std::optional<float> gridCell = std::nullopt,
                              std::optional<float> lightmapTexel = std::nullopt);
