@@ -222,6 +222,7 @@ public:
         r.params.lightmapTexel = j.value("lightmap_texel", 0.0f);
         r.params.linkSamples = j.value("link_samples", 0u);
         r.caches = j.value("caches", size_t{0});
+        r.gridCaches = j.value("grid_caches", r.caches);
         r.bakeSeconds = j.value("bake_seconds", 0.0);
         r.updateMs = j.value("update_ms", 0.0);
         r.measured = j.value("measured_rmse", 0.0);
@@ -238,6 +239,7 @@ public:
                                {"bands_y", r.params.bandsY},          {"bands_c", r.params.bandsC},
                                {"grid_cell", r.params.gridCell},      {"lightmap_texel", r.params.lightmapTexel},
                                {"link_samples", r.params.linkSamples}, {"caches", r.caches},
+                               {"grid_caches", r.gridCaches},
                                {"bake_seconds", r.bakeSeconds},       {"update_ms", r.updateMs},
                                {"measured_rmse", r.measured},         {"error", r.error},
                                {"view_errors", r.viewErrors}};
@@ -559,6 +561,9 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
             }
             rung.params = bake->params;
             rung.caches = bake->caches.size();
+            rung.gridCaches = size_t(std::count_if(bake->caches.begin(), bake->caches.end(), [](const Cache& c) {
+                return c.kind == gpu::kCacheKindGrid;
+            }));
             PIC_TRY_ASSIGN(const CacheValues* values, runtime->setLights(lights));
             // Over the views: the root mean square of their errors, the relative RMSE of all
             // their pixels together where their levels are alike.
@@ -597,9 +602,15 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     const bool dearer = baseRung.error > goal;
     // single[a][l]: the rung with axis a at level l and every other at the base.
     std::vector<std::vector<std::optional<size_t>>> single(axes.size());
+    // Where no surface reads the grid and nothing else may (--grid-caches surfaces), the base
+    // keeps no grid cache and its cell changes nothing: it is left where it is.
+    const bool gridUnread = base.gridCaches == GridCaches::Surfaces && baseRung.gridCaches == 0;
+    if (gridUnread)
+        std::fprintf(stderr, "picbake: target: no surface reads the grid, so its cell stays at the base's\n");
     for (size_t a = 0; a < axes.size(); ++a) {
         single[a].resize(axes[a].values.size());
         single[a][axes[a].base] = 0;
+        if (gridUnread && axes[a].axis == TargetAxis::GridCell) continue;
         for (size_t l = 0; l < axes[a].values.size(); ++l) {
             if (l == axes[a].base || (l > axes[a].base && !dearer)) continue;
             TargetLevels levels = baseLevels;
@@ -612,6 +623,8 @@ Result<TargetChoice> chooseBakeForTarget(const Scene& scene, const BakeOptions& 
     // The corner where every setting is at its cheapest: the cost model's anchor at the cheap
     // end (a base's update is mostly link reads; the corner's shows what is left).
     TargetLevels corner{};
+    for (size_t a = 0; a < axes.size(); ++a)
+        if (gridUnread && axes[a].axis == TargetAxis::GridCell) corner.at(a) = axes[a].base;
     if (corner != baseLevels && std::none_of(choice.rungs.begin(), choice.rungs.end(),
                                              [&](const TargetRung& r) { return r.levels == corner; })) {
         PIC_TRY_ASSIGN(TargetRung rung, measure(corner, "corner"));
@@ -778,6 +791,7 @@ nlohmann::ordered_json targetJson(const TargetChoice& choice, const TargetErrorP
                                     {"lightmap_texel", r.params.lightmapTexel},
                                     {"link_samples", r.params.linkSamples},
                                     {"caches", r.caches},
+                               {"grid_caches", r.gridCaches},
                                     {"bake_seconds", r.bakeSeconds},
                                     {"update_ms", r.updateMs},
                                     {"modelled_update_ms", r.predictedMs},

@@ -91,6 +91,7 @@ struct TargetRung {
     TargetLevels levels{};
     BakeParams params;       ///< as resolved by the bake
     size_t caches = 0;
+    size_t gridCaches = 0;   ///< of `caches`, those of the grid
     double bakeSeconds = 0.0;
     double updateMs = 0.0;   ///< CPU twin: the base's median of 5 updates; another rung's, the
                              ///< median ratio of 5 updates timed in turns with the base's, times it

@@ -30,7 +30,12 @@ TargetErrorParams smallPilot(double error) {
 }
 
 /// The base the tests start from: small, so that the pilot's bakes are quick.
-pic::BakeOptions smallBase() { return test::smallBakeOptions(2048, 32, 0.125f, 0.06f); }
+/// A small base with the bake's default grid caches (only where surfaces read them).
+pic::BakeOptions smallBase() {
+    pic::BakeOptions options = test::smallBakeOptions(2048, 32, 0.125f, 0.06f);
+    options.gridCaches = pic::GridCaches::Surfaces;
+    return options;
+}
 
 TEST(TargetAxes, LevelsRunFromCheapestToDearestAroundTheBase) {
     const pic::Scene scene = test::loadTestScene("cornell");
@@ -174,6 +179,9 @@ TEST(TargetError, ALooseTargetTakesACheaperBakeAndASecondTargetReusesThePilot) {
     }
     EXPECT_GE(singles, 9u);
     EXPECT_EQ(corners, 1u);
+    // No cornell surface reads the grid: the base keeps no grid cache and no rung moves its cell.
+    EXPECT_EQ(choice->rungs[0].gridCaches, 0u);
+    for (const pic::TargetRung& r : choice->rungs) EXPECT_EQ(r.params.gridCell, choice->rungs[0].params.gridCell) << r.name;
     for (double c : choice->cost.coefficients) EXPECT_GE(c, 0.0);
     EXPECT_GT(choice->combinations, singles);
     // The choice: within the goal, the cheapest such rung by the cost model, cheaper than the
