@@ -423,6 +423,7 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     server->mService = std::make_unique<Service>(server->mState);
     if (!options.dbPath.empty()) {
         State& state = *server->mState;
+        PIC_TRY(SessionStore::checkPath(options.dbPath));
         state.store = std::make_unique<SessionStore>(options.dbPath);
         PIC_TRY_ASSIGN(std::vector<StoredSession> stored, state.store->load());
         for (StoredSession& entry : stored) {

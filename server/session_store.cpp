@@ -30,6 +30,18 @@ bool isDigest(const std::string& text) {
 
 }  // namespace
 
+Result<void> SessionStore::checkPath(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+        return fail(ErrorCode::InvalidInput, "--db {} is a directory; give the database file's path", path);
+    const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+    if (!fs::is_directory(parent, ec))
+        return fail(ErrorCode::InvalidInput, "--db {}: the directory {} does not exist", path, parent.string());
+    if (::access(parent.c_str(), W_OK | X_OK) != 0)
+        return fail(ErrorCode::InvalidInput, "--db {}: cannot write in the directory {}", path, parent.string());
+    return {};
+}
+
 Result<std::vector<StoredSession>> SessionStore::load() const {
     std::error_code ec;
     if (!fs::exists(mPath, ec)) return std::vector<StoredSession>{};

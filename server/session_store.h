@@ -31,6 +31,9 @@ public:
     explicit SessionStore(std::string path) : mPath(std::move(path)) {}
 
     const std::string& path() const { return mPath; }
+    /// InvalidInput naming the path unless it can hold the database: not a directory, in a
+    /// directory that exists and that this process may write in (the file is replaced there).
+    static Result<void> checkPath(const std::string& path);
     /// The sessions in the file; none when it does not exist yet. Corrupt naming the file and
     /// the problem when it cannot be read as a database of this format.
     Result<std::vector<StoredSession>> load() const;

@@ -36,6 +36,7 @@
 #include "render/cpu_runtime.h"
 #include "render/renderer.h"
 #include "server/service.h"
+#include "server/session_store.h"
 #include "server/token_digest.h"
 #include "tests/support/baked_scene.h"
 #include "tests/support/command.h"
@@ -439,6 +440,31 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
+}
+
+// A --db that cannot hold the database (a directory, or a file in a missing directory) is
+// refused at start, naming the path, instead of aborting or serving without durability.
+TEST(Stream, ADatabasePathThatCannotHoldTheDatabaseIsRefused) {
+    const test::ScratchDir dir("pic_sessions_path");
+    for (const auto& [path, says] :
+         {std::pair{dir.path().string(), std::string("is a directory")},
+          std::pair{(dir / "missing" / "sessions.json").string(), std::string("does not exist")}}) {
+        SCOPED_TRACE(path);
+        std::vector<std::unique_ptr<ServedBake>> bakes;
+        ServeOptions serveOptions;
+        serveOptions.backend = "cpu";
+        auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
+        ASSERT_TRUE(bake);
+        bakes.push_back(std::move(*bake));
+        ServerOptions options;
+        options.dbPath = path;
+        auto refused = PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+        ASSERT_FALSE(refused);
+        EXPECT_EQ(refused.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(refused.error().message.find(path), std::string::npos) << refused.error().message;
+        EXPECT_NE(refused.error().message.find(says), std::string::npos) << refused.error().message;
+    }
+    EXPECT_TRUE(SessionStore::checkPath((dir / "sessions.json").string()));
 }
 
 // A database written before the digests (format 1: plain tokens) still loads: its tokens
