@@ -117,6 +117,19 @@ Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
     return served;
 }
 
+/// Starts a server over the test bake with the session database at `dbPath`.
+Result<std::unique_ptr<PicServer>> startWithDatabase(const std::string& dbPath) {
+    ServeOptions serveOptions;
+    serveOptions.backend = "cpu";
+    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
+    if (!bake) return std::unexpected(bake.error());
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    bakes.push_back(std::move(*bake));
+    ServerOptions options;
+    options.dbPath = dbPath;
+    return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+}
+
 LightSet pointLight(float x) {
     LightSet lights;
     Light light;
@@ -428,15 +441,7 @@ TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
         std::ofstream broken(db);
         broken << "not json";
     }
-    std::vector<std::unique_ptr<ServedBake>> bakes;
-    ServeOptions serveOptions;
-    serveOptions.backend = "cpu";
-    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
-    ASSERT_TRUE(bake);
-    bakes.push_back(std::move(*bake));
-    ServerOptions options;
-    options.dbPath = db.string();
-    auto refused = PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+    auto refused = startWithDatabase(db.string());
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
@@ -450,15 +455,7 @@ TEST(Stream, ADatabasePathThatCannotHoldTheDatabaseIsRefused) {
          {std::pair{dir.path().string(), std::string("is a directory")},
           std::pair{(dir / "missing" / "sessions.json").string(), std::string("does not exist")}}) {
         SCOPED_TRACE(path);
-        std::vector<std::unique_ptr<ServedBake>> bakes;
-        ServeOptions serveOptions;
-        serveOptions.backend = "cpu";
-        auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
-        ASSERT_TRUE(bake);
-        bakes.push_back(std::move(*bake));
-        ServerOptions options;
-        options.dbPath = path;
-        auto refused = PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+        auto refused = startWithDatabase(path);
         ASSERT_FALSE(refused);
         EXPECT_EQ(refused.error().code, ErrorCode::InvalidInput);
         EXPECT_NE(refused.error().message.find(path), std::string::npos) << refused.error().message;

@@ -271,6 +271,19 @@ protected:
         return {file, readBytes(file)};
     }
 
+    /// Writes `bake`, blanks `field` of its params out (JSON whitespace keeps the section's
+    /// size: a file written before the field existed) and reads the file back.
+    Result<BakeData> readWithout(const BakeData& bake, const std::string& field) {
+        auto [file, bytes] = written(bake);
+        const std::string text(bytes.begin(), bytes.end());
+        const size_t at = text.find(field);
+        if (at == std::string::npos) return fail(ErrorCode::InvalidInput, "no {} in the params", field);
+        std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
+        resealSection(bytes, 0);
+        writeBytes(file, bytes);
+        return readBakeFile(file);
+    }
+
     fs::path mDir;
 };
 
@@ -331,17 +344,8 @@ TEST_F(BakeFile, ParamsUseReadableNames) {
 
 TEST_F(BakeFile, ParamsWithoutFinalLinkSamplesReadThemAsLinkSamples) {
     // Bakes written before "link_final_samples" existed re-estimated linked nodes with
-    // link_samples rays. Blanking the field out (JSON whitespace keeps the section's size)
-    // makes such a file.
-    auto [file, bytes] = written(makeBake(LinkMode::Rtp));
-    std::string text(bytes.begin(), bytes.end());
-    const std::string field = R"("link_final_samples": 24,)";
-    const size_t at = text.find(field);
-    ASSERT_NE(at, std::string::npos);
-    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
-    resealSection(bytes, 0);
-    writeBytes(file, bytes);
-    const Result<BakeData> read = readBakeFile(file);
+    // link_samples rays.
+    const Result<BakeData> read = readWithout(makeBake(LinkMode::Rtp), R"("link_final_samples": 24,)");
     ASSERT_TRUE(read) << read.error().message;
     EXPECT_EQ(read->params.linkSamples, 8u);
     EXPECT_EQ(read->params.linkFinalSamples, 8u);
@@ -358,15 +362,7 @@ TEST_F(BakeFile, ParamsWithoutALinkCutReadAsTheSolidAngleCut) {
         ASSERT_TRUE(read) << read.error().message;
         EXPECT_EQ(read->params.linkCut, cut);
     }
-    auto [file, bytes] = written(bake);
-    std::string text(bytes.begin(), bytes.end());
-    const std::string field = R"("link_cut": "error",)";
-    const size_t at = text.find(field);
-    ASSERT_NE(at, std::string::npos);
-    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
-    resealSection(bytes, 0);
-    writeBytes(file, bytes);
-    const Result<BakeData> read = readBakeFile(file);
+    const Result<BakeData> read = readWithout(bake, R"("link_cut": "error",)");
     ASSERT_TRUE(read) << read.error().message;
     EXPECT_EQ(read->params.linkCut, LinkCut::SolidAngle);
 }
@@ -383,15 +379,7 @@ TEST_F(BakeFile, ParamsWithoutGridCachesReadAsTheVolume) {
         EXPECT_EQ(read->params.gridCaches, mode);
     }
     bake.params.gridCaches = GridCaches::Surfaces;
-    auto [file, bytes] = written(bake);
-    std::string text(bytes.begin(), bytes.end());
-    const std::string field = R"("grid_caches": "surfaces",)";
-    const size_t at = text.find(field);
-    ASSERT_NE(at, std::string::npos);
-    std::fill(bytes.begin() + at, bytes.begin() + at + field.size(), ' ');
-    resealSection(bytes, 0);
-    writeBytes(file, bytes);
-    const Result<BakeData> read = readBakeFile(file);
+    const Result<BakeData> read = readWithout(bake, R"("grid_caches": "surfaces",)");
     ASSERT_TRUE(read) << read.error().message;
     EXPECT_EQ(read->params.gridCaches, GridCaches::Volume);
 }
