@@ -1,5 +1,7 @@
 #include "core/gltf_loader.h"
 
+#include "core/light_set.h"
+
 #include <algorithm>
 #include <cctype>
 #include <array>
@@ -22,6 +24,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "core/hash.h"
+#include "core/light_set.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
@@ -842,8 +845,10 @@ private:
         const tinygltf::Light& source = mModel.lights[size_t(index)];
 
         Light light;
-        light.id =
-            uniqueLightId(source.name.empty() ? fmt::format("light_{}", index) : source.name);
+        // A name too long to be a light id (with room for uniqueLightId's "#k") is not used.
+        const bool named =
+            !source.name.empty() && source.name.size() + 8 <= kMaxLightIdBytes;
+        light.id = uniqueLightId(named ? source.name : fmt::format("light_{}", index));
         if (source.type == "point")
             light.type = LightType::Point;
         else if (source.type == "spot")

@@ -142,6 +142,9 @@ Result<Light> parseLight(const Json& value, size_t index) {
             return fail(ErrorCode::InvalidInput, "{} must be a non-empty string, got {}",
                         fields.fieldPath("id"), shown(*id));
         light.id = id->get<std::string>();
+        if (light.id.size() > kMaxLightIdBytes)
+            return fail(ErrorCode::InvalidInput, "{} is {} bytes long; at most {} are allowed",
+                        fields.fieldPath("id"), light.id.size(), kMaxLightIdBytes);
     } else {
         light.id = fmt::format("light_{}", index);
     }

@@ -15,6 +15,9 @@ namespace pic {
 
 /// Most lights one set may hold.
 inline constexpr size_t kMaxLights = 256;
+/// Longest light id, in bytes (UTF-8): ids name lights in logs, files and the session
+/// database, not payloads.
+inline constexpr size_t kMaxLightIdBytes = 128;
 
 /// The dynamic lighting of a scene: punctual lights plus a scale per emissive material.
 struct LightSet {
@@ -31,7 +34,8 @@ LightSet defaultLightSet(const Scene& scene);
 /// Parses and validates a light set from JSON text. Errors (InvalidInput) name the field
 /// and value: unknown type, NaN/Inf anywhere, negative intensity or colour, zero-length
 /// direction for spot/directional lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with
-/// outer > 0, negative range, more than kMaxLights lights, duplicate ids, unknown keys,
+/// outer > 0, negative range, more than kMaxLights lights, duplicate ids, ids longer than
+/// kMaxLightIdBytes, unknown keys,
 /// negative or non-finite emissive scales. Directions are normalised.
 Result<LightSet> parseLightSet(const std::string& json);
 

@@ -129,7 +129,13 @@ Result<void> checkRuntimeLights(const LightSet& lights, const Scene& scene) {
     const auto finite = [](const glm::vec3& v) {
         return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
     };
+    if (lights.lights.size() > kMaxLights)
+        return fail(ErrorCode::InvalidInput, "the light set holds {} lights, at most {} are allowed",
+                    lights.lights.size(), kMaxLights);
     for (const Light& light : lights.lights) {
+        if (light.id.size() > kMaxLightIdBytes)
+            return fail(ErrorCode::InvalidInput, "a light id is {} bytes long; at most {} are allowed",
+                        light.id.size(), kMaxLightIdBytes);
         if (!finite(light.position) || !finite(light.direction) || !finite(light.color) ||
             !std::isfinite(light.intensity) || light.intensity < 0.0f ||
             glm::any(glm::lessThan(light.color, glm::vec3(0.0f))))

@@ -14,6 +14,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libzstd-dev
   libplplot-dev plplot-driver-cairo
+  libsqlite3-dev libpq-dev postgresql nginx libcivetweb-dev
 )
 
 missing=()

@@ -20,6 +20,7 @@
 #include "core/cli.h"
 #include "render/gpu_runtime_flags.h"
 #include "server/service.h"
+#include "server/session_store.h"
 
 namespace pic {
 
@@ -87,7 +88,11 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--max-sessions", options.maxSessions, "sessions the server holds at most")
         ->check(CLI::Range(size_t(1), size_t(100000)));
     app.add_option("--db", options.dbPath,
-                   "session database (JSON): sessions, tokens and light sets survive a restart");
+                   "session database: an SQLite FILE (one server), or postgresql://… shared by "
+                   "replicas; sessions, token digests and light sets survive a restart");
+    app.add_option("--metrics-listen", options.metricsListen,
+                   "HOST:PORT to serve Prometheus metrics on (GET /metrics); port 0 picks a "
+                   "free one");
     double idleMinutes = 60.0;
     app.add_option("--session-idle-minutes", idleMinutes,
                    "remove a session without subscribers after this long unused")
@@ -106,6 +111,10 @@ int picserverMain(int argc, char** argv) {
         return reportError({ErrorCode::InvalidInput,
                             fmt::format("{} --bake but {} --scene; give one scene per bake",
                                         bakePaths.size(), scenePaths.size())});
+    // A database file that cannot be used is refused before the bakes take seconds to load.
+    if (!options.dbPath.empty() && !SessionStore::isPostgres(options.dbPath))
+        if (auto usable = SessionStore::checkPath(options.dbPath); !usable)
+            return reportError(usable.error());
     // SIGINT and SIGTERM go to one thread, never to whichever thread gRPC, TBB or Vulkan runs:
     // before the server is up they end the process at once, after it they shut it down.
     sigset_t stopSignals;
@@ -154,10 +163,15 @@ int picserverMain(int argc, char** argv) {
     }
     options.sessionIdle = std::chrono::milliseconds(int64_t(idleMinutes * 60000.0));
     options.session.log = logUpdate;
+    options.onListening = [](const std::string& address) {
+        std::printf("listening on %s\n", address.c_str());
+        std::fflush(stdout);
+    };
     auto server = PicServer::start(std::move(bakes), listen, std::move(options));
     if (!server) return reportError(server.error());
-    std::printf("listening on %s\n", (*server)->address().c_str());
-    std::fflush(stdout);
+    if (!(*server)->metricsAddress().empty())
+        std::fprintf(stderr, "picserver: metrics on http://%s/metrics\n",
+                     (*server)->metricsAddress().c_str());
 
     serving = true;
     const int signal = stopped.get_future().get();

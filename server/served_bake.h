@@ -2,6 +2,7 @@
 /// A bake as the server serves it (ARCHITECTURE §1): the scene, the bake data, the one
 /// runtime that relights it for every session on it, and the assets thin clients download.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -57,8 +58,11 @@ public:
 
     /// Relights the scene with `lights` and gives the resulting caches as a frame's half
     /// planes (core/frame_codec.h), one session at a time (the runtime keeps per-light state
-    /// such as shadow maps).
-    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame);
+    /// such as shadow maps). When `abandon` is set by the time this session's turn comes, it
+    /// returns at once with an error (Io) instead: a session that is closing waits for no
+    /// computation but the one already running.
+    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
+                         const std::atomic<bool>* abandon = nullptr);
 
 private:
     ServedBake() = default;

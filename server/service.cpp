@@ -13,48 +13,48 @@
 
 #include "proto/pic.grpc.pb.h"
 #include "proto/wire.h"
+#include "server/metrics_http.h"
 #include "server/session_store.h"
 #include "server/token_digest.h"
 
 namespace pic {
+
+namespace {
+
+/// Compares token digests in time independent of where they differ.
+bool sameDigest(const std::string& a, const std::string& b) {
+    if (a.size() != b.size()) return false;
+    unsigned char diff = 0;
+    for (size_t i = 0; i < a.size(); ++i) diff |= (unsigned char)(a[i] ^ b[i]);
+    return diff == 0;
+}
+
+}  // namespace
 
 struct PicServer::State {
     std::vector<std::unique_ptr<ServedBake>> bakes;
     ServerOptions options;
     mutable std::mutex mutex;
     std::map<std::string, std::shared_ptr<Session>> sessions;
+    size_t creating = 0;  ///< sessions being written to the database, counted against the cap
     std::atomic<bool> stopping{false};
-    std::condition_variable wake;     ///< notified (under mutex) when stopping or dirty is set
-    bool dirty = false;               ///< sessions changed since the database was written
+    std::condition_variable wake;     ///< notified when stopping or storeFailing is set
     std::random_device random;  ///< the OS's entropy (/dev/urandom): tokens must not be predictable
     std::unique_ptr<SessionStore> store;  ///< null without --db
-    std::mutex persistMutex;              ///< snapshots are written in the order they are taken
+    std::atomic<bool> storeFailing{false};  ///< the last database call failed: health NOT_SERVING
+    std::mutex takeoverMutex;               ///< one session loaded from the database at a time
+    grpc::HealthCheckServiceInterface* health = nullptr;
+    std::shared_ptr<Metrics> metrics = std::make_shared<Metrics>();
 
-    /// Asks the housekeeping thread to write the database soon: handlers never wait for a disk.
-    void markDirty() {
-        if (!store) return;
-        {
-            std::lock_guard lock(mutex);
-            dirty = true;
-        }
-        wake.notify_all();
-    }
-
-    /// Writes every session to the database (when there is one); a failure is logged, not
-    /// fatal: the sessions go on, only not durably.
-    void saveNow() {
-        if (!store) return;
-        std::lock_guard persisting(persistMutex);
-        std::vector<StoredSession> snapshot;
-        {
-            std::lock_guard lock(mutex);
-            for (const auto& [id, session] : sessions)
-                snapshot.push_back({id, session->editorDigest(), session->viewerDigest(),
-                                    session->bake().id(), session->latestVersion(),
-                                    session->latestLights()});
-        }
-        if (auto saved = store->save(snapshot); !saved)
-            std::fprintf(stderr, "picserver: %s\n", saved.error().message.c_str());
+    /// `call()` on the database, timed and counted in the metrics as `op`.
+    template <class Call>
+    auto timedStore(const char* op, Call call) {
+        const auto start = std::chrono::steady_clock::now();
+        auto result = call(*store);
+        metrics->recordStore(
+            op, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(),
+            !result);
+        return result;
     }
 
     /// The bake `id` names, or the first one when `id` is empty.
@@ -78,17 +78,128 @@ struct PicServer::State {
         for (int i = 0; i < words; ++i) hex += fmt::format("{:08x}", uint32_t(random()));
         return hex;
     }
+
+    /// Whether the server can take one more session (under `mutex`).
+    bool hasRoom() const { return sessions.size() + creating < options.maxSessions; }
+
+    /// The database failed: health says NOT_SERVING until housekeeping reaches it again
+    /// (woken now to ask it every second). Not under `mutex`.
+    grpc::Status storeFailed(const Error& error) {
+        bool first = false;
+        {
+            std::lock_guard lock(mutex);
+            first = !storeFailing.exchange(true);
+        }
+        wake.notify_all();
+        if (first) {
+            std::fprintf(stderr, "picserver: %s (health NOT_SERVING until it answers again)\n",
+                         error.message.c_str());
+            if (health) health->SetServingStatus(false);
+        }
+        return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                            fmt::format("the session database failed: {}", error.message));
+    }
+
+    /// Housekeeping reached the database again.
+    void storeRecovered() {
+        if (!storeFailing.exchange(false)) return;
+        std::fprintf(stderr, "picserver: %s answers again; health SERVING\n",
+                     store->describe().c_str());
+        if (health && !stopping) health->SetServingStatus(true);
+    }
+
+    /// Drops `session` from this server (its streams end UNAVAILABLE): another server holds a
+    /// newer version of it.
+    void evict(const std::shared_ptr<Session>& session) {
+        {
+            std::lock_guard lock(mutex);
+            auto it = sessions.find(session->id());
+            if (it != sessions.end() && it->second == session) sessions.erase(it);
+        }
+        session->close();
+        metrics->forgetSession(session->id());
+        std::fprintf(stderr, "picserver: session %s moved to another server\n",
+                     session->id().c_str());
+    }
+
+    /// What `session` is in the database at `version` with `lights`.
+    static StoredSession row(const Session& session, uint64_t version, LightSet lights) {
+        return {session.id(), session.editorDigest(), session.viewerDigest(), session.bake().id(),
+                version, std::move(lights)};
+    }
+
+    /// Why this server cannot carry `stored` on (bake not served, light set refused by the
+    /// scene), or empty.
+    std::string unusable(const StoredSession& stored) const {
+        const ServedBake* bake = findBake(stored.bakeId);
+        if (!bake || stored.bakeId.empty())
+            return fmt::format("its bake {} is not served here", stored.bakeId);
+        if (auto checked = checkRuntimeLights(stored.lights, bake->scene()); !checked)
+            return checked.error().message;
+        return {};
+    }
+
+    /// Session `id` from the database, when it is not on this server (a replica that went
+    /// away held it, or the server restarted): claims it by writing the version after the
+    /// stored one, so that a server still holding an older copy learns at its next write that
+    /// the session moved.
+    /// Only a caller holding one of its tokens (`digest`) has it loaded.
+    grpc::Status takeOver(const std::string& id, const std::string& digest,
+                          std::shared_ptr<Session>& out) {
+        const grpc::Status notFound(grpc::StatusCode::NOT_FOUND, fmt::format("no session \"{}\"", id));
+        if (!store) return notFound;
+        std::lock_guard loading(takeoverMutex);
+        for (int attempt = 0; attempt < 3; ++attempt) {
+            if ((out = findSession(id))) return grpc::Status::OK;
+            auto found = timedStore("find", [&](SessionStore& db) { return db.find(id); });
+            if (!found) return storeFailed(found.error());
+            if (!*found) return notFound;
+            StoredSession stored = std::move(**found);
+            if (!sameDigest(digest, stored.editorDigest) && !sameDigest(digest, stored.viewerDigest))
+                return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                                    fmt::format("the token is not one of session \"{}\"", id));
+            if (const std::string why = unusable(stored); !why.empty())
+                return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                                    fmt::format("session \"{}\" cannot be served here: {}", id, why));
+            {
+                std::lock_guard lock(mutex);
+                if (!hasRoom())
+                    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                        fmt::format("the server holds its maximum of {} sessions",
+                                                    options.maxSessions));
+                ++creating;
+            }
+            const uint64_t version = stored.version + 1;
+            stored.version = version;
+            auto claimed = timedStore("save", [&](SessionStore& db) { return db.save(stored); });
+            if (!claimed || !*claimed) {
+                {
+                    std::lock_guard lock(mutex);
+                    --creating;
+                }
+                if (!claimed) return storeFailed(claimed.error());
+                continue;  // another server claimed it first: read it again
+            }
+            std::lock_guard lock(mutex);
+            --creating;
+            if (auto it = sessions.find(id); it != sessions.end()) {  // restored meanwhile
+                out = it->second;
+                return grpc::Status::OK;
+            }
+            out = std::make_shared<Session>(id, stored.editorDigest, stored.viewerDigest,
+                                            *findBake(stored.bakeId), options.session,
+                                            SessionStart{version, std::move(stored.lights)});
+            sessions[id] = out;
+            std::fprintf(stderr, "picserver: session %s taken over from the database at version %llu\n",
+                         id.c_str(), (unsigned long long)version);
+            return grpc::Status::OK;
+        }
+        return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                            fmt::format("session \"{}\" is moving between servers; retry", id));
+    }
 };
 
 namespace {
-
-/// Compares token digests in time independent of where they differ.
-bool sameDigest(const std::string& a, const std::string& b) {
-    if (a.size() != b.size()) return false;
-    unsigned char diff = 0;
-    for (size_t i = 0; i < a.size(); ++i) diff |= (unsigned char)(a[i] ^ b[i]);
-    return diff == 0;
-}
 
 /// The session `id` and the role `token` grants in it, or the status to fail with.
 struct Access {
@@ -97,19 +208,18 @@ struct Access {
     grpc::Status status;
 };
 
-Access authorise(const PicServer::State& state, const std::string& id, const std::string& token) {
+Access authorise(PicServer::State& state, const std::string& id, const std::string& token) {
     Access access;
     if (state.stopping) {
         access.status = grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
         return access;
     }
+    const std::string digest = tokenDigest(token);
     access.session = state.findSession(id);
     if (!access.session) {
-        access.status = grpc::Status(grpc::StatusCode::NOT_FOUND,
-                                     fmt::format("no session \"{}\"", id));
-        return access;
+        access.status = state.takeOver(id, digest, access.session);
+        if (!access.status.ok()) return access;
     }
-    const std::string digest = tokenDigest(token);
     if (sameDigest(digest, access.session->editorDigest()))
         access.role = v1::EDITOR;
     else if (sameDigest(digest, access.session->viewerDigest()))
@@ -162,7 +272,8 @@ private:
 /// flight, so a slow client skips versions and holds at most one frame in the server.
 class FrameWriter final : public grpc::ServerWriteReactor<v1::Frame> {
 public:
-    explicit FrameWriter(std::shared_ptr<Session> session) : mSession(std::move(session)) {
+    FrameWriter(std::shared_ptr<Session> session, std::shared_ptr<Metrics> metrics)
+        : mSession(std::move(session)), mMetrics(std::move(metrics)) {
         // The slot may wake after this reactor is gone (a publish that copied the slot list
         // before unsubscribe); the link tells it so.
         mLink = std::make_shared<Link>();
@@ -217,6 +328,13 @@ private:
     /// write's reaction reads is set before StartWrite.
     void pump() {
         if (!mSlot || mWriting || mCancelled || mFinished) return;
+        if (mSlot->closed()) {
+            finishOnce(grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                    fmt::format("session {} closed on this server (it moved, or "
+                                                "the server is stopping); subscribe again",
+                                                mSession->id())));
+            return;
+        }
         std::shared_ptr<const Update> update = mSlot->take();
         if (!update) return;
         std::shared_ptr<const v1::Frame> frame = update->frameFor(mHeld);
@@ -229,6 +347,7 @@ private:
         uint64_t bytes = 0;
         for (const v1::Plane& plane : frame->planes()) bytes += plane.data().size();
         mSession->countSent(bytes);
+        mMetrics->recordSent(bytes);
         mInFlight = std::move(frame);
         mWriting = true;
         StartWrite(mInFlight.get());
@@ -241,6 +360,7 @@ private:
     }
 
     std::shared_ptr<Session> mSession;
+    std::shared_ptr<Metrics> mMetrics;
     std::shared_ptr<Link> mLink;
     std::shared_ptr<SubscriberSlot> mSlot;
     std::shared_ptr<const v1::Frame> mInFlight;  ///< alive until its write is done
@@ -283,25 +403,52 @@ public:
         if (!bake)
             return finish(context, grpc::Status(grpc::StatusCode::NOT_FOUND,
                                                 fmt::format("no bake \"{}\"", request->bake_id())));
-        std::shared_ptr<Session> session;
-        std::string editorToken, viewerToken;
         {
             std::lock_guard lock(mState->mutex);
-            if (mState->sessions.size() >= mState->options.maxSessions)
+            if (!mState->hasRoom())
                 return finish(context,
                               grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                                            fmt::format("the server holds its maximum of {} sessions",
                                                        mState->options.maxSessions)));
-            std::string id = mState->randomHex(2);
-            while (mState->sessions.contains(id)) id = mState->randomHex(2);
-            editorToken = mState->randomHex(4);
-            viewerToken = mState->randomHex(4);
-            session =
-                std::make_shared<Session>(id, tokenDigest(editorToken), tokenDigest(viewerToken),
-                                          *bake, mState->options.session);
-            mState->sessions[id] = session;
+            ++mState->creating;
         }
-        mState->markDirty();
+        // The session is in the database before anyone hears of it; an id another server's
+        // session holds is drawn again.
+        std::string id, editorToken, viewerToken;
+        grpc::Status status(grpc::StatusCode::UNAVAILABLE, "no free session id");
+        for (int attempt = 0; attempt < 4 && !status.ok(); ++attempt) {
+            {
+                std::lock_guard lock(mState->mutex);
+                do id = mState->randomHex(2);
+                while (mState->sessions.contains(id));
+                editorToken = mState->randomHex(4);
+                viewerToken = mState->randomHex(4);
+            }
+            if (!mState->store) {
+                status = grpc::Status::OK;
+                break;
+            }
+            const StoredSession row{id, tokenDigest(editorToken), tokenDigest(viewerToken),
+                                    bake->id(), 1, defaultLightSet(bake->scene())};
+            auto created = mState->timedStore("create", [&](SessionStore& db) { return db.create(row); });
+            if (!created) {
+                status = mState->storeFailed(created.error());
+                break;
+            }
+            if (*created) status = grpc::Status::OK;
+        }
+        std::shared_ptr<Session> session;
+        {
+            std::lock_guard lock(mState->mutex);
+            --mState->creating;
+            if (status.ok()) {
+                session = std::make_shared<Session>(id, tokenDigest(editorToken),
+                                                    tokenDigest(viewerToken), *bake,
+                                                    mState->options.session);
+                mState->sessions[id] = session;
+            }
+        }
+        if (!status.ok()) return finish(context, status);
         // The only time the tokens leave the server; it keeps their digests.
         response->set_session(session->id());
         response->set_editor_token(editorToken);
@@ -334,9 +481,42 @@ public:
                                                 "only an editor token may set lights"));
         auto lights = wire::fromProto(request->lights());
         if (!lights) return finish(context, wire::toStatus(lights.error()));
-        auto version = access.session->setLights(std::move(*lights));
-        if (!version) return finish(context, wire::toStatus(version.error()));
-        mState->markDirty();
+        // Durable before the reply: the set is committed to the database, then queued.
+        const std::shared_ptr<Session>& session = access.session;
+        bool moved = false;
+        std::optional<grpc::Status> storeStatus;
+        Session::Commit commit;
+        if (mState->store)
+            commit = [&](uint64_t version, const LightSet& set) -> Result<void> {
+                auto saved = mState->timedStore("save", [&](SessionStore& db) {
+                    return db.save(PicServer::State::row(*session, version, set));
+                });
+                if (!saved) {
+                    storeStatus = mState->storeFailed(saved.error());
+                    return std::unexpected(saved.error());
+                }
+                if (!*saved) {
+                    moved = true;
+                    return fail(ErrorCode::Io, "session {} moved to another server", session->id());
+                }
+                return {};
+            };
+        auto version = session->setLights(std::move(*lights), commit);
+        if (moved) {
+            mState->evict(session);
+            return finish(context,
+                          grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                       fmt::format("session {} moved to another server; the light "
+                                                   "set was not applied, send it again",
+                                                   session->id())));
+        }
+        if (storeStatus) return finish(context, *storeStatus);
+        if (!version) {
+            if (version.error().code == ErrorCode::Io)  // closed while it was being set
+                return finish(context, grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                                    version.error().message));
+            return finish(context, wire::toStatus(version.error()));
+        }
         response->set_version(*version);
         return finish(context, grpc::Status::OK);
     }
@@ -347,7 +527,7 @@ public:
         if (!access.status.ok())
             return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::Frame>>(
                 access.status);
-        return new FrameWriter(std::move(access.session));
+        return new FrameWriter(std::move(access.session), mState->metrics);
     }
 
     grpc::ServerUnaryReactor* GetStats(grpc::CallbackServerContext* context,
@@ -371,15 +551,20 @@ private:
 };
 
 /// The server's background work until it stops: removes sessions without subscribers that
-/// nobody used for options.sessionIdle (checking a few times per idle period), and writes the
-/// session database when sessions changed (at most once per wake, and once more at the end).
+/// nobody used for options.sessionIdle (checking a few times per idle period) from the server
+/// and the database, and while the database fails, asks it every second whether it answers.
 void housekeeping(PicServer::State& state) {
     const auto idle = state.options.sessionIdle;
     const auto period = std::clamp<std::chrono::steady_clock::duration>(
         idle / 4, std::chrono::milliseconds(10), std::chrono::seconds(30));
     std::unique_lock lock(state.mutex);
     for (;;) {
-        state.wake.wait_for(lock, period, [&] { return state.stopping.load() || state.dirty; });
+        if (state.storeFailing)
+            state.wake.wait_for(lock, std::chrono::seconds(1), [&] { return state.stopping.load(); });
+        else
+            state.wake.wait_for(lock, period,
+                                [&] { return state.stopping || state.storeFailing; });
+        if (state.stopping) return;
         std::vector<std::shared_ptr<Session>> expired;
         for (auto it = state.sessions.begin(); it != state.sessions.end();) {
             if (it->second->subscribers() == 0 && it->second->idleFor() > idle) {
@@ -389,21 +574,72 @@ void housekeeping(PicServer::State& state) {
                 ++it;
             }
         }
-        const bool save = state.dirty || !expired.empty();
-        state.dirty = false;
-        const bool stopping = state.stopping;
-        // Stopping a session joins its worker, and saving reads every session: neither under
+        // Stopping a session joins its worker, and the database may be slow: neither under
         // the lock the handlers need.
         lock.unlock();
-        for (const auto& session : expired)
+        if (state.store && state.storeFailing) {
+            if (state.timedStore("ping", [](SessionStore& db) { return db.ping(); }))
+                state.storeRecovered();
+        }
+        for (const auto& session : expired) {
             std::fprintf(stderr, "picserver: session %s removed after %.1f s unused\n",
                          session->id().c_str(),
                          std::chrono::duration<double>(session->idleFor()).count());
+            session->close();
+            state.metrics->forgetSession(session->id());
+            // Unless another server has taken it over since (a newer version).
+            if (state.store)
+                if (auto removed = state.timedStore("remove", [&](SessionStore& db) {
+                        return db.remove(session->id(), session->latestVersion());
+                    });
+                    !removed)
+                    state.storeFailed(removed.error());
+        }
         expired.clear();
-        if (save) state.saveNow();
-        if (stopping) return;
         lock.lock();
     }
+}
+
+/// The sessions of a database no other server uses (SQLite), up to the server's cap, the
+/// newest first; says what it left in the database and why. A session left there
+/// is loaded when a client asks for it and the server can carry it.
+Result<void> restore(PicServer::State& state) {
+    PIC_TRY_ASSIGN(std::vector<StoredSession> stored, state.store->loadAll());
+    size_t restored = 0;
+    size_t overCap = 0;
+    std::vector<std::string> refused;
+    // loadAll gives the oldest first: the newest get the room.
+    for (auto it = stored.rbegin(); it != stored.rend(); ++it) {
+        StoredSession& entry = *it;
+        if (const std::string why = state.unusable(entry); !why.empty()) {
+            refused.push_back(fmt::format("session {}: {}", entry.id, why));
+            continue;
+        }
+        std::lock_guard lock(state.mutex);
+        if (state.sessions.contains(entry.id)) {  // a client asked for it first
+            ++restored;
+            continue;
+        }
+        if (!state.hasRoom()) {
+            ++overCap;
+            continue;
+        }
+        state.sessions[entry.id] = std::make_shared<Session>(
+            entry.id, entry.editorDigest, entry.viewerDigest, *state.findBake(entry.bakeId),
+            state.options.session, SessionStart{entry.version + 1, std::move(entry.lights)});
+        ++restored;
+    }
+    if (stored.empty()) return {};
+    std::fprintf(stderr, "picserver: %zu of %zu sessions restored from %s\n", restored,
+                 stored.size(), state.store->describe().c_str());
+    if (overCap > 0)
+        std::fprintf(stderr,
+                     "picserver: %zu sessions left in the database: the server holds at most %zu "
+                     "(--max-sessions); each is loaded when a client asks for it and there is room\n",
+                     overCap, state.options.maxSessions);
+    for (const std::string& why : refused)
+        std::fprintf(stderr, "picserver: %s; it stays in the database, not served\n", why.c_str());
+    return {};
 }
 
 }  // namespace
@@ -419,34 +655,37 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     std::unique_ptr<PicServer> server(new PicServer());
     server->mState = std::make_shared<State>();
     server->mState->bakes = std::move(bakes);
+    // Every computed version goes into the metrics, then to the caller's log.
+    options.session.log = [metrics = server->mState->metrics,
+                           log = std::move(options.session.log)](const UpdateLog& entry) {
+        const Update& update = *entry.update;
+        uint64_t bytes = 0;
+        for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
+        metrics->recordUpdate(entry.session, update.stats.passMs, update.broadcast->update_ms(),
+                              update.encodeMs, bytes, update.baseVersion == 0);
+        if (log) log(entry);
+    };
     server->mState->options = options;
+    server->mState->metrics->setGauges([state = server->mState.get()] {
+        Metrics::Gauges gauges;
+        std::lock_guard lock(state->mutex);
+        gauges.sessions = state->sessions.size();
+        for (const auto& [id, session] : state->sessions) {
+            const v1::SessionStats stats = session->stats();
+            gauges.subscribers += stats.subscribers();
+            gauges.versionsSkipped += stats.versions_skipped();
+        }
+        gauges.storeFailing = state->storeFailing;
+        return gauges;
+    });
+    if (!options.metricsListen.empty()) {
+        PIC_TRY_ASSIGN(server->mMetricsServer,
+                       MetricsServer::start(options.metricsListen, *server->mState->metrics));
+    }
     server->mService = std::make_unique<Service>(server->mState);
     if (!options.dbPath.empty()) {
         State& state = *server->mState;
-        PIC_TRY(SessionStore::checkPath(options.dbPath));
-        state.store = std::make_unique<SessionStore>(options.dbPath);
-        PIC_TRY_ASSIGN(std::vector<StoredSession> stored, state.store->load());
-        for (StoredSession& entry : stored) {
-            ServedBake* bake = state.findBake(entry.bakeId);
-            if (!bake || entry.bakeId.empty()) {
-                std::fprintf(stderr, "picserver: session %s dropped: its bake %s is not served\n",
-                             entry.id.c_str(), entry.bakeId.c_str());
-                continue;
-            }
-            if (auto checked = checkRuntimeLights(entry.lights, bake->scene()); !checked) {
-                std::fprintf(stderr, "picserver: session %s dropped: %s\n", entry.id.c_str(),
-                             checked.error().message.c_str());
-                continue;
-            }
-            SessionStart start{entry.version + 1, std::move(entry.lights)};
-            state.sessions[entry.id] =
-                std::make_shared<Session>(entry.id, entry.editorDigest, entry.viewerDigest, *bake,
-                                          options.session, std::move(start));
-        }
-        if (!stored.empty())
-            std::fprintf(stderr, "picserver: %zu of %zu sessions restored from %s\n",
-                         state.sessions.size(), stored.size(), options.dbPath.c_str());
-        state.saveNow();
+        PIC_TRY_ASSIGN(state.store, SessionStore::open(options.dbPath));
     }
 
     grpc::EnableDefaultHealthCheckService(true);
@@ -470,8 +709,20 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
         return fail(ErrorCode::InvalidInput, "cannot listen on \"{}\" (address in use or invalid)",
                     listen);
     server->mAddress = fmt::format("{}:{}", listen.substr(0, colon), port);
-    if (auto* health = server->mServer->GetHealthCheckService())
-        health->SetServingStatus(true);
+    server->mState->health = server->mServer->GetHealthCheckService();
+    if (server->mState->health) server->mState->health->SetServingStatus(true);
+    if (options.onListening) options.onListening(server->mAddress);
+    // Sessions come back once the server listens; a request for one before is served by
+    // loading it from the database, and restore() passes over it.
+    if (State& state = *server->mState; state.store) {
+        if (state.store->shared())
+            std::fprintf(stderr,
+                         "picserver: sessions in %s: each is taken over from it on its first "
+                         "request here\n",
+                         state.store->describe().c_str());
+        else
+            PIC_TRY(restore(state));
+    }
     server->mReaper = std::thread([state = server->mState] { housekeeping(*state); });
     return server;
 }
@@ -488,22 +739,23 @@ void PicServer::shutdown() {
     std::lock_guard lock(mShutdownMutex);
     if (mShutDown || !mServer) return;
     mShutDown = true;
-    {
-        std::lock_guard stateLock(mState->mutex);
-        mState->stopping = true;
-    }
-    mState->wake.notify_all();
-    if (mReaper.joinable()) mReaper.join();
-    if (auto* health = mServer->GetHealthCheckService()) health->SetServingStatus(false);
-    // Streams never end on their own: cancel them after a short grace period.
-    mServer->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(200));
-    mServer->Wait();
+    // Drain: health NOT_SERVING and no new calls, every session closed at once (its streams
+    // end UNAVAILABLE so clients go to another server; a version not yet computed is
+    // abandoned: whoever takes the session over computes it), then gRPC stops.
     std::map<std::string, std::shared_ptr<Session>> sessions;
     {
         std::lock_guard stateLock(mState->mutex);
+        mState->stopping = true;
         sessions.swap(mState->sessions);
     }
-    sessions.clear();  // joins each session's worker
+    if (mState->health) mState->health->SetServingStatus(false);
+    mState->wake.notify_all();
+    for (const auto& [id, session] : sessions) session->close();
+    if (mReaper.joinable()) mReaper.join();
+    mServer->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+    mServer->Wait();
+    sessions.clear();  // joins each session's worker: at most the computation under way
+    mMetricsServer.reset();
 }
 
 std::shared_ptr<Session> PicServer::session(const std::string& id) const {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -14,6 +15,7 @@
 #include <grpcpp/server.h>
 
 #include "core/error.h"
+#include "server/metrics_http.h"
 #include "server/served_bake.h"
 #include "server/session.h"
 
@@ -27,15 +29,24 @@ struct ServerOptions {
     /// A session without subscribers that no client used for this long is removed (its
     /// tokens then get NOT_FOUND).
     std::chrono::milliseconds sessionIdle = std::chrono::hours(1);
-    /// The session database (server/session_store.h); empty: sessions end with the server.
+    /// Where to serve the Prometheus metrics (GET /metrics; server/metrics.h), "HOST:PORT";
+    /// empty: nowhere.
+    std::string metricsListen;
+    /// Called once the server listens, with its address, before it restores the sessions of
+    /// the database: whatever it prints comes before any update the restored sessions log.
+    std::function<void(const std::string& address)> onListening;
+    /// The session database (server/session_store.h): an SQLite file or a PostgreSQL URI;
+    /// empty: sessions end with the server.
     std::string dbPath;
 };
 
 class PicServer {
 public:
     /// Serves `bakes` (at least one; the first is the default) on `listen` ("HOST:PORT"; port 0
-    /// picks a free one), restoring the sessions of `options.dbPath` whose bake is served.
-    /// InvalidInput for an address gRPC cannot bind, Corrupt for an unreadable database.
+    /// picks a free one), restoring the sessions of an SQLite `options.dbPath` (a shared
+    /// PostgreSQL database's sessions are taken over on their first request instead).
+    /// InvalidInput for an address gRPC cannot bind or a database path that cannot hold the
+    /// database, Corrupt for an unreadable database, Io for one that cannot be reached.
     static Result<std::unique_ptr<PicServer>> start(std::vector<std::unique_ptr<ServedBake>> bakes,
                                                     const std::string& listen,
                                                     ServerOptions options);
@@ -48,9 +59,14 @@ public:
     const std::string& address() const { return mAddress; }
     /// Blocks until shutdown() has finished.
     void wait();
-    /// Stops accepting calls, ends every stream (UNAVAILABLE) and stops the sessions.
+    /// Drains: health NOT_SERVING, new calls refused (UNAVAILABLE), every stream ended
+    /// (UNAVAILABLE), versions not yet computed abandoned, then the gRPC server stopped,
+    /// within about two seconds plus one update whatever the number of sessions.
     /// Idempotent; safe from any thread but a gRPC handler.
     void shutdown();
+
+    /// "HOST:PORT" of the metrics endpoint, empty without one.
+    std::string metricsAddress() const { return mMetricsServer ? mMetricsServer->address() : std::string(); }
 
     /// A session by id (null when none): for tests and the log.
     std::shared_ptr<Session> session(const std::string& id) const;
@@ -68,6 +84,7 @@ private:
     std::mutex mShutdownMutex;
     bool mShutDown = false;
     std::thread mReaper;  ///< housekeeping: idle sessions, the database; until shutdown
+    std::unique_ptr<MetricsServer> mMetricsServer;
 };
 
 }  // namespace pic

@@ -58,6 +58,19 @@ uint64_t SubscriberSlot::skipped() const {
     return mSkipped;
 }
 
+void SubscriberSlot::close() {
+    {
+        std::lock_guard lock(mMutex);
+        mClosed = true;
+    }
+    if (mWake) mWake();
+}
+
+bool SubscriberSlot::closed() const {
+    std::lock_guard lock(mMutex);
+    return mClosed;
+}
+
 Session::Session(std::string id, std::string editorDigest, std::string viewerDigest,
                  ServedBake& bake, SessionOptions options, SessionStart start)
     : mId(std::move(id)),
@@ -81,12 +94,22 @@ Session::~Session() {
     mWorker.join();
 }
 
-Result<uint64_t> Session::setLights(LightSet lights) {
+Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
     PIC_TRY(checkRuntimeLights(lights, mBake.scene()));
+    // Versions are handed out only here, under the commit lock: the one read now is the one
+    // taken below.
+    std::lock_guard committing(mCommitMutex);
     uint64_t version = 0;
     {
         std::lock_guard lock(mMutex);
-        version = mNextVersion++;
+        if (mStopping) return fail(ErrorCode::Io, "session {} was closed", mId);
+        version = mNextVersion;
+    }
+    if (commit) PIC_TRY(commit(version, lights));
+    {
+        std::lock_guard lock(mMutex);
+        if (mStopping) return fail(ErrorCode::Io, "session {} was closed", mId);
+        mNextVersion = version + 1;
         mStats.set_versions_set(version);
         mLastUse = std::chrono::steady_clock::now();
         mLatestLights = lights;
@@ -95,6 +118,19 @@ Result<uint64_t> Session::setLights(LightSet lights) {
     }
     mChanged.notify_all();
     return version;
+}
+
+void Session::close() {
+    std::vector<std::shared_ptr<SubscriberSlot>> slots;
+    {
+        std::lock_guard lock(mMutex);
+        mStopping = true;
+        mPending.reset();
+        slots = mSlots;
+    }
+    mAbandon = true;
+    mChanged.notify_all();
+    for (const auto& slot : slots) slot->close();
 }
 
 void Session::touch() {
@@ -124,10 +160,17 @@ std::shared_ptr<const Update> Session::latestUpdate() const {
 
 std::shared_ptr<SubscriberSlot> Session::subscribe(std::function<void()> wake) {
     // Under the publish lock, so that no newer update reaches the slot before the latest.
-    std::lock_guard publishing(mPublishMutex);
-    std::lock_guard lock(mMutex);
-    auto slot = std::make_shared<SubscriberSlot>(std::move(wake), mLatest);
-    mSlots.push_back(slot);
+    std::shared_ptr<SubscriberSlot> slot;
+    bool closed = false;
+    {
+        std::lock_guard publishing(mPublishMutex);
+        std::lock_guard lock(mMutex);
+        slot = std::make_shared<SubscriberSlot>(std::move(wake), mLatest);
+        closed = mStopping;
+        if (!closed) mSlots.push_back(slot);
+    }
+    // A session closed already gives a closed slot (its wake runs outside the locks).
+    if (closed) slot->close();
     return slot;
 }
 
@@ -212,7 +255,8 @@ void Session::run() {
         update->keysOnDemand = mKeysOnDemand;
         auto frame = std::make_shared<HalfFrame>();
         const auto start = Clock::now();
-        if (auto relit = mBake.relight(job.lights, update->stats, *frame); !relit) {
+        if (auto relit = mBake.relight(job.lights, update->stats, *frame, &mAbandon); !relit) {
+            if (mAbandon) return;
             std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
                          (unsigned long long)job.version, relit.error().message.c_str());
             continue;

@@ -73,12 +73,17 @@ public:
     std::shared_ptr<const Update> take();
     /// Updates replaced before they were taken.
     uint64_t skipped() const;
+    /// Ends the subscription (its session is closing): wakes the subscriber, which sees
+    /// closed() and ends its stream.
+    void close();
+    bool closed() const;
 
 private:
     std::function<void()> mWake;
     mutable std::mutex mMutex;
     std::shared_ptr<const Update> mPending;
     uint64_t mSkipped = 0;
+    bool mClosed = false;
 };
 
 /// One update's line for the log: version, ms per pass, encode ms, bytes, subscribers.
@@ -118,9 +123,21 @@ public:
     const std::string& viewerDigest() const { return mViewerDigest; }
     ServedBake& bake() const { return mBake; }
 
+    /// What makes an accepted light set durable before the session queues it (the server's
+    /// database): called with the version the set will produce; its error refuses the set.
+    using Commit = std::function<Result<void>(uint64_t version, const LightSet& lights)>;
+
     /// Queues a light set, checked against the scene (InvalidInput naming the problem), and
-    /// returns the version it will produce.
-    Result<uint64_t> setLights(LightSet lights);
+    /// returns the version it will produce. With `commit`, the set is queued only once
+    /// `commit` succeeded (its error is returned, and the session stays as it was); light
+    /// sets of one session are committed one at a time, in version order. Io once the
+    /// session is closed.
+    Result<uint64_t> setLights(LightSet lights, const Commit& commit = {});
+
+    /// Closes the session for good (it is removed from this server): its subscribers' slots
+    /// close, the pending version is dropped and a computation not yet started is abandoned.
+    /// Does not wait; the destructor joins the worker.
+    void close();
     /// The newest accepted version and light set.
     uint64_t latestVersion() const;
     LightSet latestLights() const;
@@ -130,6 +147,7 @@ public:
     /// A new subscriber: its slot holds the newest computed update at once (if any; `wake`
     /// is not called for it, the caller takes it when ready), then every update published
     /// after, each with a call of `wake`.
+    /// A closed session gives a closed slot.
     std::shared_ptr<SubscriberSlot> subscribe(std::function<void()> wake);
     void unsubscribe(const SubscriberSlot* slot);
     size_t subscribers() const;
@@ -158,6 +176,8 @@ private:
     SessionOptions mOptions;
 
     std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
+    std::mutex mCommitMutex;   ///< one light set committed at a time, in version order
+    std::atomic<bool> mAbandon{false};  ///< closed: computations not yet started are skipped
     mutable std::mutex mMutex;
     mutable std::condition_variable mChanged;
     bool mStopping = false;

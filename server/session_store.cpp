@@ -1,12 +1,7 @@
 #include "server/session_store.h"
 
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -20,15 +15,16 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-/// 2: token digests; 1: plain tokens (read, digested on load).
-constexpr int kFormat = 2;
-
 /// 64 lowercase hex digits, as tokenDigest writes.
 bool isDigest(const std::string& text) {
     return text.size() == 64 && text.find_first_not_of("0123456789abcdef") == std::string::npos;
 }
 
 }  // namespace
+
+bool SessionStore::isPostgres(const std::string& spec) {
+    return spec.starts_with("postgresql://") || spec.starts_with("postgres://");
+}
 
 Result<void> SessionStore::checkPath(const std::string& path) {
     std::error_code ec;
@@ -42,20 +38,21 @@ Result<void> SessionStore::checkPath(const std::string& path) {
     return {};
 }
 
-Result<std::vector<StoredSession>> SessionStore::load() const {
-    std::error_code ec;
-    if (!fs::exists(mPath, ec)) return std::vector<StoredSession>{};
-    std::ifstream file(mPath, std::ios::binary);
-    if (!file) return fail(ErrorCode::Io, "cannot open the session database {}", mPath);
-    const std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+Result<std::unique_ptr<SessionStore>> SessionStore::open(const std::string& spec) {
+    if (isPostgres(spec)) return openPostgresStore(spec);
+    PIC_TRY(checkPath(spec));
+    return openSqliteStore(spec);
+}
+
+Result<std::vector<StoredSession>> parseJsonSessions(const std::string& text,
+                                                     const std::string& path) {
     const Json root = Json::parse(text, nullptr, /*allow_exceptions=*/false);
     const int format = root.is_object() ? root.value("format", 0) : 0;
-    if ((format != 1 && format != kFormat) || !root.contains("sessions") ||
-        !root["sessions"].is_array())
+    if ((format != 1 && format != 2) || !root.contains("sessions") || !root["sessions"].is_array())
         return fail(ErrorCode::Corrupt,
-                    "{} is not a pic session database of format 1 or {} (move it away to start "
-                    "afresh)",
-                    mPath, kFormat);
+                    "{} is not a pic session database (SQLite, or JSON of format 1 or 2); move "
+                    "it away to start afresh",
+                    path);
     std::vector<StoredSession> sessions;
     for (const Json& entry : root["sessions"]) {
         StoredSession session;
@@ -71,57 +68,34 @@ Result<std::vector<StoredSession>> SessionStore::load() const {
             session.bakeId = entry.at("bake_id").get<std::string>();
             session.version = entry.at("version").get<uint64_t>();
         } catch (const Json::exception& error) {
-            return fail(ErrorCode::Corrupt, "{}: session entry {}: {}", mPath, sessions.size(),
+            return fail(ErrorCode::Corrupt, "{}: session entry {}: {}", path, sessions.size(),
                         error.what());
         }
-        if (!isDigest(session.editorDigest) || !isDigest(session.viewerDigest))
-            return fail(ErrorCode::Corrupt,
-                        "{}: session {}: a token digest is not 64 lowercase hex digits", mPath,
-                        session.id);
-        auto lights = parseLightSet(entry.value("lights", Json::object()).dump());
-        if (!lights)
-            return fail(ErrorCode::Corrupt, "{}: session {}: {}", mPath, session.id,
-                        lights.error().message);
-        session.lights = std::move(*lights);
-        sessions.push_back(std::move(session));
+        PIC_TRY_ASSIGN(StoredSession checked,
+                       sessionFromRow(std::move(session.id), std::move(session.editorDigest),
+                                      std::move(session.viewerDigest), std::move(session.bakeId),
+                                      int64_t(session.version),
+                                      entry.value("lights", Json::object()).dump(), path));
+        sessions.push_back(std::move(checked));
     }
     return sessions;
 }
 
-Result<void> SessionStore::save(const std::vector<StoredSession>& sessions) {
-    Json root;
-    root["format"] = kFormat;
-    root["sessions"] = Json::array();
-    for (const StoredSession& session : sessions) {
-        Json entry;
-        entry["id"] = session.id;
-        entry["editor_token_sha256"] = session.editorDigest;
-        entry["viewer_token_sha256"] = session.viewerDigest;
-        entry["bake_id"] = session.bakeId;
-        entry["version"] = session.version;
-        entry["lights"] = Json::parse(toJson(session.lights));
-        root["sessions"].push_back(std::move(entry));
-    }
-    const std::string text = root.dump(2) + "\n";
-
-    std::lock_guard lock(mMutex);
-    const std::string temp = mPath + ".tmp";
-    // Owner-only: the digests cannot be presented as tokens, but the sessions are private.
-    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-    if (fd < 0) return fail(ErrorCode::Io, "cannot write the session database {}", temp);
-    size_t written = 0;
-    while (written < text.size()) {
-        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-        if (n <= 0) break;
-        written += size_t(n);
-    }
-    const bool synced = ::fsync(fd) == 0;
-    ::close(fd);
-    if (written != text.size() || !synced || std::rename(temp.c_str(), mPath.c_str()) != 0) {
-        std::remove(temp.c_str());
-        return fail(ErrorCode::Io, "cannot write the session database {}", mPath);
-    }
-    return {};
+Result<StoredSession> sessionFromRow(std::string id, std::string editorDigest,
+                                     std::string viewerDigest, std::string bakeId,
+                                     int64_t version, const std::string& lightsJson,
+                                     const std::string& where) {
+    if (!isDigest(editorDigest) || !isDigest(viewerDigest))
+        return fail(ErrorCode::Corrupt,
+                    "{}: session {}: a token digest is not 64 lowercase hex digits", where, id);
+    if (version < 1)
+        return fail(ErrorCode::Corrupt, "{}: session {}: version {} is not positive", where, id,
+                    version);
+    auto lights = parseLightSet(lightsJson);
+    if (!lights)
+        return fail(ErrorCode::Corrupt, "{}: session {}: {}", where, id, lights.error().message);
+    return StoredSession{std::move(id), std::move(editorDigest), std::move(viewerDigest),
+                         std::move(bakeId), uint64_t(version), std::move(*lights)};
 }
 
 }  // namespace pic

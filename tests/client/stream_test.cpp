@@ -1,7 +1,8 @@
 // The server, the stream and the thin client on loopback (127.0.0.1, port 0): sessions and
 // tokens, light-set validation, coalescing, latest-wins delivery to fast and stalled
 // subscribers, key frames for late joiners, exact decoding, the scene download, and the
-// picserver / picclient command lines. Every server a test starts is stopped by it.
+// picserver / picclient command lines (the session database: session_database_test.cpp).
+// Every server a test starts is stopped by it.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -36,9 +37,8 @@
 #include "render/cpu_runtime.h"
 #include "render/renderer.h"
 #include "server/service.h"
-#include "server/session_store.h"
-#include "server/token_digest.h"
 #include "tests/support/baked_scene.h"
+#include "tests/client/stream_fixture.h"
 #include "tests/support/command.h"
 
 namespace pic {
@@ -46,17 +46,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-const std::string kScene = test::testScenePath("cornell");
-
-/// A small bake of the Cornell box, written once per test process into a scratch directory
-/// that goes when the process exits.
-const std::string& bakePath() {
-    BakeOptions options = test::smallBakeOptions(2048, 32);
-    options.bandsY = 3;
-    options.bandsC = 2;
-    return test::bakeFile("cornell", options);
-}
+using namespace test;
 
 /// The CPU twin on the test bake, set up as serve() runs it (one bounce): it is
 /// deterministic, so it gives the served caches for the same lights.
@@ -86,131 +76,6 @@ std::unique_ptr<Twin> cpuTwin() {
     return twin;
 }
 
-struct Served {
-    std::unique_ptr<PicServer> server;
-    std::unique_ptr<PicConnection> connection;
-};
-
-Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
-             std::chrono::milliseconds sessionIdle = std::chrono::hours(1),
-             const std::string& dbPath = "") {
-    Served served;
-    ServeOptions options;
-    options.backend = backend;
-    options.bounces.bounces = 1;
-    auto bake = ServedBake::load(bakePath(), kScene, options);
-    EXPECT_TRUE(bake) << (bake ? "" : bake.error().message);
-    if (!bake) return served;
-    std::vector<std::unique_ptr<ServedBake>> bakes;
-    bakes.push_back(std::move(*bake));
-    ServerOptions serverOptions;
-    serverOptions.session.keyframeInterval = keyframeInterval;
-    serverOptions.sessionIdle = sessionIdle;
-    serverOptions.dbPath = dbPath;
-    auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", serverOptions);
-    EXPECT_TRUE(server) << (server ? "" : server.error().message);
-    if (!server) return served;
-    served.server = std::move(*server);
-    auto connection = PicConnection::connect(served.server->address());
-    EXPECT_TRUE(connection) << (connection ? "" : connection.error().message);
-    if (connection) served.connection = std::move(*connection);
-    return served;
-}
-
-/// Starts a server over the test bake with the session database at `dbPath`.
-Result<std::unique_ptr<PicServer>> startWithDatabase(const std::string& dbPath) {
-    ServeOptions serveOptions;
-    serveOptions.backend = "cpu";
-    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
-    if (!bake) return std::unexpected(bake.error());
-    std::vector<std::unique_ptr<ServedBake>> bakes;
-    bakes.push_back(std::move(*bake));
-    ServerOptions options;
-    options.dbPath = dbPath;
-    return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
-}
-
-LightSet pointLight(float x) {
-    LightSet lights;
-    Light light;
-    light.id = "lamp";
-    light.type = LightType::Point;
-    light.position = glm::vec3(x, 0.5f, 0.0f);  // inside the box (ceiling at y = 1)
-    light.intensity = 4.0f;
-    lights.lights.push_back(light);
-    return lights;
-}
-
-/// The header of the served bake, for the decoders.
-v1::SceneHeader sceneHeaderOf(PicConnection& connection) {
-    auto header = connection.sceneHeader("");
-    EXPECT_TRUE(header) << (header ? "" : header.error().message);
-    return header ? *header : v1::SceneHeader{};
-}
-
-/// Reads frames on its own thread, decoding each, until cancelled.
-class Reader {
-public:
-    Reader(PicConnection& connection, const std::string& session, const std::string& token)
-        : mDecoder(sceneHeaderOf(connection)),
-          mStream(connection.subscribe(session, token)),
-          mThread([this] { run(); }) {}
-    ~Reader() {
-        mStream->cancel();
-        mThread.join();
-    }
-
-    /// Waits until a frame of version ≥ `version` was decoded.
-    bool waitFor(uint64_t version, std::chrono::milliseconds timeout = 30s) {
-        const auto start = std::chrono::steady_clock::now();
-        while (std::chrono::steady_clock::now() - start < timeout) {
-            {
-                std::lock_guard lock(mMutex);
-                if (!versions.empty() && versions.back() >= version) return true;
-            }
-            std::this_thread::sleep_for(2ms);
-        }
-        return false;
-    }
-
-    std::vector<uint64_t> received() {
-        std::lock_guard lock(mMutex);
-        return versions;
-    }
-    std::vector<bool> keys() {
-        std::lock_guard lock(mMutex);
-        return keyFrames;
-    }
-    HalfFrame frame() {
-        std::lock_guard lock(mMutex);
-        return mDecoder.frame();
-    }
-    std::vector<std::string> errors() {
-        std::lock_guard lock(mMutex);
-        return mErrors;
-    }
-
-private:
-    void run() {
-        v1::Frame frame;
-        while (mStream->next(frame)) {
-            std::lock_guard lock(mMutex);
-            keyFrames.push_back(frame.base_version() == 0);
-            const uint64_t version = frame.version();
-            if (auto applied = mDecoder.apply(frame); !applied)
-                mErrors.push_back(applied.error().message);
-            versions.push_back(version);
-        }
-    }
-
-    FrameDecoder mDecoder;
-    std::unique_ptr<FrameStream> mStream;
-    std::mutex mMutex;
-    std::vector<uint64_t> versions;
-    std::vector<bool> keyFrames;
-    std::vector<std::string> mErrors;
-    std::thread mThread;
-};
 
 TEST(Stream, TwoSubscribersReceiveEveryVersionTheyCanAndAlwaysTheLastDecodedExactly) {
     Served served = serve();
@@ -394,123 +259,6 @@ TEST(Stream, IdleSessionsWithoutSubscribersAreRemoved) {
     EXPECT_TRUE(kept) << "a session with a subscriber stays";
 }
 
-TEST(Stream, SessionsSurviveARestartWithTheDatabase) {
-    const test::ScratchDir dir("pic_sessions");
-    const fs::path db = dir / "sessions.json";
-    std::string id, editor, viewer;
-    const LightSet lights = pointLight(0.25f);
-    {
-        Served served = serve("cpu", 32, std::chrono::hours(1), db.string());
-        ASSERT_TRUE(served.connection);
-        auto session = served.connection->createSession();
-        ASSERT_TRUE(session);
-        id = session->session();
-        editor = session->editor_token();
-        viewer = session->viewer_token();
-        auto version = served.connection->setLights(id, editor, lights);
-        ASSERT_TRUE(version);
-        EXPECT_EQ(*version, 2u);
-    }
-    EXPECT_EQ(fs::status(db).permissions() & fs::perms::others_read, fs::perms::none)
-        << "the database is private";
-    {
-        // It holds the tokens' digests, not the tokens.
-        std::ifstream in(db);
-        const std::string text{std::istreambuf_iterator<char>(in),
-                               std::istreambuf_iterator<char>()};
-        EXPECT_EQ(text.find(editor), std::string::npos);
-        EXPECT_EQ(text.find(viewer), std::string::npos);
-        EXPECT_NE(text.find(tokenDigest(viewer)), std::string::npos);
-    }
-    Served restarted = serve("cpu", 32, std::chrono::hours(1), db.string());
-    ASSERT_TRUE(restarted.connection);
-    auto joined = restarted.connection->joinSession(id, viewer);
-    ASSERT_TRUE(joined) << joined.error().message;
-    EXPECT_EQ(joined->version(), 3u) << "versions go on after the restart";
-    auto restored = wire::fromProto(joined->lights());
-    ASSERT_TRUE(restored);
-    ASSERT_EQ(restored->lights.size(), 1u);
-    EXPECT_EQ(restored->lights[0].position, lights.lights[0].position);
-    Reader reader(*restarted.connection, id, viewer);
-    EXPECT_TRUE(reader.waitFor(3));
-    auto denied = restarted.connection->setLights(id, viewer, lights);
-    EXPECT_FALSE(denied) << "roles survive too";
-
-    // A database that is not one is refused, naming the file.
-    {
-        std::ofstream broken(db);
-        broken << "not json";
-    }
-    auto refused = startWithDatabase(db.string());
-    ASSERT_FALSE(refused);
-    EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
-    EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
-}
-
-// A --db that cannot hold the database (a directory, or a file in a missing directory) is
-// refused at start, naming the path, instead of aborting or serving without durability.
-TEST(Stream, ADatabasePathThatCannotHoldTheDatabaseIsRefused) {
-    const test::ScratchDir dir("pic_sessions_path");
-    for (const auto& [path, says] :
-         {std::pair{dir.path().string(), std::string("is a directory")},
-          std::pair{(dir / "missing" / "sessions.json").string(), std::string("does not exist")}}) {
-        SCOPED_TRACE(path);
-        auto refused = startWithDatabase(path);
-        ASSERT_FALSE(refused);
-        EXPECT_EQ(refused.error().code, ErrorCode::InvalidInput);
-        EXPECT_NE(refused.error().message.find(path), std::string::npos) << refused.error().message;
-        EXPECT_NE(refused.error().message.find(says), std::string::npos) << refused.error().message;
-    }
-    EXPECT_TRUE(SessionStore::checkPath((dir / "sessions.json").string()));
-}
-
-// A database written before the digests (format 1: plain tokens) still loads: its tokens
-// open their sessions, and the next save keeps only their digests.
-TEST(Stream, AFormatOneDatabaseLoadsAndIsRewrittenWithDigests) {
-    const test::ScratchDir dir("pic_sessions_v1");
-    const fs::path db = dir / "sessions.json";
-    std::string id, editor, viewer;
-    {
-        Served served = serve("cpu", 32, std::chrono::hours(1), db.string());
-        ASSERT_TRUE(served.connection);
-        auto session = served.connection->createSession();
-        ASSERT_TRUE(session);
-        id = session->session();
-        editor = session->editor_token();
-        viewer = session->viewer_token();
-    }
-    // Rewrite it as format 1 would have had it.
-    {
-        std::ifstream in(db);
-        nlohmann::json root = nlohmann::json::parse(in);
-        root["format"] = 1;
-        for (nlohmann::json& entry : root["sessions"]) {
-            entry.erase("editor_token_sha256");
-            entry.erase("viewer_token_sha256");
-            entry["editor_token"] = editor;
-            entry["viewer_token"] = viewer;
-        }
-        std::ofstream(db) << root.dump(2);
-    }
-    {
-        Served restarted = serve("cpu", 32, std::chrono::hours(1), db.string());
-        ASSERT_TRUE(restarted.connection);
-        auto joined = restarted.connection->joinSession(id, viewer);
-        ASSERT_TRUE(joined) << joined.error().message;
-        auto version = restarted.connection->setLights(id, editor, pointLight(0.1f));
-        EXPECT_TRUE(version) << (version ? "" : version.error().message);
-        auto denied = restarted.connection->setLights(id, "not-a-token", pointLight(0.1f));
-        EXPECT_FALSE(denied);
-    }
-    std::ifstream in(db);
-    const nlohmann::json root = nlohmann::json::parse(in);
-    EXPECT_EQ(root.at("format"), 2);
-    const std::string text = root.dump();
-    EXPECT_EQ(text.find(editor), std::string::npos);
-    EXPECT_EQ(text.find(viewer), std::string::npos);
-    EXPECT_EQ(root.at("sessions").at(0).at("editor_token_sha256"), tokenDigest(editor));
-}
-
 // The load runs one update with the scene's own lights (ServedBake::warmUp), and a session
 // that then asks for the same lights gets the same caches as a runtime that never ran one.
 TEST(Stream, ALoadRunsAFirstUpdateThatChangesNoResult) {
@@ -535,24 +283,46 @@ TEST(Stream, ALoadRunsAFirstUpdateThatChangesNoResult) {
 TEST(Stream, HealthCheckSaysServing) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
-    // grpc.health.v1.Health/Check with an empty request (the whole server); the reply
-    // HealthCheckResponse{status: SERVING = 1} is the two bytes 08 01.
-    auto channel = grpc::CreateChannel(served.server->address(), grpc::InsecureChannelCredentials());
-    grpc::GenericStub stub(channel);
-    grpc::ClientContext context;
-    grpc::ByteBuffer request, response;
-    grpc::Slice empty("");
-    request = grpc::ByteBuffer(&empty, 1);
-    std::promise<grpc::Status> done;
-    stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
-                   &response, [&](grpc::Status status) { done.set_value(status); });
-    grpc::Status status = done.get_future().get();
-    ASSERT_TRUE(status.ok()) << status.error_message();
-    std::vector<grpc::Slice> slices;
-    ASSERT_TRUE(response.Dump(&slices).ok());
-    std::string bytes;
-    for (const auto& slice : slices) bytes.append(reinterpret_cast<const char*>(slice.begin()), slice.size());
-    EXPECT_EQ(bytes, std::string("\x08\x01", 2));
+    EXPECT_EQ(healthStatus(served.server->address()), "SERVING");
+}
+
+// GET /metrics: Prometheus text with the updates computed per session, the update and pass
+// histograms, frames sent, sessions, subscribers and the database's calls; other paths 404.
+TEST(Stream, MetricsCountWhatTheServerDid) {
+    const test::ScratchDir dir("pic_metrics");
+    ServerOptions options;
+    options.metricsListen = "127.0.0.1:0";
+    options.dbPath = (dir / "sessions.db").string();
+    Served served = serveWith(options);
+    ASSERT_TRUE(served.connection);
+    const std::string address = served.server->metricsAddress();
+    ASSERT_TRUE(address.starts_with("127.0.0.1:")) << address;
+    EXPECT_NE(address, "127.0.0.1:0");
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    ASSERT_TRUE(served.connection->setLights(session->session(), session->editor_token(), pointLight(0.1f)));
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(reader.waitFor(2));
+
+    const HttpReply reply = httpGet(address, "/metrics");
+    ASSERT_EQ(reply.status, "HTTP/1.1 200 OK") << reply.body;
+    const std::string& text = reply.body;
+    EXPECT_EQ(metricValue(text, "pic_sessions"), 1.0) << text;
+    EXPECT_EQ(metricValue(text, "pic_subscribers"), 1.0);
+    EXPECT_EQ(metricValue(text, "pic_session_versions_computed_total{session=\"" +
+                                    session->session() + "\"}"),
+              2.0)
+        << text;
+    EXPECT_GE(metricValue(text, "pic_updates_total"), 2.0);
+    EXPECT_GE(metricValue(text, "pic_frames_sent_total"), 1.0);
+    EXPECT_EQ(metricValue(text, "pic_update_ms_count"), metricValue(text, "pic_updates_total"));
+    EXPECT_EQ(metricValue(text, "pic_update_ms_bucket{le=\"+Inf\"}"), metricValue(text, "pic_update_ms_count"));
+    EXPECT_NE(text.find("pic_pass_ms_bucket{pass=\""), std::string::npos) << text;
+    EXPECT_EQ(metricValue(text, "pic_store_ms_count{op=\"create\"}"), 1.0);
+    EXPECT_EQ(metricValue(text, "pic_store_ms_count{op=\"save\"}"), 1.0);
+    EXPECT_EQ(metricValue(text, "pic_store_up"), 1.0);
+    EXPECT_NE(text.find("# TYPE pic_update_ms histogram"), std::string::npos);
+    EXPECT_TRUE(httpGet(address, "/other").status.starts_with("HTTP/1.1 404")) << httpGet(address, "/other").status;
 }
 
 /// One ServerReflectionInfo exchange: sends `request`, collects the first reply's bytes.
@@ -680,6 +450,8 @@ TEST(Stream, MalformedLightSetsAreInvalidArgumentNamingTheField) {
              }
          }},
         {"emissiveScale", [&](v1::LightSet& s) { (*s.mutable_emissive_scale())["no such material"] = 1.0f; }},
+        // An id is a name, not a payload: a 1 MiB one would go into the database.
+        {"lights[0].id", [&](v1::LightSet& s) { s.mutable_lights(0)->set_id(std::string(1 << 20, 'x')); }},
     };
     for (const Case& c : cases) {
         v1::SetLightsRequest request;
@@ -882,58 +654,12 @@ TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
     EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
 }
 
-/// Runs a command with its stdout on a pipe; the child's pid and the read end.
-struct Child {
-    pid_t pid = -1;
-    FILE* out = nullptr;
-};
-
-Child spawn(const std::vector<std::string>& args) {
-    int fds[2];
-    if (pipe(fds) != 0) return {};
-    pid_t pid = fork();
-    if (pid == 0) {
-        dup2(fds[1], STDOUT_FILENO);
-        close(fds[0]);
-        close(fds[1]);
-        std::vector<char*> argv;
-        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(argv[0], argv.data());
-        _exit(127);
-    }
-    close(fds[1]);
-    return {pid, fdopen(fds[0], "r")};
-}
-
-std::string readLine(FILE* file) {
-    char line[4096];
-    if (!std::fgets(line, sizeof line, file)) return {};
-    std::string text(line);
-    if (!text.empty() && text.back() == '\n') text.pop_back();
-    return text;
-}
-
-int waitExit(pid_t pid) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-std::string run(const std::string& command, int& exit) {
-    std::string output;
-    FILE* pipe = popen(command.c_str(), "r");
-    char buffer[4096];
-    while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
-    exit = WEXITSTATUS(pclose(pipe));
-    return output;
-}
 
 TEST(StreamCli, PicserverAndPicclientEndToEnd) {
-    Child server = spawn({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
+    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
                           "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet"});
-    ASSERT_GT(server.pid, 0);
-    const std::string first = readLine(server.out);
+    ASSERT_GT(server.pid(), 0);
+    const std::string first = readLine(server.out());
     ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
     const std::string address = first.substr(std::string("listening on ").size());
     EXPECT_NE(address, "127.0.0.1:0");
@@ -1023,24 +749,23 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_TRUE(statsJson.contains("broadcast_bytes")) << stats;
 
     // The update log: one line per update after the first line.
-    const std::string updateLine = readLine(server.out);
+    const std::string updateLine = readLine(server.out());
     EXPECT_TRUE(updateLine.starts_with("update session=")) << updateLine;
     EXPECT_NE(updateLine.find("encode_ms="), std::string::npos);
     EXPECT_NE(updateLine.find("bytes="), std::string::npos);
     EXPECT_NE(updateLine.find("subscribers="), std::string::npos);
 
-    kill(server.pid, SIGTERM);
-    EXPECT_EQ(waitExit(server.pid), 0);
-    std::fclose(server.out);
+    server.signal(SIGTERM);
+    EXPECT_EQ(server.wait(), 0);
 }
 
 TEST(StreamCli, TlsServerAndClient) {
     const std::string tls = PIC_TEST_TLS_DIR;
-    Child server = spawn({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
+    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
                           "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet",
                           "--tls-cert", tls + "/server.crt", "--tls-key", tls + "/server.key"});
-    ASSERT_GT(server.pid, 0);
-    const std::string first = readLine(server.out);
+    ASSERT_GT(server.pid(), 0);
+    const std::string first = readLine(server.out());
     ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
     const std::string address = first.substr(std::string("listening on ").size());
     int exit = 0;
@@ -1053,9 +778,8 @@ TEST(StreamCli, TlsServerAndClient) {
     std::string plain = run(client + " session --server " + address + " --connect-timeout 1 2>&1", exit);
     EXPECT_EQ(exit, 1) << plain;
     EXPECT_NE(plain.find("--tls-ca"), std::string::npos) << plain;
-    kill(server.pid, SIGTERM);
-    EXPECT_EQ(waitExit(server.pid), 0);
-    std::fclose(server.out);
+    server.signal(SIGTERM);
+    EXPECT_EQ(server.wait(), 0);
 
     std::string half = run(std::string(PIC_PICSERVER) + " --bake " + bakePath() + " --scene " +
                                kScene + " --tls-cert " + tls + "/server.crt 2>&1",

@@ -217,6 +217,11 @@ TEST(LightSetValidation, RejectsBadTypesAndIds) {
     // A generated id collides with an explicit one just the same.
     expectError(R"({"lights":[{"type":"point","id":"light_1"},{"type":"point"}]})",
                 "lights[1].id \"light_1\" is used twice");
+    // An id names a light; it is not a payload (a 1 MiB one would reach the session database).
+    const std::string longest(kMaxLightIdBytes, 'x');
+    EXPECT_TRUE(parseLightSet(oneLight(R"("type":"point","id":")" + longest + "\"")));
+    expectError(oneLight(R"("type":"point","id":")" + longest + "x\""),
+                "lights[0].id is 129 bytes long; at most 128 are allowed");
 }
 
 TEST(LightSetValidation, RejectsBadNumbers) {
