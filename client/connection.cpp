@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <mutex>
+#include <random>
+#include <thread>
 #include <unistd.h>
 
 #include "core/gltf_loader.h"
@@ -22,6 +25,35 @@ namespace fs = std::filesystem;
 /// A deadline for unary calls: a server that hangs must not hang the client.
 void setDeadline(grpc::ClientContext& context) {
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+}
+
+/// Runs `call(context)` about `session` (a fresh context each try) again while it fails
+/// UNAVAILABLE (the server drains, the session moved, a replica went away) and `patience`
+/// has not passed, with backoff from 50 ms to 1 s. The session id goes in the metadata load
+/// balancers route by.
+template <class Call>
+grpc::Status retrying(std::chrono::milliseconds patience, const std::string& session, Call call) {
+    const auto start = std::chrono::steady_clock::now();
+    auto backoff = std::chrono::milliseconds(50);
+    for (;;) {
+        grpc::ClientContext context;
+        setDeadline(context);
+        if (!session.empty()) context.AddMetadata(wire::kSessionMetadata, session);
+        grpc::Status status = call(context);
+        if (status.error_code() != grpc::StatusCode::UNAVAILABLE ||
+            std::chrono::steady_clock::now() - start + backoff > patience)
+            return status;
+        std::this_thread::sleep_for(backoff);
+        backoff = std::min(backoff * 2, std::chrono::milliseconds(1000));
+    }
+}
+
+/// A new session id: 64 random bits as 16 lowercase hex digits.
+std::string drawSessionId() {
+    static std::mutex mutex;
+    static std::random_device random;
+    std::lock_guard lock(mutex);
+    return fmt::format("{:08x}{:08x}", uint32_t(random()), uint32_t(random()));
 }
 
 /// An asset name from the server as a path inside `folder`, or InvalidInput when it would
@@ -48,30 +80,68 @@ Result<void> writeFile(const fs::path& path, const std::string& bytes) {
 
 }  // namespace
 
-FrameStream::FrameStream(v1::Pic::Stub& stub, const v1::SubscribeRequest& request) {
-    mReader = stub.Subscribe(&mContext, request);
+FrameStream::FrameStream(v1::Pic::Stub& stub, v1::SubscribeRequest request,
+                         std::chrono::milliseconds patience)
+    : mStub(stub), mRequest(std::move(request)), mPatience(patience) {
+    std::lock_guard lock(mMutex);
+    start();
 }
 
 FrameStream::~FrameStream() {
-    if (!mFinished) {
-        mContext.TryCancel();
-        v1::Frame drained;
-        while (mReader->Read(&drained)) {
-        }
-        mReader->Finish();
+    if (!mFinished) finishCall();
+}
+
+void FrameStream::start() {
+    mContext = std::make_unique<grpc::ClientContext>();
+    mContext->AddMetadata(wire::kSessionMetadata, mRequest.session());
+    if (mCancelled) mContext->TryCancel();
+    mReader = mStub.Subscribe(mContext.get(), mRequest);
+}
+
+grpc::Status FrameStream::finishCall() {
+    {
+        std::lock_guard lock(mMutex);
+        mContext->TryCancel();
     }
+    v1::Frame drained;
+    while (mReader->Read(&drained)) {
+    }
+    return mReader->Finish();
 }
 
 bool FrameStream::next(v1::Frame& frame) {
     if (mFinished) return false;
-    if (mReader->Read(&frame)) return true;
-    mStatus = mReader->Finish();
-    mFinished = true;
-    return false;
+    // Patience counts from this call, which a frame ends: the time without frames.
+    const auto lastFrame = std::chrono::steady_clock::now();
+    auto backoff = std::chrono::milliseconds(50);
+    for (;;) {
+        if (mReader->Read(&frame)) return true;
+        grpc::Status status = mReader->Finish();
+        const grpc::StatusCode code = status.error_code();
+        const bool retryable = code == grpc::StatusCode::UNAVAILABLE ||
+                               code == grpc::StatusCode::INTERNAL ||
+                               code == grpc::StatusCode::UNKNOWN;
+        std::unique_lock lock(mMutex);
+        if (!retryable || mCancelled || mPatience.count() == 0 ||
+            std::chrono::steady_clock::now() - lastFrame + backoff > mPatience) {
+            mStatus = mCancelled ? grpc::Status(grpc::StatusCode::CANCELLED, "cancelled") : status;
+            mFinished = true;
+            return false;
+        }
+        mWake.wait_for(lock, backoff, [&] { return mCancelled; });
+        backoff = std::min(backoff * 2, std::chrono::milliseconds(2000));
+        ++mResubscriptions;
+        start();
+    }
 }
 
 void FrameStream::cancel() {
-    mContext.TryCancel();
+    {
+        std::lock_guard lock(mMutex);
+        mCancelled = true;
+        mContext->TryCancel();
+    }
+    mWake.notify_all();
 }
 
 grpc::Status FrameStream::status() {
@@ -112,52 +182,56 @@ Result<v1::ListBakesResponse> PicConnection::listBakes() {
 }
 
 Result<v1::CreateSessionResponse> PicConnection::createSession(const std::string& bakeId) {
-    grpc::ClientContext context;
-    setDeadline(context);
     v1::CreateSessionRequest request;
     request.set_bake_id(bakeId);
     v1::CreateSessionResponse response;
-    grpc::Status status = mStub->CreateSession(&context, request, &response);
+    // A new id each try: a try that failed on its way back may have created its session
+    // (which then idles out unused).
+    grpc::Status status = retrying(mPatience, "", [&](grpc::ClientContext& context) {
+        request.set_session(drawSessionId());
+        context.AddMetadata(wire::kSessionMetadata, request.session());
+        return mStub->CreateSession(&context, request, &response);
+    });
     if (!status.ok()) return std::unexpected(wire::fromStatus(status, "CreateSession"));
     return response;
 }
 
 Result<v1::JoinSessionResponse> PicConnection::joinSession(const std::string& session,
                                                            const std::string& token) {
-    grpc::ClientContext context;
-    setDeadline(context);
     v1::JoinSessionRequest request;
     request.set_session(session);
     request.set_token(token);
     v1::JoinSessionResponse response;
-    grpc::Status status = mStub->JoinSession(&context, request, &response);
+    grpc::Status status = retrying(mPatience, session, [&](grpc::ClientContext& context) {
+        return mStub->JoinSession(&context, request, &response);
+    });
     if (!status.ok()) return std::unexpected(wire::fromStatus(status, "JoinSession"));
     return response;
 }
 
 Result<v1::SessionStats> PicConnection::stats(const std::string& session,
                                              const std::string& token) {
-    grpc::ClientContext context;
-    setDeadline(context);
     v1::GetStatsRequest request;
     request.set_session(session);
     request.set_token(token);
     v1::SessionStats response;
-    grpc::Status status = mStub->GetStats(&context, request, &response);
+    grpc::Status status = retrying(mPatience, session, [&](grpc::ClientContext& context) {
+        return mStub->GetStats(&context, request, &response);
+    });
     if (!status.ok()) return std::unexpected(wire::fromStatus(status, "GetStats"));
     return response;
 }
 
 Result<uint64_t> PicConnection::setLights(const std::string& session, const std::string& token,
                                           const LightSet& lights) {
-    grpc::ClientContext context;
-    setDeadline(context);
     v1::SetLightsRequest request;
     request.set_session(session);
     request.set_token(token);
     *request.mutable_lights() = wire::toProto(lights);
     v1::SetLightsResponse response;
-    grpc::Status status = mStub->SetLights(&context, request, &response);
+    grpc::Status status = retrying(mPatience, session, [&](grpc::ClientContext& context) {
+        return mStub->SetLights(&context, request, &response);
+    });
     if (!status.ok()) return std::unexpected(wire::fromStatus(status, "SetLights"));
     return response.version();
 }
@@ -321,11 +395,12 @@ Result<ClientScene> PicConnection::fetchScene(const std::string& bakeId,
 }
 
 std::unique_ptr<FrameStream> PicConnection::subscribe(const std::string& session,
-                                                      const std::string& token) {
+                                                      const std::string& token,
+                                                      std::chrono::milliseconds patience) {
     v1::SubscribeRequest request;
     request.set_session(session);
     request.set_token(token);
-    return std::make_unique<FrameStream>(*mStub, request);
+    return std::make_unique<FrameStream>(*mStub, std::move(request), patience);
 }
 
 Result<v1::SceneHeader> PicConnection::sceneHeader(const std::string& bakeId) {

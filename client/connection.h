@@ -4,9 +4,12 @@
 /// textures the server computed.
 
 #include <array>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -36,10 +39,17 @@ struct ClientScene {
     CacheIndexMaps indexMaps() const;
 };
 
-/// One Subscribe call: frames as they arrive, until the stream ends or is cancelled.
+/// A Subscribe stream: frames as they arrive, until the stream ends or is cancelled.
+///
+/// With a `patience`, a stream the server ends UNAVAILABLE (it is draining, or the session
+/// moved to another replica) or that breaks (INTERNAL, UNKNOWN: a proxy lost its upstream) is
+/// subscribed again, with backoff from 50 ms to 2 s, until a frame arrives or `patience`
+/// passes without one. The first frame after a resubscription is a key frame of the latest
+/// version, which a FrameDecoder takes whatever it held.
 class FrameStream {
 public:
-    FrameStream(v1::Pic::Stub& stub, const v1::SubscribeRequest& request);
+    FrameStream(v1::Pic::Stub& stub, v1::SubscribeRequest request,
+                std::chrono::milliseconds patience = std::chrono::milliseconds(0));
     ~FrameStream();
 
     /// Blocks for the next frame into `frame`; false when the stream has ended (status() says
@@ -49,12 +59,26 @@ public:
     void cancel();
     /// The stream's final status, once next() returned false.
     grpc::Status status();
+    /// How many times the stream was subscribed again.
+    uint32_t resubscriptions() const { return mResubscriptions; }
 
 private:
-    grpc::ClientContext mContext;
+    /// Starts a call (under mMutex).
+    void start();
+    /// Ends the current call: cancels and drains it, and returns its status.
+    grpc::Status finishCall();
+
+    v1::Pic::Stub& mStub;
+    const v1::SubscribeRequest mRequest;
+    const std::chrono::milliseconds mPatience;
+    std::mutex mMutex;  ///< guards the context against cancel() from another thread
+    std::condition_variable mWake;  ///< cancel() ends a backoff wait
+    bool mCancelled = false;
+    std::unique_ptr<grpc::ClientContext> mContext;
     std::unique_ptr<grpc::ClientReader<v1::Frame>> mReader;
     bool mFinished = false;
     grpc::Status mStatus;
+    std::atomic<uint32_t> mResubscriptions{0};
 };
 
 /// A channel to one picserver and its calls, each returning the server's refusal as an Error
@@ -68,6 +92,13 @@ public:
         const std::string& rootCertsPem = "");
 
     const std::string& address() const { return mAddress; }
+    /// How long session calls (create, join, stats, set lights) go on trying while the
+    /// server answers UNAVAILABLE: it drains, the session moved to another replica, a replica
+    /// behind the load balancer went away. 0 (the default): one try. A retried SetLights that
+    /// had been applied before its reply was lost is applied again as a newer version of the
+    /// same set.
+    void setPatience(std::chrono::milliseconds patience) { mPatience = patience; }
+    std::chrono::milliseconds patience() const { return mPatience; }
     v1::Pic::Stub& stub() { return *mStub; }
 
     Result<v1::ListBakesResponse> listBakes();
@@ -87,8 +118,10 @@ public:
     Result<v1::SceneHeader> sceneHeader(const std::string& bakeId);
     /// The session's counters (GetStats).
     Result<v1::SessionStats> stats(const std::string& session, const std::string& token);
-    /// Starts a Subscribe stream.
-    std::unique_ptr<FrameStream> subscribe(const std::string& session, const std::string& token);
+    /// Starts a Subscribe stream; with a `patience`, one that subscribes again when the server
+    /// sends it elsewhere (FrameStream).
+    std::unique_ptr<FrameStream> subscribe(const std::string& session, const std::string& token,
+                                           std::chrono::milliseconds patience = std::chrono::milliseconds(0));
 
 private:
     /// GetScene: the header, and the assets written under `folder` unless `headerOnly`.
@@ -96,6 +129,7 @@ private:
                                      const std::string& folder);
 
     std::string mAddress;
+    std::chrono::milliseconds mPatience{0};
     std::shared_ptr<grpc::Channel> mChannel;
     std::unique_ptr<v1::Pic::Stub> mStub;
 };

@@ -117,7 +117,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     std::vector<Received> received(options.clients);
     std::vector<std::thread> threads;
     for (uint32_t i = 0; i < options.clients; ++i) {
-        streams.push_back(connection.subscribe(session, editor));
+        streams.push_back(connection.subscribe(session, editor, connection.patience()));
         threads.emplace_back(subscribeLoop, std::ref(*streams.back()), std::cref(header),
                              std::ref(received[i]), std::ref(ready), std::ref(mutex));
     }

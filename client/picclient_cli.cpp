@@ -40,12 +40,18 @@ struct Common {
     std::string session;
     std::string token;
     double connectSeconds = 10;
+    double patienceSeconds = 30;
 };
 
 void addServer(CLI::App& app, Common& common) {
     app.add_option("--server", common.server, "picserver address HOST:PORT");
     app.add_option("--connect-timeout", common.connectSeconds, "seconds to wait for the server")
         ->check(CLI::PositiveNumber);
+    app.add_option("--patience", common.patienceSeconds,
+                   "seconds to go on trying (with backoff) while the server answers UNAVAILABLE: "
+                   "it drains, or a replica behind the load balancer went away; streams "
+                   "subscribe again; 0: give up at once")
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--tls-ca", common.tlsCa,
                    "connect with TLS, trusting the certificates in this PEM file")
         ->check(CLI::ExistingFile);
@@ -56,6 +62,10 @@ void addSession(CLI::App& app, Common& common) {
     app.add_option("--token", common.token, "the session's editor or viewer token")->required();
 }
 
+std::chrono::milliseconds patienceOf(const Common& common) {
+    return std::chrono::milliseconds(int64_t(common.patienceSeconds * 1000.0));
+}
+
 Result<std::unique_ptr<PicConnection>> connectTo(const Common& common) {
     std::string rootCerts;
     if (!common.tlsCa.empty()) {
@@ -64,9 +74,12 @@ Result<std::unique_ptr<PicConnection>> connectTo(const Common& common) {
         if (rootCerts.empty())
             return fail(ErrorCode::InvalidInput, "--tls-ca {} is empty or unreadable", common.tlsCa);
     }
-    return PicConnection::connect(
-        common.server, std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)),
-        rootCerts);
+    PIC_TRY_ASSIGN(auto connection,
+                   PicConnection::connect(common.server,
+                                          std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)),
+                                          rootCerts));
+    connection->setPatience(patienceOf(common));
+    return connection;
 }
 
 int runSession(const Common& common, const std::string& bakeId) {
@@ -99,7 +112,7 @@ int runWatch(const Common& common, uint64_t count, double seconds) {
     if (!joined) return reportError(joined.error());
     auto header = connection->sceneHeader(joined->bake_id());
     if (!header) return reportError(header.error());
-    auto stream = connection->subscribe(common.session, common.token);
+    auto stream = connection->subscribe(common.session, common.token, patienceOf(common));
     FrameDecoder decoder(*header);
     v1::Frame frame;
     uint64_t frames = 0;
@@ -226,7 +239,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!camera) return reportError(camera.error());
 
     // Subscribe first, then push: the wait below measures the light change to the frame.
-    auto stream = connection->subscribe(common.session, common.token);
+    auto stream = connection->subscribe(common.session, common.token, patienceOf(common));
     uint64_t wanted = joined->version();
     LightSet lights;
     const auto pushStart = Clock::now();

@@ -197,6 +197,10 @@ const char* statusName(grpc::StatusCode code) {
 
 }  // namespace
 
+bool isSessionId(const std::string& id) {
+    return id.size() == 16 && id.find_first_not_of("0123456789abcdef") == std::string::npos;
+}
+
 Error fromStatus(const grpc::Status& status, const std::string& call) {
     ErrorCode code = ErrorCode::Internal;
     switch (status.error_code()) {

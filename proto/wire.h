@@ -13,6 +13,13 @@
 
 namespace pic::wire {
 
+/// The request metadata that carries a call's session id, for load balancers that route by
+/// session (proto/pic.proto, "Routing").
+inline constexpr const char* kSessionMetadata = "pic-session";
+
+/// Whether `id` is a session id as servers draw them: 16 lowercase hex digits.
+bool isSessionId(const std::string& id);
+
 /// A light set as the wire carries it: only the fields each light type uses, no range for
 /// "no cut-off".
 v1::LightSet toProto(const LightSet& lights);

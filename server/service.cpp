@@ -403,8 +403,18 @@ public:
         if (!bake)
             return finish(context, grpc::Status(grpc::StatusCode::NOT_FOUND,
                                                 fmt::format("no bake \"{}\"", request->bake_id())));
+        // An id the client drew (behind a load balancer: the one it routed by), else ours.
+        const std::string& wanted = request->session();
+        if (!wanted.empty() && !wire::isSessionId(wanted))
+            return finish(context, grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                                fmt::format("session \"{}\" is not 16 lowercase "
+                                                            "hex digits",
+                                                            wanted.substr(0, 64))));
+        const grpc::Status taken(grpc::StatusCode::ALREADY_EXISTS,
+                                 fmt::format("session \"{}\" exists already", wanted));
         {
             std::lock_guard lock(mState->mutex);
+            if (!wanted.empty() && mState->sessions.contains(wanted)) return finish(context, taken);
             if (!mState->hasRoom())
                 return finish(context,
                               grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
@@ -412,15 +422,19 @@ public:
                                                        mState->options.maxSessions)));
             ++mState->creating;
         }
-        // The session is in the database before anyone hears of it; an id another server's
-        // session holds is drawn again.
+        // The session is in the database before anyone hears of it; an id of ours that
+        // another server's session holds is drawn again.
         std::string id, editorToken, viewerToken;
         grpc::Status status(grpc::StatusCode::UNAVAILABLE, "no free session id");
         for (int attempt = 0; attempt < 4 && !status.ok(); ++attempt) {
             {
                 std::lock_guard lock(mState->mutex);
-                do id = mState->randomHex(2);
-                while (mState->sessions.contains(id));
+                if (wanted.empty()) {
+                    do id = mState->randomHex(2);
+                    while (mState->sessions.contains(id));
+                } else {
+                    id = wanted;
+                }
                 editorToken = mState->randomHex(4);
                 viewerToken = mState->randomHex(4);
             }
@@ -435,12 +449,18 @@ public:
                 status = mState->storeFailed(created.error());
                 break;
             }
-            if (*created) status = grpc::Status::OK;
+            if (*created) {
+                status = grpc::Status::OK;
+            } else if (!wanted.empty()) {  // the client's id is another server's session
+                status = taken;
+                break;
+            }
         }
         std::shared_ptr<Session> session;
         {
             std::lock_guard lock(mState->mutex);
             --mState->creating;
+            if (status.ok() && mState->sessions.contains(id)) status = taken;  // raced for it
             if (status.ok()) {
                 session = std::make_shared<Session>(id, tokenDigest(editorToken),
                                                     tokenDigest(viewerToken), *bake,

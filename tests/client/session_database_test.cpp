@@ -108,6 +108,60 @@ TEST(SessionDatabase, APathThatCannotHoldTheDatabaseIsRefused) {
     EXPECT_TRUE(SessionStore::checkPath((dir / "sessions.db").string()));
 }
 
+// A client with patience carries on across a restart of its server: the stream that the
+// drain ends UNAVAILABLE subscribes again once the server is back on its address (a key
+// frame of the restored version), and a light set sent while it is away goes through.
+TEST(SessionDatabase, AClientWithPatienceCarriesOnAcrossARestart) {
+    const test::ScratchDir dir("pic_sessions_patience");
+    const std::string db = (dir / "sessions.db").string();
+    ServerOptions options;
+    options.dbPath = db;
+    Served first = serveWith(options);
+    ASSERT_TRUE(first.connection);
+    const std::string address = first.server->address();
+    auto connection = PicConnection::connect(address);
+    ASSERT_TRUE(connection);
+    (*connection)->setPatience(30s);
+    auto session = (*connection)->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    const std::string id = session->session(), editor = session->editor_token();
+    const v1::SceneHeader header = sceneHeaderOf(**connection);
+    auto stream = (*connection)->subscribe(id, session->viewer_token(), 30s);
+    FrameDecoder decoder(header);
+    v1::Frame frame;
+    ASSERT_TRUE(stream->next(frame));
+    ASSERT_TRUE(decoder.apply(frame));
+    EXPECT_EQ(decoder.version(), 1u);
+
+    first.connection.reset();
+    first.server.reset();  // drained: the stream ends UNAVAILABLE and tries again
+    std::thread restart([&] {
+        std::this_thread::sleep_for(500ms);
+        ServeOptions serveOptions;
+        serveOptions.backend = "cpu";
+        serveOptions.bounces.bounces = 1;
+        auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
+        ASSERT_TRUE(bake);
+        std::vector<std::unique_ptr<ServedBake>> bakes;
+        bakes.push_back(std::move(*bake));
+        auto server = PicServer::start(std::move(bakes), address, options);
+        ASSERT_TRUE(server) << server.error().message;
+        first.server = std::move(*server);
+    });
+    // Sent while the server is away: retried until it is back.
+    auto version = (*connection)->setLights(id, editor, pointLight(0.3f));
+    restart.join();
+    ASSERT_TRUE(version) << version.error().message;
+    EXPECT_EQ(*version, 3u) << "restored at 2, then this set";
+    while (decoder.version() < *version) {
+        ASSERT_TRUE(stream->next(frame)) << stream->status().error_message();
+        ASSERT_TRUE(decoder.apply(frame));
+    }
+    EXPECT_GE(stream->resubscriptions(), 1u);
+    EXPECT_EQ(lightsOf(**connection, id, editor), toJson(pointLight(0.3f)));
+    stream->cancel();
+}
+
 // Two servers on one file would each overwrite the other's sessions: the second is refused
 // at start, naming the file.
 TEST(SessionDatabase, TwoServersOnOneFileAreRefused) {

@@ -53,9 +53,11 @@ v1::SceneHeader sceneHeaderOf(PicConnection& connection);
 /// Reads frames on its own thread, decoding each, until cancelled.
 class Reader {
 public:
-    Reader(PicConnection& connection, const std::string& session, const std::string& token)
+    /// With a `patience`, the stream subscribes again when sent elsewhere (FrameStream).
+    Reader(PicConnection& connection, const std::string& session, const std::string& token,
+           std::chrono::milliseconds patience = std::chrono::milliseconds(0))
         : mDecoder(sceneHeaderOf(connection)),
-          mStream(connection.subscribe(session, token)),
+          mStream(connection.subscribe(session, token, patience)),
           mThread([this] { run(); }) {}
     ~Reader() {
         mStream->cancel();

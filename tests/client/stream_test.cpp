@@ -409,6 +409,28 @@ TEST(Stream, TokensAndRoles) {
     EXPECT_EQ(stream->status().error_code(), grpc::StatusCode::UNAUTHENTICATED);
 }
 
+// A client behind a load balancer draws the session id it routes by: the server takes it,
+// once; an id of another form is refused. Every session call carries it as metadata.
+TEST(Stream, CreateSessionTakesTheIdTheClientDrewOnce) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    const auto create = [&](const std::string& id) {
+        grpc::ClientContext context;
+        v1::CreateSessionRequest request;
+        request.set_session(id);
+        v1::CreateSessionResponse response;
+        const grpc::Status status = served.connection->stub().CreateSession(&context, request, &response);
+        return status.ok() ? response.session() : "status " + std::to_string(int(status.error_code()));
+    };
+    EXPECT_EQ(create("0123456789abcdef"), "0123456789abcdef");
+    EXPECT_EQ(create("0123456789abcdef"), "status " + std::to_string(int(grpc::StatusCode::ALREADY_EXISTS)));
+    for (const char* bad : {"0123456789ABCDEF", "0123", "0123456789abcdef0", "../../etc/passwd0"})
+        EXPECT_EQ(create(bad), "status " + std::to_string(int(grpc::StatusCode::INVALID_ARGUMENT))) << bad;
+    auto drawn = served.connection->createSession();
+    ASSERT_TRUE(drawn);
+    EXPECT_TRUE(wire::isSessionId(drawn->session())) << drawn->session();
+}
+
 TEST(Stream, MalformedLightSetsAreInvalidArgumentNamingTheField) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
