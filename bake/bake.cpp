@@ -1,9 +1,11 @@
 #include "bake/bake.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include "bake/grid_caches.h"
@@ -49,15 +51,14 @@ constexpr uint32_t kDefaultBandsC = 2;
 
 }  // namespace
 
-uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidAngle) {
+uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel) {
     const uint32_t nL = bake.links.linksPerCache;
     const size_t nC = bake.caches.size();
-    // Links of a cache are packed from its first slot, so a cache is blind when its first
-    // link sees nothing.
+    PIC_CHECK(seesSurfel.size() == nC);
     std::vector<uint32_t> remap(nC, kNoCache);
     uint32_t kept = 0;
     for (size_t c = 0; c < nC; ++c)
-        if (visibleSolidAngle[c * nL] > 0.0f) remap[c] = kept++;
+        if (seesSurfel[c]) remap[c] = kept++;
     const uint32_t dropped = static_cast<uint32_t>(nC - kept);
     if (dropped == 0) return 0;
 
@@ -202,7 +203,35 @@ Result<std::vector<Surfel>> placeBakeSurfels(const Scene& scene, const EmbreeSce
     }
 }
 
-Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report) {
+std::pair<uint64_t, uint64_t> shardCaches(uint64_t nC, BakeShard shard) {
+    // nC < 2³² and count ≤ kMaxShards: the products cannot overflow.
+    return {nC * shard.index / shard.count, nC * (shard.index + 1) / shard.count};
+}
+
+Result<BakeShard> parseBakeShard(const std::string& text) {
+    const auto fromText = [](std::string_view digits, uint32_t& value) {
+        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+        return !digits.empty() && ec == std::errc{} && end == digits.data() + digits.size();
+    };
+    const size_t slash = text.find('/');
+    BakeShard shard;
+    if (slash == std::string::npos || !fromText(std::string_view(text).substr(0, slash), shard.index) ||
+        !fromText(std::string_view(text).substr(slash + 1), shard.count))
+        return fail(ErrorCode::InvalidInput, "--shard {}: expected I/N, e.g. 0/4", text);
+    if (shard.count == 0 || shard.count > kMaxShards)
+        return fail(ErrorCode::InvalidInput, "--shard {}: the shard count must be 1 to {}", text,
+                    kMaxShards);
+    if (shard.index >= shard.count)
+        return fail(ErrorCode::InvalidInput,
+                    "--shard {}: shards are numbered 0 to {} (as a Kubernetes Indexed Job's "
+                    "JOB_COMPLETION_INDEX)",
+                    text, shard.count - 1);
+    return shard;
+}
+
+Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, BakeShard shard,
+                             BakeReport& report) {
+    PIC_CHECK(shard.count > 0 && shard.index < shard.count);
     BakeData bake;
     PIC_TRY_ASSIGN(bake.params, resolveBakeParams(scene, options, bake.defaults));
     BakeParams& p = bake.params;
@@ -290,14 +319,143 @@ Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeRep
     linkParams.seed = p.seed;
     linkParams.reads = p.linkReads;
     linkParams.cut = p.linkCut;
+    BakePart part;
+    part.index = shard.index;
+    part.count = shard.count;
+    std::tie(part.cacheBegin, part.cacheEnd) = shardCaches(bake.caches.size(), shard);
+    linkParams.cacheBegin = part.cacheBegin;
+    linkParams.cacheEnd = part.cacheEnd;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
+    // Links of a cache are packed from its first slot, so a cache sees a surfel when its first
+    // link does.
+    part.seesSurfel.resize(part.cacheEnd - part.cacheBegin);
+    for (size_t c = 0; c < part.seesSurfel.size(); ++c)
+        part.seesSurfel[c] = links.visibleSolidAngle[c * p.linksPerCache] > 0.0f;
     bake.links = std::move(links.links);
     bake.surfelWeights = weights.empty() ? std::vector<float>(bake.surfels.size(), 1.0f) : weights;
     report.links = links.stats;
-    report.blindCachesDropped = dropBlindCaches(bake, links.visibleSolidAngle);
     linkTimer.stop();
 
+    part.bake = std::move(bake);
     report.peakMemoryBytes = peakMemoryBytes();
+    return part;
+}
+
+Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report) {
+    PIC_TRY_ASSIGN(BakePart part, runBakePart(scene, options, BakeShard{}, report));
+    BakeJoiner joiner;
+    PIC_TRY(joiner.add(std::move(part), "the bake"));
+    return joiner.finish(report.blindCachesDropped);
+}
+
+namespace {
+
+template <class T>
+bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+/// What two parts' shared arrays first differ in, if anything.
+std::optional<std::string_view> firstDifference(const BakeData& a, const BakeData& b) {
+    if (a.sceneHash != b.sceneHash) return "scene hash";
+    if (!(a.params == b.params) || a.defaults != b.defaults) return "parameters";
+    if (!sameBytes(a.surfels, b.surfels)) return "surfels";
+    if (!sameBytes(a.surfelWeights, b.surfelWeights)) return "surfel flux weights";
+    if (!sameBytes(a.nodes, b.nodes) || a.levelOffsets != b.levelOffsets) return "hierarchy";
+    if (!sameBytes(a.caches, b.caches)) return "caches";
+    const GridLayout &ga = a.grid, &gb = b.grid;
+    if (ga.origin != gb.origin || ga.cellSize != gb.cellSize || ga.dims != gb.dims ||
+        ga.cacheIndex != gb.cacheIndex)
+        return "grid";
+    const LightmapLayout &la = a.lightmap, &lb = b.lightmap;
+    if (la.width != lb.width || la.height != lb.height || la.texelSize != lb.texelSize ||
+        la.chartCount != lb.chartCount || la.cacheIndex != lb.cacheIndex ||
+        !sameBytes(la.triangleUvs, lb.triangleUvs))
+        return "light map";
+    if (a.links.mode != b.links.mode || a.links.linksPerCache != b.links.linksPerCache ||
+        a.links.bands != b.links.bands)
+        return "link layout";
+    return std::nullopt;
+}
+
+/// Copies `from`, the links of caches [first, first + n), into `to`, which holds every cache's.
+void placeLinks(LinkSet& to, const LinkSet& from, uint64_t first) {
+    const size_t nL = to.linksPerCache;
+    const size_t coefficients = size_t{to.bands} * to.bands;
+    std::ranges::copy(from.rtp, to.rtp.begin() + first * nL);
+    std::ranges::copy(from.shNodes, to.shNodes.begin() + first * nL);
+    std::ranges::copy(from.shCoefficients, to.shCoefficients.begin() + first * nL * coefficients);
+    std::ranges::copy(from.tint, to.tint.begin() + first * nL);
+    std::ranges::copy(from.offset, to.offset.begin() + first * nL * 3);
+    std::ranges::copy(from.spreadShare, to.spreadShare.begin() + first * nL);
+}
+
+}  // namespace
+
+Result<void> BakeJoiner::add(BakePart part, const std::string& name) {
+    const uint64_t nC = part.bake.caches.size();
+    if (mBake) {
+        const std::string& first = *std::ranges::find_if(mNames, [](const auto& n) { return !n.empty(); });
+        if (part.count != mNames.size())
+            return fail(ErrorCode::InvalidInput, "{} is shard {} of {}, {} one of {}", name, part.index,
+                        part.count, first, mNames.size());
+        if (const auto difference = firstDifference(*mBake, part.bake))
+            return fail(ErrorCode::InvalidInput,
+                        "{} and {} differ in their {}: they are parts of different bakes (scene, "
+                        "options, seed or picbake build); bake every shard with the same command",
+                        first, name, *difference);
+    } else {
+        mNames.resize(part.count);
+    }
+    if (!mNames[part.index].empty())
+        return fail(ErrorCode::InvalidInput, "{} and {} are both shard {} of {}", mNames[part.index],
+                    name, part.index, part.count);
+    const auto [begin, end] = shardCaches(nC, BakeShard{part.index, part.count});
+    if (part.cacheBegin != begin || part.cacheEnd != end)
+        return fail(ErrorCode::InvalidInput, "{} links caches [{}, {}); shard {} of {} links [{}, {})",
+                    name, part.cacheBegin, part.cacheEnd, part.index, part.count, begin, end);
+    mNames[part.index] = name;
+
+    if (!mBake) {
+        mSees.assign(nC, 0);
+        mBake = std::move(part.bake);
+        if (part.count > 1) {
+            // Room for every cache's links; this part's go in their place below.
+            LinkSet& links = mBake->links;
+            LinkSet own = std::move(links);
+            links = LinkSet{own.mode, own.linksPerCache, own.bands};
+            const size_t nLinks = nC * own.linksPerCache;
+            if (own.mode == LinkMode::Rtp) {
+                links.rtp.assign(nLinks, RtpLink{0, 0.0f, 0, 0.0f});
+            } else {
+                links.shNodes.assign(nLinks, 0u);
+                links.shCoefficients.assign(nLinks * own.bands * own.bands, 0u);
+            }
+            links.tint.assign(nLinks, 0u);
+            links.offset.assign(nLinks * 3, 0u);
+            links.spreadShare.assign(nLinks, 0u);
+            placeLinks(links, own, begin);
+        }
+    } else {
+        placeLinks(mBake->links, part.bake.links, begin);
+    }
+    std::ranges::copy(part.seesSurfel, mSees.begin() + begin);
+    return {};
+}
+
+Result<BakeData> BakeJoiner::finish(uint32_t& dropped) {
+    if (!mBake) return fail(ErrorCode::InvalidInput, "no part of a sharded bake was given");
+    std::vector<size_t> missing;
+    for (size_t i = 0; i < mNames.size(); ++i)
+        if (mNames[i].empty()) missing.push_back(i);
+    if (!missing.empty())
+        return fail(ErrorCode::InvalidInput, "{} of {} missing: the merge needs every part",
+                    fmt::format("shard{} {}", missing.size() > 1 ? "s" : "", fmt::join(missing, ", ")),
+                    mNames.size());
+    BakeData bake = std::move(*mBake);
+    mBake.reset();
+    dropped = dropBlindCaches(bake, mSees);
     return bake;
 }
 

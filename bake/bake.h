@@ -9,6 +9,7 @@
 
 #include "bake/link_generation.h"
 #include "core/bake_data.h"
+#include "core/bake_file.h"
 #include "core/error.h"
 #include "core/scene.h"
 
@@ -74,10 +75,47 @@ Result<std::vector<Surfel>> placeBakeSurfels(const Scene& scene, const EmbreeSce
 /// Runs every bake stage on a loaded scene.
 Result<BakeData> runBake(const Scene& scene, const BakeOptions& options, BakeReport& report);
 
+/// Which caches one process links in a sharded bake: shard `index` of `count` (from 0, as a
+/// Kubernetes Indexed Job numbers its pods) links caches [nC·index/count, nC·(index+1)/count).
+/// Every shard runs the stages before the links in full; they are deterministic.
+struct BakeShard {
+    uint32_t index = 0;
+    uint32_t count = 1;
+};
+
+/// The caches [first, second) that `shard` links of nC.
+std::pair<uint64_t, uint64_t> shardCaches(uint64_t nC, BakeShard shard);
+
+/// Parses "I/N" (0 ≤ I < N ≤ kMaxShards), naming the value when it is not one.
+Result<BakeShard> parseBakeShard(const std::string& text);
+inline constexpr uint32_t kMaxShards = 4096;
+
+/// Runs every bake stage, linking the caches of `shard` only (BakePart, core/bake_file.h).
+Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, BakeShard shard,
+                             BakeReport& report);
+
+/// Joins the parts of a sharded bake, given one at a time in any order, into the bake runBake
+/// makes of the same scene and options, byte for byte. Refuses a part of another bake (scene,
+/// options, seed or build), a shard given twice, and finishing with a shard missing. Holds
+/// one part's arrays and the links of all, not every part at once.
+class BakeJoiner {
+public:
+    /// `name` names the part in messages (its path).
+    Result<void> add(BakePart part, const std::string& name);
+    /// The whole bake, its blind caches dropped (dropBlindCaches; how many in `dropped`).
+    Result<BakeData> finish(uint32_t& dropped);
+
+private:
+    std::optional<BakeData> mBake;   ///< the first part's, its links grown to every cache
+    std::vector<uint8_t> mSees;      ///< per cache: its links see a surfel
+    std::vector<std::string> mNames; ///< per shard: the part given for it, empty while missing
+};
+
 /// Removes caches whose links see no surfel (e.g. on the outside of a room's walls): their
 /// radiance is zero whatever the lights, so their grid vertices and light-map texels become
-/// kNoCache, which the runtime reads as zero. Returns how many were dropped.
-uint32_t dropBlindCaches(BakeData& bake, const std::vector<float>& visibleSolidAngle);
+/// kNoCache, which the runtime reads as zero. `seesSurfel` holds one flag per cache. Returns
+/// how many were dropped.
+uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel);
 
 /// Peak resident memory of this process so far, in bytes (0 if unknown).
 uint64_t peakMemoryBytes();

@@ -773,8 +773,12 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                                                        : std::vector<float>{};
     const std::vector<float>& fluxWeight = weights.empty() ? uniform : weights;
 
+    if (params.cacheBegin > std::min(params.cacheEnd, caches.size()))
+        return fail(ErrorCode::InvalidInput, "cache range [{}, {}) starts past the {} caches",
+                    params.cacheBegin, params.cacheEnd, caches.size());
     const uint32_t nL = params.linksPerCache;
-    const size_t nC = caches.size();
+    const size_t first = params.cacheBegin;
+    const size_t nC = std::min(params.cacheEnd, caches.size()) - first;  // caches linked here
     const int bands = static_cast<int>(params.bands);
     const int coefficients = shCount(bands);
 
@@ -808,7 +812,8 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
         std::vector<float> sh(coefficients);
         uint64_t rayCount = 0;
         for (size_t c = begin; c < end; ++c) {
-            rayCount += linker.link(static_cast<uint32_t>(c), caches[c], scratch, chosen);
+            const Cache& cache = caches[first + c];
+            rayCount += linker.link(static_cast<uint32_t>(first + c), cache, scratch, chosen);
             if (chosen.empty()) blind.fetch_add(1, std::memory_order_relaxed);
             used[c] = static_cast<uint32_t>(chosen.size());
             for (size_t l = 0; l < chosen.size(); ++l) {
@@ -834,17 +839,17 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
                     link.oneMinusCosAlpha = std::min(2.0f, e.unoccluded / (2.0f * kPi));
                     glm::vec3 direction = glm::normalize(e.directionSum);
                     if (params.reads == LinkReads::Visible &&
-                        caches[c].kind == gpu::kCacheKindLightmap && e.exact &&
+                        cache.kind == gpu::kCacheKindLightmap && e.exact &&
                         e.sampleCount > 0) {
                         double along = 0.0, total = 0.0;
                         for (uint32_t j = 0; j < e.sampleCount; ++j) {
                             const VisibleSample& s = scratch.samples[e.sampleBegin + j];
                             along += double(s.share) *
-                                     readWeight.kernel(glm::dot(caches[c].normal, s.direction));
+                                     readWeight.kernel(glm::dot(cache.normal, s.direction));
                             total += s.share;
                         }
                         if (total > 0.0)
-                            direction = alongNormalDirection(readWeight, caches[c].normal, direction,
+                            direction = alongNormalDirection(readWeight, cache.normal, direction,
                                                              link.oneMinusCosAlpha, along / total);
                     }
                     link.directionOct = encodeOctahedral(direction);

@@ -26,6 +26,11 @@ struct LinkParams {
     LinkReads reads = LinkReads::Visible;
     LinkCut cut = LinkCut::ErrorBound;
     uint64_t seed = 1;
+    /// Links caches [cacheBegin, min(cacheEnd, nC)) only (one shard of a bake); the LinkSet
+    /// and visibleSolidAngle then hold that many caches. A cache's links depend on its index,
+    /// not on the range.
+    size_t cacheBegin = 0;
+    size_t cacheEnd = SIZE_MAX;
 };
 
 /// Per-link diagnostics that the bake file does not keep (for tests and statistics).
@@ -41,7 +46,7 @@ struct LinkStats {
 struct LinkResult {
     LinkSet links;
     LinkStats stats;
-    std::vector<float> visibleSolidAngle;  ///< per link (nC·nL), sr; 0 for padding
+    std::vector<float> visibleSolidAngle;  ///< per link (nC·nL of the range), sr; 0 for padding
 };
 
 /// Builds the links of every cache against the hierarchy (surfels in leaf order). A link reads

@@ -18,6 +18,7 @@
 #include "core/gltf_loader.h"
 #include "core/image.h"
 #include "core/parallel.h"
+#include "core/progress.h"
 
 namespace pic {
 
@@ -86,6 +87,30 @@ void printTarget(const TargetChoice& choice, const TargetErrorParams& params) {
                      params.budgetMs ? " within the budget" : "", chosen.name.c_str(), chosen.error);
 }
 
+/// Writes the stage timings of `report` beside `outPath`; returns their total.
+double writeTimings(const BakeReport& report, const std::string& outPath) {
+    Json timings;
+    timings["seconds"] = Json::object();
+    double total = 0.0;
+    for (const auto& [stage, s] : report.seconds) {
+        timings["seconds"][stage] = s;
+        total += s;
+    }
+    timings["seconds_total"] = total;
+    timings["peak_memory_bytes"] = report.peakMemoryBytes;
+    timings["threads"] = workerCount();
+    writeBeside(timings, timingsPath(outPath));
+    return total;
+}
+
+/// "load 0.12, rays 0.40, …"
+std::string stageList(const BakeReport& report) {
+    std::string stages;
+    for (const auto& [stage, s] : report.seconds)
+        stages += fmt::format("{}{} {:.2f}", stages.empty() ? "" : ", ", stage, s);
+    return stages;
+}
+
 int runBakeCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options,
                    const std::optional<TargetErrorParams>& target) {
     using Clock = std::chrono::steady_clock;
@@ -118,17 +143,7 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     if (auto written = writeBakeFile(outPath, *bake); !written) return reportError(written.error());
     report.seconds.emplace_back("write", std::chrono::duration<double>(Clock::now() - writeStart).count());
 
-    Json timings;
-    timings["seconds"] = Json::object();
-    double total = 0.0;
-    for (const auto& [stage, s] : report.seconds) {
-        timings["seconds"][stage] = s;
-        total += s;
-    }
-    timings["seconds_total"] = total;
-    timings["peak_memory_bytes"] = report.peakMemoryBytes;
-    timings["threads"] = workerCount();
-    writeBeside(timings, timingsPath(outPath));
+    const double total = writeTimings(report, outPath);
     std::error_code ec;
     if (choice)
         writeBeside(targetJson(*choice, *target), targetPath(outPath));
@@ -196,15 +211,80 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     for (const auto& [name, bytes] : info->sectionBytes)
         sections += fmt::format("{}{} {}", sections.empty() ? "" : ", ", name, humanBytes(bytes));
     fmt::print("  bytes           {} total: {}\n", humanBytes(info->fileSize), sections);
-    std::string stages;
-    for (const auto& [stage, s] : report.seconds)
-        stages += fmt::format("{}{} {:.2f}", stages.empty() ? "" : ", ", stage, s);
-    fmt::print("  seconds         {} (total {:.2f}) on {} threads\n", stages, total, workerCount());
+    fmt::print("  seconds         {} (total {:.2f}) on {} threads\n", stageList(report), total, workerCount());
     fmt::print("  peak memory     {}\n", humanBytes(report.peakMemoryBytes));
     if (choice) printTarget(*choice, *target);
     if (report.links.clampedCoefficients)
         fmt::print("  warning         {} SH link coefficients exceeded the half-float range and were clamped\n",
                    report.links.clampedCoefficients);
+    return 0;
+}
+
+/// `picbake bake … --shard I/N`: every stage, the links of one shard's caches.
+int runBakeShardCommand(const std::string& scenePath, const std::string& outPath, const BakeOptions& options,
+                        BakeShard shard) {
+    using Clock = std::chrono::steady_clock;
+    auto start = Clock::now();
+    auto scene = loadScene(scenePath);
+    if (!scene) return reportError(scene.error());
+    BakeReport report;
+    report.seconds.emplace_back("load", std::chrono::duration<double>(Clock::now() - start).count());
+    auto part = runBakePart(*scene, options, shard, report);
+    if (!part) return reportError(part.error());
+    auto writeStart = Clock::now();
+    if (auto written = writeBakePart(outPath, *part); !written) return reportError(written.error());
+    report.seconds.emplace_back("write", std::chrono::duration<double>(Clock::now() - writeStart).count());
+    const double total = writeTimings(report, outPath);
+    std::error_code ec;
+    fmt::print("pic bake part {}/{}: {} -> {}\n", shard.index, shard.count, scenePath, outPath);
+    fmt::print("  caches          links of caches [{}, {}) of {}; join all {} parts with picbake merge\n",
+               part->cacheBegin, part->cacheEnd, part->bake.caches.size(), shard.count);
+    fmt::print("  surfels nS      {}, links nL {}, {}\n", part->bake.params.surfels, part->bake.params.linksPerCache,
+               toString(part->bake.params.linkMode));
+    fmt::print("  links           {:.1f} used per cache, {:.3g} M rays, {} caches that see no surface\n",
+               report.links.meanLinksUsed, report.links.rays / 1e6,
+               std::ranges::count(part->seesSurfel, uint8_t{0}));
+    fmt::print("  bytes           {}\n", humanBytes(std::filesystem::file_size(outPath, ec)));
+    fmt::print("  seconds         {} (total {:.2f}) on {} threads\n", stageList(report), total, workerCount());
+    fmt::print("  peak memory     {}\n", humanBytes(report.peakMemoryBytes));
+    return 0;
+}
+
+/// `picbake merge PART… -o OUT.pic`: the parts joined, byte-identical to the unsharded bake.
+int runMergeCommand(const std::vector<std::string>& partPaths, const std::string& outPath) {
+    using Clock = std::chrono::steady_clock;
+    auto start = Clock::now();
+    BakeJoiner joiner;
+    Progress progress("parts", partPaths.size());
+    for (const std::string& path : partPaths) {
+        auto part = readBakePart(path);
+        if (!part) return reportError(part.error());
+        if (auto added = joiner.add(std::move(*part), path); !added) return reportError(added.error());
+        progress.advance();
+    }
+    progress.finish();
+    BakeReport report;
+    auto bake = joiner.finish(report.blindCachesDropped);
+    if (!bake) return reportError(bake.error());
+    report.seconds.emplace_back("read", std::chrono::duration<double>(Clock::now() - start).count());
+    auto writeStart = Clock::now();
+    if (auto written = writeBakeFile(outPath, *bake); !written) return reportError(written.error());
+    report.seconds.emplace_back("write", std::chrono::duration<double>(Clock::now() - writeStart).count());
+    report.peakMemoryBytes = peakMemoryBytes();
+    const double total = writeTimings(report, outPath);
+    std::error_code ec;
+    std::filesystem::remove(targetPath(outPath), ec);  // a stale prediction of another bake
+
+    auto info = inspectBakeFile(outPath);
+    if (!info) return reportError(info.error());
+    fmt::print("pic merge: {} parts -> {}\n", partPaths.size(), outPath);
+    fmt::print("  surfels nS      {}, nodes {}\n", info->surfels, info->nodes);
+    fmt::print("  unique caches   {} ({} that see no surface were dropped), {} grid vertices, {} light-map texels\n",
+               info->caches, report.blindCachesDropped, info->gridCaches, info->lightmapCaches);
+    fmt::print("  links nL        {}, {}\n", info->linksPerCache, toString(info->params.linkMode));
+    fmt::print("  bytes           {}\n", humanBytes(info->fileSize));
+    fmt::print("  seconds         {} (total {:.2f})\n", stageList(report), total);
+    fmt::print("  peak memory     {}\n", humanBytes(report.peakMemoryBytes));
     return 0;
 }
 
@@ -300,6 +380,18 @@ int picbakeMain(int argc, char** argv) {
                             "target on the same scene, or 'none' (default: " + defaultCacheDir() + ")");
     bakeCommand->add_option("--pilot-spp", target.spp, "with --target-error: pilot reference samples per pixel (default 256)")
         ->check(CLI::Range(2u, 1u << 20));
+    std::string shardText;
+    CLI::Option* shardOption = bakeCommand->add_option(
+        "--shard", shardText,
+        "I/N: write part I (0 to N-1) of a bake split N ways, the links of one N-th of the caches "
+        "(every part runs the stages before the links); `picbake merge` joins the parts");
+
+    CLI::App* mergeCommand = app.add_subcommand(
+        "merge", "join the parts of a sharded bake into the bake file an unsharded bake writes");
+    std::vector<std::string> partPaths;
+    std::string mergeOut;
+    mergeCommand->add_option("parts", partPaths, "every part (picbake bake --shard I/N), in any order")->required();
+    mergeCommand->add_option("-o,--out", mergeOut, "bake file to write (.pic)")->required();
 
     CLI::App* infoCommand = app.add_subcommand("info", "describe a bake file");
     std::string infoPath;
@@ -325,8 +417,18 @@ int picbakeMain(int argc, char** argv) {
         } else if (*budgetOption) {
             return reportError(Error{ErrorCode::InvalidInput, "--budget-ms needs --target-error"});
         }
+        if (*shardOption) {
+            if (targeted)
+                return reportError(Error{ErrorCode::InvalidInput,
+                                         "--shard cannot be combined with --target-error: the pilot "
+                                         "chooses among whole bakes"});
+            auto shard = parseBakeShard(shardText);
+            if (!shard) return reportError(shard.error());
+            return runBakeShardCommand(scenePath, outPath, bakeFlags.toOptions(), *shard);
+        }
         return runBakeCommand(scenePath, outPath, bakeFlags.toOptions(), targeted);
     }
+    if (mergeCommand->parsed()) return runMergeCommand(partPaths, mergeOut);
     return runInfoCommand(infoPath, json);
 }
 

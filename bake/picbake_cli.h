@@ -1,5 +1,5 @@
 #pragma once
-/// `picbake bake` and `picbake info` (ARCHITECTURE.md §5).
+/// `picbake bake`, `picbake merge` and `picbake info` (ARCHITECTURE.md §5).
 
 namespace pic {
 

@@ -98,6 +98,8 @@ struct BakeParams {
     LinkCut linkCut = LinkCut::ErrorBound;
     uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
     uint64_t seed = 1;
+
+    friend bool operator==(const BakeParams&, const BakeParams&) = default;
 };
 
 /// The sparse grid of caches: a cache index per grid vertex (kNoCache where none).

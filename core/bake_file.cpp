@@ -38,7 +38,7 @@ static_assert(std::numeric_limits<float>::is_iec559, "bake files hold IEEE-754 f
 
 namespace {
 
-constexpr char kMagic[8] = {'P', 'I', 'C', 'B', 'A', 'K', 'E', '\0'};
+constexpr size_t kMagicBytes = 8;
 constexpr size_t kNameBytes = 24;
 
 struct FileHeader {
@@ -84,6 +84,14 @@ struct LinksRecord {
 };
 static_assert(sizeof(LinksRecord) == 16);
 
+struct ShardRecord {
+    uint32_t index;
+    uint32_t count;
+    uint64_t cacheBegin;
+    uint64_t cacheEnd;
+};
+static_assert(sizeof(ShardRecord) == 24);
+
 static_assert(sizeof(glm::vec2) == 8 && std::is_trivially_copyable_v<glm::vec2>);
 
 /// Section names in the order the writer emits them; a file must hold each exactly once.
@@ -96,6 +104,24 @@ constexpr std::array<std::string_view, 18> kSectionNames = {
 constexpr size_t kSectionCount = kSectionNames.size();
 static_assert(std::ranges::all_of(kSectionNames,
                                   [](std::string_view n) { return n.size() < kNameBytes; }));
+
+/// A part's sections: a bake's, then its shard.
+constexpr auto kPartSectionNames = [] {
+    std::array<std::string_view, kSectionCount + 2> names{};
+    std::ranges::copy(kSectionNames, names.begin());
+    names[kSectionCount] = "shard";
+    names[kSectionCount + 1] = "shard_sees";
+    return names;
+}();
+
+/// What tells a bake from a part on disk and in messages.
+struct FileKind {
+    std::array<char, kMagicBytes> magic;
+    std::span<const std::string_view> sections;
+    std::string_view noun;
+};
+constexpr FileKind kBakeKind{{'P', 'I', 'C', 'B', 'A', 'K', 'E', '\0'}, kSectionNames, "bake file"};
+constexpr FileKind kPartKind{{'P', 'I', 'C', 'P', 'A', 'R', 'T', '\0'}, kPartSectionNames, "bake part"};
 
 /// The arrays of a bake, borrowed from a BakeData or from a mapped file.
 struct BakeView {
@@ -244,11 +270,11 @@ Result<void> checkCachesAndLayouts(const BakeView& v, ErrorCode code, const std:
     return {};
 }
 
-/// The link records of the link mode, and no others.
-Result<void> checkLinkRecords(const BakeView& v, ErrorCode code, const std::string& what) {
+/// The link records of the link mode for nC linked caches, and no others.
+Result<void> checkLinkRecords(const BakeView& v, uint64_t nC, ErrorCode code,
+                              const std::string& what) {
     const LinksRecord& links = v.links;
     const uint64_t nNodes = v.nodes.size();
-    const uint64_t nC = v.caches.size();
     const uint64_t nL = links.linksPerCache;
     const uint64_t nLinks = nC * nL;  // both below 2³², cannot overflow
     if (links.mode == static_cast<uint32_t>(LinkMode::Rtp)) {
@@ -284,26 +310,27 @@ Result<void> checkLinkRecords(const BakeView& v, ErrorCode code, const std::stri
     return fail(code, "{}: link mode {} is neither sh (0) nor rtp (1)", what, links.mode);
 }
 
-Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& what) {
-    PIC_TRY(checkLinkRecords(v, code, what));
-    const uint64_t nLinks = uint64_t{v.caches.size()} * v.links.linksPerCache;
+/// The links of nC caches: the bake's, or a part's range.
+Result<void> checkLinks(const BakeView& v, uint64_t nC, ErrorCode code, const std::string& what) {
+    PIC_TRY(checkLinkRecords(v, nC, code, what));
+    const uint64_t nLinks = nC * v.links.linksPerCache;
     if (v.tint.size() != nLinks)
-        return fail(code, "{}: links of {} caches × {} links need {} tints, found {}", what,
-                    v.caches.size(), v.links.linksPerCache, nLinks, v.tint.size());
+        return fail(code, "{}: links of {} caches × {} links need {} tints, found {}", what, nC,
+                    v.links.linksPerCache, nLinks, v.tint.size());
     for (size_t i = 0; i < v.tint.size(); ++i)
         if (v.tint[i] >> 30 != 0)
             return fail(code, "{}: tint {} of link {} sets bits above the 30 of its channels", what,
                         v.tint[i], i);
     if (v.offset.size() != nLinks * 3)
         return fail(code, "{}: links of {} caches × {} links need {} offset components, found {}",
-                    what, v.caches.size(), v.links.linksPerCache, nLinks * 3, v.offset.size());
+                    what, nC, v.links.linksPerCache, nLinks * 3, v.offset.size());
     for (size_t i = 0; i < v.offset.size(); ++i)
         if ((v.offset[i] & 0x7C00u) == 0x7C00u)
             return fail(code, "{}: offset of link {} is not finite (half bits {:#06x})", what,
                         i / 3, v.offset[i]);
     if (v.spreadShare.size() != nLinks)
         return fail(code, "{}: links of {} caches × {} links need {} spread shares, found {}", what,
-                    v.caches.size(), v.links.linksPerCache, nLinks, v.spreadShare.size());
+                    nC, v.links.linksPerCache, nLinks, v.spreadShare.size());
     for (size_t i = 0; i < v.spreadShare.size(); ++i)
         if (v.spreadShare[i] > kSpreadShareSteps)
             return fail(code, "{}: spread share code {} of link {} exceeds {}", what,
@@ -312,11 +339,13 @@ Result<void> checkLinks(const BakeView& v, ErrorCode code, const std::string& wh
 }
 
 /// Checks that counts agree across arrays and that every index lies in range, so that the
-/// runtime can use the arrays without bounds checks.
-Result<void> checkContents(const BakeView& v, ErrorCode code, const std::string& what) {
+/// runtime can use the arrays without bounds checks; the links are those of `linkedCaches`
+/// caches (all of them in a bake).
+Result<void> checkContents(const BakeView& v, uint64_t linkedCaches, ErrorCode code,
+                           const std::string& what) {
     if (auto ok = checkNodes(v, code, what); !ok) return ok;
     if (auto ok = checkCachesAndLayouts(v, code, what); !ok) return ok;
-    return checkLinks(v, code, what);
+    return checkLinks(v, linkedCaches, code, what);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -364,13 +393,13 @@ Result<std::string> paramsJson(const BakeParams& p,
 /// Reads the fields of the params object, remembering which it saw to report unknown ones.
 class ParamsReader {
 public:
-    ParamsReader(const nlohmann::json& object, const std::string& path)
-        : mObject(object), mPath(path) {}
+    ParamsReader(const nlohmann::json& object, const std::string& file)
+        : mObject(object), mFile(file) {}
 
     Result<const nlohmann::json*> field(const char* key) {
         const auto it = mObject.find(key);
         if (it == mObject.end())
-            return fail(ErrorCode::Corrupt, "params of bake file {} lack \"{}\"", mPath, key);
+            return fail(ErrorCode::Corrupt, "params of {} lack \"{}\"", mFile, key);
         mSeen.insert(key);
         return &*it;
     }
@@ -379,7 +408,7 @@ public:
         PIC_TRY_ASSIGN(const nlohmann::json* value, field(key));
         if (!value->is_number_unsigned() || value->get<uint64_t>() > max)
             return fail(ErrorCode::Corrupt,
-                        "params of bake file {}: \"{}\" is {}, not an integer in [0, {}]", mPath,
+                        "params of {}: \"{}\" is {}, not an integer in [0, {}]", mFile,
                         key, value->dump(), max);
         return value->get<uint64_t>();
     }
@@ -400,8 +429,8 @@ public:
     Result<float> f32(const char* key) {
         PIC_TRY_ASSIGN(const nlohmann::json* value, field(key));
         if (!value->is_number())
-            return fail(ErrorCode::Corrupt, "params of bake file {}: \"{}\" is {}, not a number",
-                        mPath, key, value->dump());
+            return fail(ErrorCode::Corrupt, "params of {}: \"{}\" is {}, not a number",
+                        mFile, key, value->dump());
         return static_cast<float>(value->get<double>());
     }
 
@@ -413,20 +442,20 @@ public:
             if (value->is_string() && value->get_ref<const std::string&>() == name) return index;
             ++index;
         }
-        return fail(ErrorCode::Corrupt, "params of bake file {}: \"{}\" is {}, expected one of {}",
-                    mPath, key, value->dump(), fmt::join(names, ", "));
+        return fail(ErrorCode::Corrupt, "params of {}: \"{}\" is {}, expected one of {}",
+                    mFile, key, value->dump(), fmt::join(names, ", "));
     }
 
     Result<std::map<std::string, std::string>> stringMap(const char* key) {
         PIC_TRY_ASSIGN(const nlohmann::json* value, field(key));
         if (!value->is_object())
-            return fail(ErrorCode::Corrupt, "params of bake file {}: \"{}\" is not an object",
-                        mPath, key);
+            return fail(ErrorCode::Corrupt, "params of {}: \"{}\" is not an object",
+                        mFile, key);
         std::map<std::string, std::string> result;
         for (const auto& [name, text] : value->items()) {
             if (!text.is_string())
                 return fail(ErrorCode::Corrupt,
-                            "params of bake file {}: \"{}\".\"{}\" is {}, not a string", mPath, key,
+                            "params of {}: \"{}\".\"{}\" is {}, not a string", mFile, key,
                             name, text.dump());
             result.emplace(name, text.get<std::string>());
         }
@@ -437,14 +466,14 @@ public:
     Result<void> checkAllSeen() const {
         for (const auto& [key, value] : mObject.items())
             if (!mSeen.contains(key))
-                return fail(ErrorCode::Corrupt, "params of bake file {} hold unknown field \"{}\"",
-                            mPath, key);
+                return fail(ErrorCode::Corrupt, "params of {} hold unknown field \"{}\"",
+                            mFile, key);
         return {};
     }
 
 private:
     const nlohmann::json& mObject;
-    const std::string& mPath;
+    const std::string& mFile;
     std::set<std::string, std::less<>> mSeen;
 };
 
@@ -453,13 +482,13 @@ struct ParsedParams {
     std::map<std::string, std::string> defaults;
 };
 
-Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::string& path) {
+Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::string& file) {
     const auto* text = reinterpret_cast<const char*>(bytes.data());
     const nlohmann::json json = nlohmann::json::parse(text, text + bytes.size(), nullptr, false);
     if (json.is_discarded() || !json.is_object())
-        return fail(ErrorCode::Corrupt, "params section of bake file {} is not a JSON object",
-                    path);
-    ParamsReader reader(json, path);
+        return fail(ErrorCode::Corrupt, "params section of {} is not a JSON object",
+                    file);
+    ParamsReader reader(json, file);
     ParsedParams parsed;
     BakeParams& p = parsed.params;
     PIC_TRY_ASSIGN(p.surfels, reader.u32("surfels"));
@@ -494,7 +523,7 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     PIC_TRY_ASSIGN(p.seed, reader.unsignedField("seed", std::numeric_limits<uint64_t>::max()));
     PIC_TRY_ASSIGN(parsed.defaults, reader.stringMap("defaults"));
     if (auto ok = reader.checkAllSeen(); !ok) return std::unexpected(ok.error());
-    if (auto ok = checkParams(p, ErrorCode::Corrupt, fmt::format("bake file {}", path)); !ok)
+    if (auto ok = checkParams(p, ErrorCode::Corrupt, file); !ok)
         return std::unexpected(ok.error());
     return parsed;
 }
@@ -525,25 +554,25 @@ private:
 /// A whole file mapped read-only; the mapping outlives the descriptor.
 class MappedFile {
 public:
-    static Result<MappedFile> open(const std::string& path) {
+    /// `file` names it in messages ("bake file PATH").
+    static Result<MappedFile> open(const std::string& path, const std::string& file) {
         const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
         if (fd < 0) {
             const int err = errno;
-            if (err == ENOENT)
-                return fail(ErrorCode::NotFound, "bake file {} does not exist", path);
-            return fail(ErrorCode::Io, "cannot open bake file {}: {}", path, errnoText(err));
+            if (err == ENOENT) return fail(ErrorCode::NotFound, "{} does not exist", file);
+            return fail(ErrorCode::Io, "cannot open {}: {}", file, errnoText(err));
         }
-        FileDescriptor file(fd);
+        FileDescriptor descriptor(fd);
         struct stat info {};
         if (::fstat(fd, &info) != 0)
-            return fail(ErrorCode::Io, "cannot stat bake file {}: {}", path, errnoText(errno));
+            return fail(ErrorCode::Io, "cannot stat {}: {}", file, errnoText(errno));
         if (!S_ISREG(info.st_mode))
-            return fail(ErrorCode::InvalidInput, "bake file {} is not a regular file", path);
+            return fail(ErrorCode::InvalidInput, "{} is not a regular file", file);
         const size_t size = static_cast<size_t>(info.st_size);
         if (size == 0) return MappedFile(nullptr, 0);
         void* data = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
         if (data == MAP_FAILED)
-            return fail(ErrorCode::Io, "cannot map bake file {}: {}", path, errnoText(errno));
+            return fail(ErrorCode::Io, "cannot map {}: {}", file, errnoText(errno));
         return MappedFile(data, size);
     }
 
@@ -565,155 +594,193 @@ private:
     size_t mSize;
 };
 
-/// A validated, mapped bake file; the views point into `file`.
+/// A validated, mapped bake file or part; the views point into `file`.
 struct DecodedBake {
     MappedFile file;
     FileHeader header;
     std::vector<std::pair<std::string, uint64_t>> sectionBytes;  ///< in file order
     BakeView view;
     ParsedParams params;
+    ShardRecord shard{};               ///< parts only
+    std::span<const uint8_t> sees;     ///< parts only
 };
 
 using SectionMap = std::map<std::string, std::span<const std::byte>, std::less<>>;
 
-Result<FileHeader> readHeader(std::span<const std::byte> bytes, const std::string& path) {
-    if (bytes.size() < sizeof(kMagic) || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+Result<FileHeader> readHeader(std::span<const std::byte> bytes, const std::string& path,
+                              const FileKind& kind, const std::string& file) {
+    const auto startsWith = [&](const FileKind& k) {
+        return bytes.size() >= kMagicBytes && std::memcmp(bytes.data(), k.magic.data(), kMagicBytes) == 0;
+    };
+    if (&kind == &kBakeKind && startsWith(kPartKind))
         return fail(ErrorCode::Corrupt,
-                    "{} is not a pic bake file (it does not start with \"PICBAKE\")", path);
+                    "{} is one part of a sharded bake, not a whole bake: join all the parts with "
+                    "`picbake merge PART... -o OUT.pic`",
+                    path);
+    if (&kind == &kPartKind && startsWith(kBakeKind))
+        return fail(ErrorCode::Corrupt,
+                    "{} is a whole bake, not a part of a sharded bake (`picbake bake --shard I/N` "
+                    "writes parts)",
+                    path);
+    if (!startsWith(kind))
+        return fail(ErrorCode::Corrupt, "{} is not a pic {} (it does not start with \"{}\")", path,
+                    kind.noun, kind.magic.data());
     // The version is checked before anything else so that a newer layout is reported as such.
     uint32_t version = 0;
     if (bytes.size() >= offsetof(FileHeader, formatVersion) + sizeof(version)) {
         std::memcpy(&version, bytes.data() + offsetof(FileHeader, formatVersion), sizeof(version));
         if (version != kBakeFormatVersion)
             return fail(ErrorCode::Corrupt,
-                        "bake file {} has format version {}, this build reads version {}; "
+                        "{} has format version {}, this build reads version {}; "
                         "bake the scene again",
-                        path, version, kBakeFormatVersion);
+                        file, version, kBakeFormatVersion);
     }
     if (bytes.size() < kBakeHeaderBytes)
         return fail(ErrorCode::Corrupt,
-                    "bake file {} is truncated: it has {} bytes, the header alone needs {}", path,
+                    "{} is truncated: it has {} bytes, the header alone needs {}", file,
                     bytes.size(), kBakeHeaderBytes);
     FileHeader header;
     uint64_t headerChecksum = 0;
     std::memcpy(&header, bytes.data(), sizeof(header));
     std::memcpy(&headerChecksum, bytes.data() + sizeof(header), sizeof(headerChecksum));
     if (hashBytes(&header, sizeof(header)) != headerChecksum)
-        return fail(ErrorCode::Corrupt, "bake file {} has a corrupt header (checksum mismatch)",
-                    path);
+        return fail(ErrorCode::Corrupt, "{} has a corrupt header (checksum mismatch)",
+                    file);
     if (bytes.size() < header.fileSize)
         return fail(ErrorCode::Corrupt,
-                    "bake file {} is truncated: its header says {} bytes, the file has {}", path,
+                    "{} is truncated: its header says {} bytes, the file has {}", file,
                     header.fileSize, bytes.size());
     if (bytes.size() > header.fileSize)
         return fail(ErrorCode::Corrupt,
-                    "bake file {} has {} bytes, its header says {}: trailing data", path,
+                    "{} has {} bytes, its header says {}: trailing data", file,
                     bytes.size(), header.fileSize);
     return header;
 }
 
 /// Validates the section table and every section's placement and checksum.
 Result<SectionMap> readSections(std::span<const std::byte> bytes, const FileHeader& header,
-                                const std::string& path) {
+                                std::span<const std::string_view> names, const std::string& file) {
     const uint64_t fileSize = bytes.size();
     if (header.sectionCount > (fileSize - kBakeHeaderBytes) / kBakeSectionEntryBytes)
         return fail(ErrorCode::Corrupt,
-                    "section table of bake file {} ({} entries) runs past the end of the file",
-                    path, header.sectionCount);
+                    "section table of {} ({} entries) runs past the end of the file",
+                    file, header.sectionCount);
     const uint64_t tableEnd = kBakeHeaderBytes + header.sectionCount * kBakeSectionEntryBytes;
     const std::span<const std::byte> table =
         bytes.subspan(kBakeHeaderBytes, tableEnd - kBakeHeaderBytes);
     if (hashBytes(table.data(), table.size()) != header.tableChecksum)
         return fail(ErrorCode::Corrupt,
-                    "bake file {} has a corrupt section table (checksum mismatch)", path);
+                    "{} has a corrupt section table (checksum mismatch)", file);
 
     SectionMap sections;
     for (uint32_t i = 0; i < header.sectionCount; ++i) {
         SectionEntry entry;
         std::memcpy(&entry, table.data() + i * kBakeSectionEntryBytes, sizeof(entry));
         const std::string name(entry.name, strnlen(entry.name, kNameBytes));
-        if (std::ranges::find(kSectionNames, name) == kSectionNames.end())
-            return fail(ErrorCode::Corrupt, "bake file {} has unknown section '{}'", path, name);
+        if (std::ranges::find(names, name) == names.end())
+            return fail(ErrorCode::Corrupt, "{} has unknown section '{}'", file, name);
         if (sections.contains(name))
-            return fail(ErrorCode::Corrupt, "bake file {} has section '{}' twice", path, name);
+            return fail(ErrorCode::Corrupt, "{} has section '{}' twice", file, name);
         if (entry.offset % kBakeSectionAlignment != 0 || entry.offset < tableEnd)
             return fail(ErrorCode::Corrupt,
-                        "section '{}' of bake file {} starts at byte {}, not a multiple of {} "
+                        "section '{}' of {} starts at byte {}, not a multiple of {} "
                         "after the section table",
-                        name, path, entry.offset, kBakeSectionAlignment);
+                        name, file, entry.offset, kBakeSectionAlignment);
         if (entry.offset > fileSize || entry.size > fileSize - entry.offset)
             return fail(ErrorCode::Corrupt,
-                        "section '{}' of bake file {} (bytes {} to {}) runs past the end of the "
+                        "section '{}' of {} (bytes {} to {}) runs past the end of the "
                         "file ({} bytes)",
-                        name, path, entry.offset, entry.offset + entry.size, fileSize);
+                        name, file, entry.offset, entry.offset + entry.size, fileSize);
         const std::span<const std::byte> section = bytes.subspan(entry.offset, entry.size);
         if (hashBytes(section.data(), section.size()) != entry.checksum)
             return fail(ErrorCode::Corrupt,
-                        "section '{}' of bake file {} is corrupt (checksum mismatch)", name, path);
+                        "section '{}' of {} is corrupt (checksum mismatch)", name, file);
         sections.emplace(name, section);
     }
-    for (std::string_view name : kSectionNames)
+    for (std::string_view name : names)
         if (!sections.contains(name))
-            return fail(ErrorCode::Corrupt, "bake file {} lacks section '{}'", path, name);
+            return fail(ErrorCode::Corrupt, "{} lacks section '{}'", file, name);
     return sections;
 }
 
 template <class T>
 Result<std::span<const T>> arrayIn(const SectionMap& sections, std::string_view name,
-                                   const std::string& path) {
+                                   const std::string& file) {
     static_assert(std::is_trivially_copyable_v<T> && alignof(T) <= kBakeSectionAlignment);
     const std::span<const std::byte> bytes = sections.find(name)->second;
     if (bytes.size() % sizeof(T) != 0)
         return fail(ErrorCode::Corrupt,
-                    "section '{}' of bake file {} has {} bytes, not a multiple of its {}-byte "
+                    "section '{}' of {} has {} bytes, not a multiple of its {}-byte "
                     "records",
-                    name, path, bytes.size(), sizeof(T));
+                    name, file, bytes.size(), sizeof(T));
     // Sections start 64-byte aligned in a page-aligned mapping, so the records are aligned.
     return std::span<const T>(reinterpret_cast<const T*>(bytes.data()), bytes.size() / sizeof(T));
 }
 
 template <class T>
-Result<T> recordIn(const SectionMap& sections, std::string_view name, const std::string& path) {
+Result<T> recordIn(const SectionMap& sections, std::string_view name, const std::string& file) {
     const std::span<const std::byte> bytes = sections.find(name)->second;
     if (bytes.size() != sizeof(T))
-        return fail(ErrorCode::Corrupt, "section '{}' of bake file {} has {} bytes, expected {}",
-                    name, path, bytes.size(), sizeof(T));
+        return fail(ErrorCode::Corrupt, "section '{}' of {} has {} bytes, expected {}",
+                    name, file, bytes.size(), sizeof(T));
     T record;
     std::memcpy(&record, bytes.data(), sizeof(T));
     return record;
 }
 
-Result<BakeView> viewSections(const SectionMap& s, const std::string& path) {
+Result<BakeView> viewSections(const SectionMap& s, const std::string& file) {
     BakeView v;
-    PIC_TRY_ASSIGN(v.surfels, arrayIn<Surfel>(s, "surfels", path));
-    PIC_TRY_ASSIGN(v.surfelWeights, arrayIn<float>(s, "surfel_weights", path));
-    PIC_TRY_ASSIGN(v.nodes, arrayIn<Node>(s, "nodes", path));
-    PIC_TRY_ASSIGN(v.levelOffsets, arrayIn<uint32_t>(s, "levels", path));
-    PIC_TRY_ASSIGN(v.caches, arrayIn<Cache>(s, "caches", path));
-    PIC_TRY_ASSIGN(v.grid, recordIn<GridRecord>(s, "grid", path));
-    PIC_TRY_ASSIGN(v.gridIndex, arrayIn<uint32_t>(s, "grid_index", path));
-    PIC_TRY_ASSIGN(v.lightmap, recordIn<LightmapRecord>(s, "lightmap", path));
-    PIC_TRY_ASSIGN(v.lightmapIndex, arrayIn<uint32_t>(s, "lightmap_index", path));
-    PIC_TRY_ASSIGN(v.lightmapUvs, arrayIn<glm::vec2>(s, "lightmap_uvs", path));
-    PIC_TRY_ASSIGN(v.links, recordIn<LinksRecord>(s, "links", path));
-    PIC_TRY_ASSIGN(v.rtp, arrayIn<RtpLink>(s, "links_rtp", path));
-    PIC_TRY_ASSIGN(v.shNodes, arrayIn<uint32_t>(s, "links_sh_nodes", path));
-    PIC_TRY_ASSIGN(v.shCoefficients, arrayIn<uint16_t>(s, "links_sh_coeffs", path));
-    PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", path));
-    PIC_TRY_ASSIGN(v.offset, arrayIn<uint16_t>(s, "links_offset", path));
-    PIC_TRY_ASSIGN(v.spreadShare, arrayIn<uint8_t>(s, "links_spread_share", path));
+    PIC_TRY_ASSIGN(v.surfels, arrayIn<Surfel>(s, "surfels", file));
+    PIC_TRY_ASSIGN(v.surfelWeights, arrayIn<float>(s, "surfel_weights", file));
+    PIC_TRY_ASSIGN(v.nodes, arrayIn<Node>(s, "nodes", file));
+    PIC_TRY_ASSIGN(v.levelOffsets, arrayIn<uint32_t>(s, "levels", file));
+    PIC_TRY_ASSIGN(v.caches, arrayIn<Cache>(s, "caches", file));
+    PIC_TRY_ASSIGN(v.grid, recordIn<GridRecord>(s, "grid", file));
+    PIC_TRY_ASSIGN(v.gridIndex, arrayIn<uint32_t>(s, "grid_index", file));
+    PIC_TRY_ASSIGN(v.lightmap, recordIn<LightmapRecord>(s, "lightmap", file));
+    PIC_TRY_ASSIGN(v.lightmapIndex, arrayIn<uint32_t>(s, "lightmap_index", file));
+    PIC_TRY_ASSIGN(v.lightmapUvs, arrayIn<glm::vec2>(s, "lightmap_uvs", file));
+    PIC_TRY_ASSIGN(v.links, recordIn<LinksRecord>(s, "links", file));
+    PIC_TRY_ASSIGN(v.rtp, arrayIn<RtpLink>(s, "links_rtp", file));
+    PIC_TRY_ASSIGN(v.shNodes, arrayIn<uint32_t>(s, "links_sh_nodes", file));
+    PIC_TRY_ASSIGN(v.shCoefficients, arrayIn<uint16_t>(s, "links_sh_coeffs", file));
+    PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", file));
+    PIC_TRY_ASSIGN(v.offset, arrayIn<uint16_t>(s, "links_offset", file));
+    PIC_TRY_ASSIGN(v.spreadShare, arrayIn<uint8_t>(s, "links_spread_share", file));
     return v;
 }
 
-/// Maps `path` and runs every check of the format on it.
-Result<DecodedBake> decodeBakeFile(const std::string& path) {
-    PIC_TRY_ASSIGN(MappedFile file, MappedFile::open(path));
-    const std::span<const std::byte> bytes = file.bytes();
-    PIC_TRY_ASSIGN(const FileHeader header, readHeader(bytes, path));
-    PIC_TRY_ASSIGN(const SectionMap sections, readSections(bytes, header, path));
-    PIC_TRY_ASSIGN(BakeView view, viewSections(sections, path));
-    PIC_TRY_ASSIGN(ParsedParams params, parseParams(sections.find("params")->second, path));
-    if (auto ok = checkContents(view, ErrorCode::Corrupt, fmt::format("bake file {}", path)); !ok)
+/// Maps the bake or part at `path` and runs every check of its format on it.
+Result<DecodedBake> decodeBakeFile(const std::string& path, const FileKind& kind) {
+    const std::string file = fmt::format("{} {}", kind.noun, path);
+    PIC_TRY_ASSIGN(MappedFile mapped, MappedFile::open(path, file));
+    const std::span<const std::byte> bytes = mapped.bytes();
+    PIC_TRY_ASSIGN(const FileHeader header, readHeader(bytes, path, kind, file));
+    PIC_TRY_ASSIGN(const SectionMap sections, readSections(bytes, header, kind.sections, file));
+    PIC_TRY_ASSIGN(BakeView view, viewSections(sections, file));
+    PIC_TRY_ASSIGN(ParsedParams params, parseParams(sections.find("params")->second, file));
+    const uint64_t nC = view.caches.size();
+    ShardRecord shard{0, 1, 0, nC};
+    std::span<const uint8_t> sees;
+    if (&kind == &kPartKind) {
+        PIC_TRY_ASSIGN(shard, recordIn<ShardRecord>(sections, "shard", file));
+        PIC_TRY_ASSIGN(sees, arrayIn<uint8_t>(sections, "shard_sees", file));
+        if (shard.count == 0 || shard.index >= shard.count)
+            return fail(ErrorCode::Corrupt, "{} says it is shard {} of {}", file, shard.index,
+                        shard.count);
+        if (shard.cacheBegin > shard.cacheEnd || shard.cacheEnd > nC)
+            return fail(ErrorCode::Corrupt, "{} links caches [{}, {}) of {}", file,
+                        shard.cacheBegin, shard.cacheEnd, nC);
+        if (sees.size() != shard.cacheEnd - shard.cacheBegin)
+            return fail(ErrorCode::Corrupt, "{} has {} shard_sees entries for {} caches", file,
+                        sees.size(), shard.cacheEnd - shard.cacheBegin);
+        if (const auto bad = std::ranges::find_if(sees, [](uint8_t x) { return x > 1; });
+            bad != sees.end())
+            return fail(ErrorCode::Corrupt, "{}: shard_sees entry {} is {}, expected 0 or 1", file,
+                        bad - sees.begin(), *bad);
+    }
+    if (auto ok = checkContents(view, shard.cacheEnd - shard.cacheBegin, ErrorCode::Corrupt, file);
+        !ok)
         return std::unexpected(ok.error());
 
     // Section sizes in file order, as the table lists them.
@@ -725,7 +792,8 @@ Result<DecodedBake> decodeBakeFile(const std::string& path) {
         sectionBytes.emplace_back(std::string(entry.name, strnlen(entry.name, kNameBytes)),
                                   entry.size);
     }
-    return DecodedBake{std::move(file), header, std::move(sectionBytes), view, std::move(params)};
+    return DecodedBake{std::move(mapped), header, std::move(sectionBytes), view, std::move(params),
+                       shard, sees};
 }
 
 template <class T>
@@ -816,35 +884,32 @@ private:
     std::string mPath;
 };
 
-}  // namespace
-
-Result<void> writeBakeFile(const std::string& path, const BakeData& bake) {
-    const std::string what = fmt::format("cannot write bake file {}", path);
-    if (auto ok = checkParams(bake.params, ErrorCode::InvalidInput, what); !ok) return ok;
-    const BakeView view = viewOf(bake);
-    if (auto ok = checkContents(view, ErrorCode::InvalidInput, what); !ok) return ok;
-    PIC_TRY_ASSIGN(const std::string params, paramsJson(bake.params, bake.defaults, what));
-    const auto sections = sectionBytesOf(view, params);
-
+/// Writes `sections` (in `kind.sections` order) to `path` atomically: a temporary file in the
+/// same directory, fsync, rename, fsync of the directory. `what` starts every message.
+Result<void> writeSections(const std::string& path, const FileKind& kind, uint64_t sceneHash,
+                           std::span<const std::span<const std::byte>> sections,
+                           const std::string& what) {
+    PIC_CHECK(sections.size() == kind.sections.size());
     // Lay the sections out one after another at aligned offsets; value-initialised records
     // keep every unused name byte zero.
-    std::array<SectionEntry, kSectionCount> table{};
-    uint64_t offset = kBakeHeaderBytes + sizeof(table);
-    for (size_t i = 0; i < kSectionCount; ++i) {
+    std::vector<SectionEntry> table(sections.size());
+    const uint64_t tableBytes = table.size() * sizeof(SectionEntry);
+    uint64_t offset = kBakeHeaderBytes + tableBytes;
+    for (size_t i = 0; i < table.size(); ++i) {
         SectionEntry& entry = table[i];
-        kSectionNames[i].copy(entry.name, kNameBytes);
+        kind.sections[i].copy(entry.name, kNameBytes);
         entry.offset = alignUp(offset);
         entry.size = sections[i].size();
         entry.checksum = hashBytes(sections[i].data(), sections[i].size());
         offset = entry.offset + entry.size;
     }
     FileHeader header{};
-    std::memcpy(header.magic, kMagic, sizeof(kMagic));
+    std::memcpy(header.magic, kind.magic.data(), kMagicBytes);
     header.formatVersion = kBakeFormatVersion;
-    header.sectionCount = kSectionCount;
-    header.sceneHash = bake.sceneHash;
+    header.sectionCount = static_cast<uint32_t>(table.size());
+    header.sceneHash = sceneHash;
     header.fileSize = offset;
-    header.tableChecksum = hashBytes(table.data(), sizeof(table));
+    header.tableChecksum = hashBytes(table.data(), tableBytes);
     const uint64_t headerChecksum = hashBytes(&header, sizeof(header));
 
     const auto ioError = [&](std::string_view step, int err) {
@@ -865,7 +930,7 @@ Result<void> writeBakeFile(const std::string& path, const BakeData& bake) {
     int err = append(bytesOf(header));
     if (err == 0) err = append(bytesOf(headerChecksum));
     if (err == 0) err = append(std::as_bytes(std::span(table)));
-    for (size_t i = 0; i < kSectionCount && err == 0; ++i) {
+    for (size_t i = 0; i < table.size() && err == 0; ++i) {
         err = append(std::span(kZeros).first(table[i].offset - written));
         if (err == 0) err = append(sections[i]);
     }
@@ -888,8 +953,9 @@ Result<void> writeBakeFile(const std::string& path, const BakeData& bake) {
     return {};
 }
 
-Result<BakeData> readBakeFile(const std::string& path) {
-    PIC_TRY_ASSIGN(const DecodedBake decoded, decodeBakeFile(path));
+
+/// The arrays of a decoded file, copied.
+BakeData bakeOf(const DecodedBake& decoded) {
     const BakeView& v = decoded.view;
     BakeData bake;
     bake.params = decoded.params.params;
@@ -922,8 +988,65 @@ Result<BakeData> readBakeFile(const std::string& path) {
     return bake;
 }
 
+}  // namespace
+
+Result<void> writeBakeFile(const std::string& path, const BakeData& bake) {
+    const std::string what = fmt::format("cannot write bake file {}", path);
+    if (auto ok = checkParams(bake.params, ErrorCode::InvalidInput, what); !ok) return ok;
+    const BakeView view = viewOf(bake);
+    if (auto ok = checkContents(view, view.caches.size(), ErrorCode::InvalidInput, what); !ok)
+        return ok;
+    PIC_TRY_ASSIGN(const std::string params, paramsJson(bake.params, bake.defaults, what));
+    return writeSections(path, kBakeKind, bake.sceneHash, sectionBytesOf(view, params), what);
+}
+
+Result<BakeData> readBakeFile(const std::string& path) {
+    PIC_TRY_ASSIGN(const DecodedBake decoded, decodeBakeFile(path, kBakeKind));
+    return bakeOf(decoded);
+}
+
+Result<void> writeBakePart(const std::string& path, const BakePart& part) {
+    const std::string what = fmt::format("cannot write bake part {}", path);
+    const BakeData& bake = part.bake;
+    const uint64_t nC = bake.caches.size();
+    if (part.count == 0 || part.index >= part.count)
+        return fail(ErrorCode::InvalidInput, "{}: shard {} of {}", what, part.index, part.count);
+    if (part.cacheBegin > part.cacheEnd || part.cacheEnd > nC)
+        return fail(ErrorCode::InvalidInput, "{}: caches [{}, {}) of {}", what, part.cacheBegin,
+                    part.cacheEnd, nC);
+    if (part.seesSurfel.size() != part.cacheEnd - part.cacheBegin ||
+        std::ranges::any_of(part.seesSurfel, [](uint8_t x) { return x > 1; }))
+        return fail(ErrorCode::InvalidInput, "{}: {} seesSurfel flags (0 or 1) for {} caches", what,
+                    part.seesSurfel.size(), part.cacheEnd - part.cacheBegin);
+    if (auto ok = checkParams(bake.params, ErrorCode::InvalidInput, what); !ok) return ok;
+    const BakeView view = viewOf(bake);
+    if (auto ok = checkContents(view, part.cacheEnd - part.cacheBegin, ErrorCode::InvalidInput, what);
+        !ok)
+        return ok;
+    PIC_TRY_ASSIGN(const std::string params, paramsJson(bake.params, bake.defaults, what));
+    const ShardRecord shard{part.index, part.count, part.cacheBegin, part.cacheEnd};
+    const auto bakeSections = sectionBytesOf(view, params);
+    std::array<std::span<const std::byte>, kPartSectionNames.size()> sections;
+    std::ranges::copy(bakeSections, sections.begin());
+    sections[kSectionCount] = bytesOf(shard);
+    sections[kSectionCount + 1] = std::as_bytes(std::span(part.seesSurfel));
+    return writeSections(path, kPartKind, bake.sceneHash, sections, what);
+}
+
+Result<BakePart> readBakePart(const std::string& path) {
+    PIC_TRY_ASSIGN(const DecodedBake decoded, decodeBakeFile(path, kPartKind));
+    BakePart part;
+    part.index = decoded.shard.index;
+    part.count = decoded.shard.count;
+    part.cacheBegin = decoded.shard.cacheBegin;
+    part.cacheEnd = decoded.shard.cacheEnd;
+    part.seesSurfel = toVector(decoded.sees);
+    part.bake = bakeOf(decoded);
+    return part;
+}
+
 Result<BakeFileInfo> inspectBakeFile(const std::string& path) {
-    PIC_TRY_ASSIGN(const DecodedBake decoded, decodeBakeFile(path));
+    PIC_TRY_ASSIGN(const DecodedBake decoded, decodeBakeFile(path, kBakeKind));
     const BakeView& v = decoded.view;
     const auto holdsCache = [](uint32_t index) { return index != kNoCache; };
     BakeFileInfo info;

@@ -43,6 +43,12 @@
 ///   links_offset     nC·nL·3 × u16 finite half float, metres (LinkSet::offset), both modes
 ///   links_spread_share nC·nL × u8 code ≤ 63 (LinkSet::spreadShare, encodeSpreadShare), both modes
 ///
+/// A part of a sharded bake (BakePart) has the same layout with magic "PICPART\0", the links of
+/// its cache range only (cacheEnd − cacheBegin caches in every links_* section) and two more
+/// sections after links_spread_share:
+///   shard            u32 index I, u32 count N, u64 cacheBegin, u64 cacheEnd
+///   shard_sees       (cacheEnd − cacheBegin) × u8: 1 where the cache's links see a surfel, else 0
+///
 /// Both directions check that the counts agree and that every node and cache index is in range
 /// (kNoNode / kNoCache aside; RTP padding links have factor 0), so the runtime can index the
 /// arrays without bounds checks.
@@ -71,8 +77,28 @@ inline constexpr uint64_t kBakeSectionAlignment = 64;
 /// InvalidInput if the bake's arrays are inconsistent, Io naming the path on any failure.
 Result<void> writeBakeFile(const std::string& path, const BakeData& bake);
 
-/// Reads and fully validates a bake file: NotFound if missing, Corrupt naming what is wrong.
+/// Reads and fully validates a bake file: NotFound if missing, Corrupt naming what is wrong (a
+/// part of a sharded bake given as a bake, too).
 Result<BakeData> readBakeFile(const std::string& path);
+
+/// One part of a sharded bake (`picbake bake --shard I/N`): the bake as it stands before the
+/// caches that see no surfel are dropped, every cache present, with the links of the caches
+/// [cacheBegin, cacheEnd) only. `picbake merge` joins the parts (bake/bake.h BakeJoiner).
+struct BakePart {
+    uint32_t index = 0;                ///< I, from 0
+    uint32_t count = 1;                ///< N
+    uint64_t cacheBegin = 0;
+    uint64_t cacheEnd = 0;
+    std::vector<uint8_t> seesSurfel;   ///< per cache of the range: 1 when its links see a surfel
+    BakeData bake;                     ///< links: (cacheEnd − cacheBegin)·nL entries
+};
+
+/// Writes a part atomically, as writeBakeFile writes a bake.
+Result<void> writeBakePart(const std::string& path, const BakePart& part);
+
+/// Reads and fully validates a part: NotFound if missing, Corrupt naming what is wrong (a whole
+/// bake given as a part, too).
+Result<BakePart> readBakePart(const std::string& path);
 
 /// A summary of a validated bake file, for `picbake info`.
 struct BakeFileInfo {

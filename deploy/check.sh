@@ -8,13 +8,14 @@
 #   bash deploy/check.sh
 #
 # What it checks:
-#   - kubectl kustomize renders deploy/k8s and deploy/overlays/example (the latter with
+#   - kubectl kustomize renders deploy/k8s, deploy/k8s/bake and deploy/overlays/example (the latter with
 #     db.env.example as its db.env, in a copy)
 #   - nginx -t accepts deploy/compose/nginx.conf and deploy/k8s/nginx.conf, run on copies in a
 #     temporary directory where the host names are 127.0.0.1, the paths (pid, temp dirs) lie in
 #     that directory, and, on an nginx older than the config needs, the newer syntax is turned
 #     into its older form (each such change is printed)
-#   - the YAML files parse (python3 with PyYAML), compose.yaml has the expected services, and
+#   - the YAML files parse (python3 with PyYAML), compose.yaml has the expected services, the
+#     Indexed Job of deploy/k8s/bake has as many completions as PIC_SHARDS, and
 #     `docker compose config` / `podman-compose config` accept it where they are installed
 #   - deploy/Containerfile copies every source directory the top-level CMakeLists.txt adds
 #   - deploy/Containerfile installs the Debian package of every shared library that the built
@@ -49,15 +50,19 @@ version_ge() {
 check_kustomize() {
     if ! command -v kubectl >/dev/null; then
         skip "kubectl kustomize deploy/k8s: kubectl not installed"
+        skip "kubectl kustomize deploy/k8s/bake: kubectl not installed"
         skip "kubectl kustomize deploy/overlays/example: kubectl not installed"
         return
     fi
     local out="$TMP/kustomize.out"
-    if kubectl kustomize "$HERE/k8s" >"$TMP/base.yaml" 2>"$out"; then
-        pass "kubectl kustomize deploy/k8s ($(grep -c '^kind:' "$TMP/base.yaml") resources)"
-    else
-        fail "kubectl kustomize deploy/k8s" "$out"
-    fi
+    local dir
+    for dir in k8s k8s/bake; do
+        if kubectl kustomize "$HERE/$dir" >"$TMP/rendered.yaml" 2>"$out"; then
+            pass "kubectl kustomize deploy/$dir ($(grep -c '^kind:' "$TMP/rendered.yaml") resources)"
+        else
+            fail "kubectl kustomize deploy/$dir" "$out"
+        fi
+    done
 
     # The overlay reads db.env, which is not in git: render a copy with the example's values.
     mkdir -p "$TMP/kdeploy/overlays"
@@ -142,7 +147,7 @@ import glob, sys, yaml
 bad = False
 parsed = {}
 files = ["compose.yaml", "prometheus.yml", "prometheus-kubernetes.yml"] + sorted(
-    glob.glob("k8s/*.yaml") + glob.glob("overlays/*/*.yaml"))
+    glob.glob("k8s/*.yaml") + glob.glob("k8s/bake/*.yaml") + glob.glob("overlays/*/*.yaml"))
 for f in files:
     try:
         docs = [d for d in yaml.safe_load_all(open(f)) if d is not None]
@@ -166,10 +171,21 @@ for name in ("picserver1", "picserver2", "picserver3"):
             print(f"compose.yaml: {name} has no {flag}"); bad = True
     if s.get("image") != "pic:latest" or "healthcheck" not in s:
         print(f"compose.yaml: {name} lacks image pic:latest or its healthcheck"); bad = True
+# The sharded bake: as many pods as shards.
+for job in parsed.get("k8s/bake/bake-jobs.yaml", []):
+    if job.get("spec", {}).get("completionMode") != "Indexed":
+        continue
+    spec = job["spec"]
+    env = {e["name"]: e.get("value") for e in spec["template"]["spec"]["containers"][0].get("env", [])}
+    completions, shards = spec.get("completions"), int(env.get("PIC_SHARDS", "0"))
+    if completions != shards or not 1 <= spec.get("parallelism", 1) <= completions:
+        print(f"k8s/bake/bake-jobs.yaml: completions {completions}, PIC_SHARDS {shards}, "
+              f"parallelism {spec.get('parallelism')}: expected completions = PIC_SHARDS >= "
+              "parallelism >= 1"); bad = True
 sys.exit(1 if bad else 0)
 EOF
         then
-            pass "YAML parses (compose.yaml, prometheus*.yml, k8s/*.yaml, overlays) and compose.yaml has its 6 services"
+            pass "YAML parses (compose.yaml, prometheus*.yml, k8s/*.yaml, k8s/bake, overlays), compose.yaml has its 6 services, the bake Job's shard counts agree"
         else
             fail "YAML parses / compose.yaml structure" "$out"
         fi

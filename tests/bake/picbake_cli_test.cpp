@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "tests/support/baked_scene.h"
@@ -198,6 +200,90 @@ TEST_F(PicbakeCli, TargetErrorFlagsAreChecked) {
     r = run("bake " + scene("cornell") + " -o " + out + " --target-error 0.1 --pilot-camera 1,2,3");
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("--pilot-camera"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(PicbakeCli, ShardedBakeMergesIntoTheUnshardedFileByteForByte) {
+    // cornell is open at the front, so some caches see no surface and the merge drops them.
+    for (const std::string mode : {"rtp", "sh"}) {
+        SCOPED_TRACE(mode);
+        const std::string flags = " --link-mode " + mode + " --seed 3";
+        const std::string whole = (mDir / ("whole_" + mode + ".pic")).string();
+        ASSERT_EQ(run(smallBake("cornell", whole) + flags).exitCode, 0);
+        std::vector<std::string> parts;
+        for (int i = 0; i < 3; ++i) {
+            parts.push_back((mDir / fmt::format("{}_part{}.pic", mode, i)).string());
+            // One part on one thread: the split of the work between threads changes nothing.
+            test::CommandResult r = run(smallBake("cornell", parts.back()) + flags +
+                                        fmt::format(" --shard {}/3", i) + (i == 1 ? " --threads 1" : ""));
+            ASSERT_EQ(r.exitCode, 0) << r.err;
+            EXPECT_NE(r.out.find(fmt::format("pic bake part {}/3", i)), std::string::npos) << r.out;
+            EXPECT_TRUE(fs::exists(parts.back() + ".timings.json"));
+        }
+        // A part holds a third of the links, not all of them.
+        EXPECT_LT(fs::file_size(parts[0]), fs::file_size(whole));
+        const std::string merged = (mDir / ("merged_" + mode + ".pic")).string();
+        test::CommandResult r = run("merge " + parts[2] + " " + parts[0] + " " + parts[1] + " -o " + merged);
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_NE(r.out.find("pic merge: 3 parts"), std::string::npos) << r.out;
+        EXPECT_EQ(test::readFile(merged), test::readFile(whole));
+        EXPECT_EQ(run("info " + merged).exitCode, 0);
+    }
+    // More shards than some have caches to link, and one shard alone, still give the same file.
+    const std::string whole = (mDir / "whole_rtp.pic").string();
+    const std::string single = (mDir / "single.pic").string(), merged = (mDir / "merged_single.pic").string();
+    ASSERT_EQ(run(smallBake("cornell", single) + " --link-mode rtp --seed 3 --shard 0/1").exitCode, 0);
+    ASSERT_EQ(run("merge " + single + " -o " + merged).exitCode, 0);
+    EXPECT_EQ(test::readFile(merged), test::readFile(whole));
+}
+
+TEST_F(PicbakeCli, MergeRefusesMissingRepeatedAndForeignPartsWithExitCode2) {
+    std::vector<std::string> parts;
+    for (int i = 0; i < 3; ++i) {
+        parts.push_back((mDir / fmt::format("p{}.pic", i)).string());
+        ASSERT_EQ(run(smallBake("cornell", parts.back()) + fmt::format(" --shard {}/3", i)).exitCode, 0);
+    }
+    const std::string out = (mDir / "out.pic").string();
+    test::CommandResult r = run("merge " + parts[0] + " " + parts[2] + " -o " + out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("shard 1 of 3 missing"), std::string::npos) << r.err;
+    r = run("merge " + parts[0] + " " + parts[1] + " " + parts[1] + " " + parts[2] + " -o " + out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("both shard 1 of 3"), std::string::npos) << r.err;
+
+    // A part of a bake with another seed, or of a split two ways, is not one of these.
+    const std::string otherSeed = (mDir / "seed.pic").string(), halves = (mDir / "half.pic").string();
+    ASSERT_EQ(run(smallBake("cornell", otherSeed) + " --seed 9 --shard 1/3").exitCode, 0);
+    r = run("merge " + parts[0] + " " + otherSeed + " " + parts[2] + " -o " + out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("parts of different bakes"), std::string::npos) << r.err;
+    ASSERT_EQ(run(smallBake("cornell", halves) + " --shard 1/2").exitCode, 0);
+    r = run("merge " + parts[0] + " " + halves + " -o " + out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("is shard 1 of 2"), std::string::npos) << r.err;
+
+    // A whole bake is no part, and a part no bake.
+    const std::string whole = (mDir / "whole.pic").string();
+    ASSERT_EQ(run(smallBake("cornell", whole)).exitCode, 0);
+    r = run("merge " + whole + " -o " + out);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("is a whole bake, not a part"), std::string::npos) << r.err;
+    r = run("info " + parts[0]);
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("picbake merge"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(PicbakeCli, ShardFlagIsChecked) {
+    const std::string out = (mDir / "x.pic").string();
+    for (const std::string bad : {"3/3", "1/0", "a/3", "1", "1/", "/3", "1/4097", "0/3x"}) {
+        test::CommandResult r = run(smallBake("cornell", out) + " --shard " + bad);
+        EXPECT_EQ(r.exitCode, 2) << bad;
+        EXPECT_NE(r.err.find("--shard " + bad), std::string::npos) << r.err;
+    }
+    test::CommandResult r = run("bake " + scene("cornell") + " -o " + out + " --target-error 0.1 --shard 0/2");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("--shard cannot be combined with --target-error"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
 }
 

@@ -300,8 +300,10 @@ TEST(Stream, MetricsCountWhatTheServerDid) {
     EXPECT_NE(address, "127.0.0.1:0");
     auto session = served.connection->createSession();
     ASSERT_TRUE(session);
-    ASSERT_TRUE(served.connection->setLights(session->session(), session->editor_token(), pointLight(0.1f)));
+    // Version 1 first: a light set pushed while it computes would supersede it.
     Reader reader(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(reader.waitFor(1));
+    ASSERT_TRUE(served.connection->setLights(session->session(), session->editor_token(), pointLight(0.1f)));
     ASSERT_TRUE(reader.waitFor(2));
 
     const HttpReply reply = httpGet(address, "/metrics");

@@ -666,6 +666,96 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     EXPECT_TRUE(filesInDir().empty());
 }
 
+/// Shard `index` of `count` of `bake`: every array, the links of caches [begin, end) only.
+BakePart partOf(const BakeData& bake, uint32_t index, uint32_t count, uint64_t begin, uint64_t end) {
+    BakePart part;
+    part.index = index;
+    part.count = count;
+    part.cacheBegin = begin;
+    part.cacheEnd = end;
+    part.seesSurfel.assign(end - begin, 1);
+    part.bake = bake;
+    LinkSet& links = part.bake.links;
+    const size_t nL = links.linksPerCache, coefficients = size_t{links.bands} * links.bands;
+    const auto keep = [&](auto& values, size_t perLink) {
+        if (values.empty()) return;
+        values = {values.begin() + begin * nL * perLink, values.begin() + end * nL * perLink};
+    };
+    keep(links.rtp, 1);
+    keep(links.shNodes, 1);
+    keep(links.shCoefficients, coefficients);
+    keep(links.tint, 1);
+    keep(links.offset, 3);
+    keep(links.spreadShare, 1);
+    return part;
+}
+
+TEST_F(BakeFile, PartRoundTripsWithItsShard) {
+    for (const LinkMode mode : {LinkMode::Rtp, LinkMode::Sh}) {
+        BakePart part = partOf(makeBake(mode), 1, 2, 1, 3);
+        part.seesSurfel = {1, 0};
+        const std::string file = path("part.pic");
+        ASSERT_TRUE(writeBakePart(file, part));
+        const Result<BakePart> read = readBakePart(file);
+        ASSERT_TRUE(read) << read.error().message;
+        EXPECT_EQ(read->index, 1u);
+        EXPECT_EQ(read->count, 2u);
+        EXPECT_EQ(read->cacheBegin, 1u);
+        EXPECT_EQ(read->cacheEnd, 3u);
+        EXPECT_EQ(read->seesSurfel, part.seesSurfel);
+        expectSameBake(part.bake, read->bake);
+    }
+    EXPECT_EQ(filesInDir(), std::vector<std::string>{"part.pic"});
+}
+
+TEST_F(BakeFile, APartIsNoBakeAndABakeNoPart) {
+    const BakeData bake = makeBake(LinkMode::Rtp);
+    const auto [bakeFile, bytes] = written(bake);
+    const std::string partFile = path("part.pic");
+    ASSERT_TRUE(writeBakePart(partFile, partOf(bake, 0, 2, 0, 1)));
+    for (const Error& error : {errorOf(readBakeFile(partFile)), errorOf(inspectBakeFile(partFile))}) {
+        EXPECT_EQ(error.code, ErrorCode::Corrupt);
+        EXPECT_TRUE(contains(error.message, "one part of a sharded bake")) << error.message;
+        EXPECT_TRUE(contains(error.message, "picbake merge")) << error.message;
+    }
+    const Error error = errorOf(readBakePart(bakeFile));
+    EXPECT_EQ(error.code, ErrorCode::Corrupt);
+    EXPECT_TRUE(contains(error.message, "is a whole bake, not a part")) << error.message;
+    EXPECT_TRUE(contains(error.message, bakeFile)) << error.message;
+}
+
+TEST_F(BakeFile, InconsistentPartIsNotWrittenAndResealedOneIsRefused) {
+    const BakeData bake = makeBake(LinkMode::Rtp);
+    const std::string file = path("part.pic");
+    BakePart part = partOf(bake, 2, 2, 1, 3);  // shard 2 of 2 does not exist
+    EXPECT_EQ(errorOf(writeBakePart(file, part)).code, ErrorCode::InvalidInput);
+    part = partOf(bake, 1, 2, 1, 3);
+    part.cacheEnd = 4;  // past the 3 caches
+    EXPECT_EQ(errorOf(writeBakePart(file, part)).code, ErrorCode::InvalidInput);
+    part = partOf(bake, 1, 2, 1, 3);
+    part.seesSurfel = {1, 2};
+    EXPECT_EQ(errorOf(writeBakePart(file, part)).code, ErrorCode::InvalidInput);
+    part = partOf(bake, 1, 2, 1, 3);
+    part.cacheBegin = 0;  // links of two caches said to be of three
+    part.seesSurfel = {1, 1, 1};
+    const Error error = errorOf(writeBakePart(file, part));
+    EXPECT_EQ(error.code, ErrorCode::InvalidInput);
+    EXPECT_TRUE(contains(error.message, "3 caches")) << error.message;
+    EXPECT_TRUE(filesInDir().empty());
+
+    // Checksums right, shard record wrong: index 5 of 2.
+    ASSERT_TRUE(writeBakePart(file, partOf(bake, 1, 2, 1, 3)));
+    std::vector<char> bytes = readBytes(file);
+    const size_t shardSection = std::size(kAllSections);
+    const auto offset = load<uint64_t>(bytes, kBakeHeaderBytes + shardSection * kBakeSectionEntryBytes + 24);
+    store<uint32_t>(bytes, offset, 5);
+    resealSection(bytes, shardSection);
+    writeBytes(file, bytes);
+    const Error corrupt = errorOf(readBakePart(file));
+    EXPECT_EQ(corrupt.code, ErrorCode::Corrupt);
+    EXPECT_TRUE(contains(corrupt.message, "shard 5 of 2")) << corrupt.message;
+}
+
 TEST_F(BakeFile, SceneMismatchIsRefused) {
     const BakeData bake = makeBake(LinkMode::Rtp);
     const auto [file, bytes] = written(bake);

@@ -4,6 +4,7 @@
 
 #include "server/session_store.h"
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -142,7 +143,10 @@ TEST_P(SessionStoreTest, RowsAreCreatedFoundSavedOnlyForwardAndRemoved) {
     found = store->find("a");
     ASSERT_TRUE(found);
     EXPECT_FALSE(*found);
-    // A save after a removal puts the row back (a server still carrying the session).
+    // A save after a removal puts the row back (a server still carrying the session), created
+    // now: a millisecond after "b" at least, so that "b" is the older (rows created in the same
+    // millisecond come in id order).
+    std::this_thread::sleep_for(std::chrono::milliseconds(3));
     EXPECT_EQ(outcome(store->save(sessionNamed("a", 4, 0.5f))), "true");
 
     auto all = store->loadAll();
