@@ -1,5 +1,7 @@
 #include "client/connection.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -7,9 +9,13 @@
 #include <fstream>
 #include <iterator>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <thread>
 #include <unistd.h>
+
+#include <grpcpp/create_channel.h>
+#include <grpcpp/support/client_interceptor.h>
 
 #include "core/gltf_loader.h"
 #include "core/sh.h"
@@ -27,10 +33,21 @@ void setDeadline(grpc::ClientContext& context) {
     context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
 }
 
-/// Runs `call(context)` about `session` (a fresh context each try) again while it fails
-/// UNAVAILABLE (the server drains, the session moved, a replica went away) and `patience`
-/// has not passed, with backoff from 50 ms to 1 s. The session id goes in the metadata load
-/// balancers route by.
+/// The delay a RESOURCE_EXHAUSTED reply asks for (wire::kRetryAfterMetadata), if any.
+std::optional<std::chrono::milliseconds> retryAfter(const grpc::ClientContext& context) {
+    const auto& trailers = context.GetServerTrailingMetadata();
+    const auto it = trailers.find(wire::kRetryAfterMetadata);
+    if (it == trailers.end()) return std::nullopt;
+    int64_t ms = 0;
+    const auto [end, ec] = std::from_chars(it->second.data(), it->second.data() + it->second.size(), ms);
+    if (ec != std::errc{} || ms < 0) return std::nullopt;
+    return std::chrono::milliseconds(std::min<int64_t>(ms, 60000));
+}
+
+/// Runs `call(context)` about `session` (a fresh context each try) again while `patience`
+/// has not passed and it fails UNAVAILABLE (the server drains, the session moved, a replica
+/// went away; backoff from 50 ms to 1 s) or RESOURCE_EXHAUSTED with a delay to wait (a rate
+/// limit). The session id goes in the metadata load balancers route by.
 template <class Call>
 grpc::Status retrying(std::chrono::milliseconds patience, const std::string& session, Call call) {
     const auto start = std::chrono::steady_clock::now();
@@ -40,11 +57,18 @@ grpc::Status retrying(std::chrono::milliseconds patience, const std::string& ses
         setDeadline(context);
         if (!session.empty()) context.AddMetadata(wire::kSessionMetadata, session);
         grpc::Status status = call(context);
-        if (status.error_code() != grpc::StatusCode::UNAVAILABLE ||
-            std::chrono::steady_clock::now() - start + backoff > patience)
+        std::chrono::milliseconds wait = backoff;
+        if (status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED) {
+            const auto asked = retryAfter(context);
+            if (!asked) return status;
+            wait = *asked;
+        } else if (status.error_code() != grpc::StatusCode::UNAVAILABLE) {
             return status;
-        std::this_thread::sleep_for(backoff);
-        backoff = std::min(backoff * 2, std::chrono::milliseconds(1000));
+        } else {
+            backoff = std::min(backoff * 2, std::chrono::milliseconds(1000));
+        }
+        if (std::chrono::steady_clock::now() - start + wait > patience) return status;
+        std::this_thread::sleep_for(wait);
     }
 }
 
@@ -55,6 +79,32 @@ std::string drawSessionId() {
     std::lock_guard lock(mutex);
     return fmt::format("{:08x}{:08x}", uint32_t(random()), uint32_t(random()));
 }
+
+/// Adds `authorization: Bearer KEY` to every call of a channel.
+class ApiKeyInterceptor final : public grpc::experimental::Interceptor {
+public:
+    explicit ApiKeyInterceptor(const std::string& value) : mValue(value) {}
+    void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
+        if (methods->QueryInterceptionHookPoint(
+                grpc::experimental::InterceptionHookPoints::PRE_SEND_INITIAL_METADATA))
+            methods->GetSendInitialMetadata()->emplace(wire::kAuthorizationMetadata, mValue);
+        methods->Proceed();
+    }
+
+private:
+    const std::string& mValue;
+};
+
+class ApiKeyInterceptorFactory final : public grpc::experimental::ClientInterceptorFactoryInterface {
+public:
+    explicit ApiKeyInterceptorFactory(const std::string& key) : mValue("Bearer " + key) {}
+    grpc::experimental::Interceptor* CreateClientInterceptor(grpc::experimental::ClientRpcInfo*) override {
+        return new ApiKeyInterceptor(mValue);
+    }
+
+private:
+    std::string mValue;
+};
 
 /// An asset name from the server as a path inside `folder`, or InvalidInput when it would
 /// leave it (a server must not make a client write anywhere else).
@@ -149,10 +199,26 @@ grpc::Status FrameStream::status() {
 }
 
 Result<std::unique_ptr<PicConnection>> PicConnection::connect(const std::string& address,
-                                                              std::chrono::milliseconds timeout,
-                                                              const std::string& rootCertsPem) {
+                                                              const ConnectOptions& options) {
+    const std::string& apiKey = options.apiKey;
+    const std::string& rootCertsPem = options.rootCertsPem;
+    const std::chrono::milliseconds timeout = options.timeout;
+    // gRPC refuses metadata values outside printable ASCII; say so instead of failing each call.
+    if (!std::ranges::all_of(apiKey, [](char c) { return c > ' ' && c < 127; }))
+        return fail(ErrorCode::InvalidInput,
+                    "the API key holds a space or a character outside printable ASCII");
+    if (options.keepalive < std::chrono::seconds(1))
+        return fail(ErrorCode::InvalidInput, "keepalive must be at least 1 s, got {} ms",
+                    options.keepalive.count());
     grpc::ChannelArguments arguments;
-    arguments.SetMaxReceiveMessageSize(-1);
+    arguments.SetMaxReceiveMessageSize(int(wire::kMaxReplyBytes));
+    arguments.SetMaxSendMessageSize(int(wire::kMaxRequestBytes));
+    const int keepaliveMs = int(std::min<int64_t>(options.keepalive.count(), INT32_MAX));
+    arguments.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS, keepaliveMs);
+    arguments.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, std::min(keepaliveMs, 10000));
+    arguments.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    // A stream can be quiet for minutes (no light changes): keep pinging through the silence.
+    arguments.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
     auto connection = std::unique_ptr<PicConnection>(new PicConnection());
     connection->mAddress = address;
     std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
@@ -161,7 +227,14 @@ Result<std::unique_ptr<PicConnection>> PicConnection::connect(const std::string&
         ssl.pem_root_certs = rootCertsPem;
         credentials = grpc::SslCredentials(ssl);
     }
-    connection->mChannel = grpc::CreateCustomChannel(address, credentials, arguments);
+    if (apiKey.empty()) {
+        connection->mChannel = grpc::CreateCustomChannel(address, credentials, arguments);
+    } else {
+        std::vector<std::unique_ptr<grpc::experimental::ClientInterceptorFactoryInterface>> interceptors;
+        interceptors.push_back(std::make_unique<ApiKeyInterceptorFactory>(apiKey));
+        connection->mChannel = grpc::experimental::CreateCustomChannelWithInterceptors(
+            address, credentials, arguments, std::move(interceptors));
+    }
     if (!connection->mChannel->WaitForConnected(std::chrono::system_clock::now() + timeout))
         return fail(ErrorCode::Io, "cannot reach a picserver at {} (waited {} ms{})", address,
                     timeout.count(),

@@ -81,20 +81,35 @@ private:
     std::atomic<uint32_t> mResubscriptions{0};
 };
 
+/// How a PicConnection reaches its server.
+struct ConnectOptions {
+    /// How long to wait for the server to accept the connection.
+    std::chrono::milliseconds timeout = std::chrono::seconds(10);
+    /// TLS, trusting these certificates (PEM); empty: plaintext.
+    std::string rootCertsPem;
+    /// Sent with every call as `authorization: Bearer KEY`: the operator credential of a
+    /// server with --api-keys; empty: none.
+    std::string apiKey;
+    /// A ping after this long without traffic, and the connection counted as dead when the
+    /// answer takes as long again (at most 10 s): a stream from a server that stopped
+    /// answering (frozen, or its network gone) fails UNAVAILABLE instead of waiting forever.
+    std::chrono::milliseconds keepalive = std::chrono::seconds(20);
+};
+
 /// A channel to one picserver and its calls, each returning the server's refusal as an Error
 /// that names the call and the status (INVALID_ARGUMENT → InvalidInput, ...).
 class PicConnection {
 public:
-    /// Connects to `address` ("HOST:PORT"), waiting up to `timeout` for the server; Io when it
-    /// cannot be reached. With `rootCertsPem` the channel is TLS, trusting those certificates.
-    static Result<std::unique_ptr<PicConnection>> connect(
-        const std::string& address, std::chrono::milliseconds timeout = std::chrono::seconds(10),
-        const std::string& rootCertsPem = "");
+    /// Connects to `address` ("HOST:PORT"), waiting up to `options.timeout` for the server; Io
+    /// when it cannot be reached. InvalidInput for an API key that no header can carry.
+    static Result<std::unique_ptr<PicConnection>> connect(const std::string& address,
+                                                          const ConnectOptions& options = {});
 
     const std::string& address() const { return mAddress; }
     /// How long session calls (create, join, stats, set lights) go on trying while the
-    /// server answers UNAVAILABLE: it drains, the session moved to another replica, a replica
-    /// behind the load balancer went away. 0 (the default): one try. A retried SetLights that
+    /// server answers UNAVAILABLE (it drains, the session moved to another replica, a replica
+    /// behind the load balancer went away) or RESOURCE_EXHAUSTED with a delay to wait (too
+    /// many light sets a second). 0 (the default): one try. A retried SetLights that
     /// had been applied before its reply was lost is applied again as a newer version of the
     /// same set.
     void setPatience(std::chrono::milliseconds patience) { mPatience = patience; }

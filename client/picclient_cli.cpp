@@ -39,7 +39,9 @@ struct Common {
     std::string tlsCa;
     std::string session;
     std::string token;
+    std::string apiKey;
     double connectSeconds = 10;
+    double keepaliveSeconds = 20;
     double patienceSeconds = 30;
 };
 
@@ -55,6 +57,14 @@ void addServer(CLI::App& app, Common& common) {
     app.add_option("--tls-ca", common.tlsCa,
                    "connect with TLS, trusting the certificates in this PEM file")
         ->check(CLI::ExistingFile);
+    app.add_option("--keepalive", common.keepaliveSeconds,
+                   "seconds without traffic before a ping; a server that does not answer within "
+                   "as long (at most 10 s) counts as gone (default 20)")
+        ->check(CLI::Range(1.0, 86400.0));
+    app.add_option("--api-key", common.apiKey,
+                   "operator API key of a server with --api-keys (default: $PIC_API_KEY); sent "
+                   "with every call")
+        ->envname("PIC_API_KEY");
 }
 
 void addSession(CLI::App& app, Common& common) {
@@ -74,10 +84,12 @@ Result<std::unique_ptr<PicConnection>> connectTo(const Common& common) {
         if (rootCerts.empty())
             return fail(ErrorCode::InvalidInput, "--tls-ca {} is empty or unreadable", common.tlsCa);
     }
-    PIC_TRY_ASSIGN(auto connection,
-                   PicConnection::connect(common.server,
-                                          std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0)),
-                                          rootCerts));
+    ConnectOptions options;
+    options.timeout = std::chrono::milliseconds(int64_t(common.connectSeconds * 1000.0));
+    options.rootCertsPem = std::move(rootCerts);
+    options.apiKey = common.apiKey;
+    options.keepalive = std::chrono::milliseconds(int64_t(common.keepaliveSeconds * 1000.0));
+    PIC_TRY_ASSIGN(auto connection, PicConnection::connect(common.server, options));
     connection->setPatience(patienceOf(common));
     return connection;
 }

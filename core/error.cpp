@@ -14,4 +14,11 @@ const char* toString(ErrorCode code) {
     return "error";
 }
 
+std::string clipped(std::string_view text, size_t maxBytes) {
+    if (text.size() <= maxBytes) return std::string(text);
+    size_t end = maxBytes;
+    while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+    return std::string(text.substr(0, end)) + "...";
+}
+
 }  // namespace pic

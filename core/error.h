@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <expected>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
@@ -53,6 +54,10 @@ inline int exitCode(const Error& error) {
 
 /// Short lower-case name of an error code, for messages.
 const char* toString(ErrorCode code);
+
+/// Text from a client or a file as a message shows it: at most `maxBytes` (cut at a UTF-8
+/// character boundary) and "..." when cut, so that a megabyte of input never fills a log.
+std::string clipped(std::string_view text, size_t maxBytes = 64);
 
 }  // namespace pic
 

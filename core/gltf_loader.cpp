@@ -845,9 +845,9 @@ private:
         const tinygltf::Light& source = mModel.lights[size_t(index)];
 
         Light light;
-        // A name too long to be a light id (with room for uniqueLightId's "#k") is not used.
-        const bool named =
-            !source.name.empty() && source.name.size() + 8 <= kMaxLightIdBytes;
+        // A name that cannot be a light id (too long, with room for uniqueLightId's "#k", or
+        // with control characters) is not used.
+        const bool named = isLightId(source.name) && source.name.size() + 8 <= kMaxLightIdBytes;
         light.id = uniqueLightId(named ? source.name : fmt::format("light_{}", index));
         if (source.type == "point")
             light.type = LightType::Point;
@@ -984,6 +984,71 @@ private:
     bool mIgnoredMorphTargets = false;
 };
 
+/// The JSON text of a glTF file's bytes: all of a .gltf, the first chunk of a .glb.
+Result<std::string_view> gltfJsonOf(std::string_view bytes, const std::string& path) {
+    if (bytes.size() < kGlbMagic.size() ||
+        !std::equal(kGlbMagic.begin(), kGlbMagic.end(), bytes.begin()))
+        return bytes;
+    // GLB: 12-byte header, then chunk 0 = u32 length, u32 type "JSON", the JSON text.
+    constexpr size_t kChunkData = 20;
+    uint32_t length = 0;
+    uint32_t type = 0;
+    if (bytes.size() >= kChunkData) {
+        std::memcpy(&length, bytes.data() + 12, 4);
+        std::memcpy(&type, bytes.data() + 16, 4);
+    }
+    constexpr uint32_t kJsonChunk = 0x4E4F534Au;
+    if (bytes.size() < kChunkData || type != kJsonChunk || length > bytes.size() - kChunkData)
+        return fail(ErrorCode::Corrupt, "'{}' is not a valid GLB file (no JSON chunk)", path);
+    return bytes.substr(kChunkData, length);
+}
+
+std::string percentDecoded(const std::string& uri) {
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit((unsigned char)uri[i + 1]) &&
+            std::isxdigit((unsigned char)uri[i + 2])) {
+            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+/// The files a glTF's JSON references (buffers and images, not data: URIs), relative to its
+/// folder, each once. InvalidInput for one outside the folder: an absolute path, a ".." part
+/// or a URL; a scene may read only what lies beside it.
+Result<std::vector<std::string>> referencedFiles(std::string_view json, const std::string& path) {
+    nlohmann::json root = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
+    if (!root.is_object())
+        return fail(ErrorCode::Corrupt, "'{}' is not glTF: its JSON does not parse to an object",
+                    path);
+    std::vector<std::string> files;
+    for (const char* list : {"buffers", "images"}) {
+        auto entries = root.find(list);
+        if (entries == root.end() || !entries->is_array()) continue;
+        for (const auto& entry : *entries) {
+            if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
+            std::string uri = entry["uri"].get<std::string>();
+            if (uri.starts_with("data:")) continue;
+            std::string file = percentDecoded(uri);
+            fs::path relative(file);
+            bool escapes = relative.is_absolute() || file.find("://") != std::string::npos ||
+                           file.find('\0') != std::string::npos;
+            for (const auto& part : relative) escapes = escapes || part == "..";
+            if (escapes)
+                return fail(ErrorCode::InvalidInput,
+                            "'{}': {} URI \"{}\" leaves the scene's folder: a scene may only "
+                            "reference files beside it or below",
+                            path, list, uri.substr(0, 256));
+            if (std::find(files.begin(), files.end(), file) == files.end()) files.push_back(file);
+        }
+    }
+    return files;
+}
+
 /// loadScene without the exception guard.
 Result<Scene> loadSceneUnguarded(const std::string& path, const LoadOptions& options) {
     std::error_code ec;
@@ -1005,6 +1070,13 @@ Result<Scene> loadSceneUnguarded(const std::string& path, const LoadOptions& opt
         file.read(reinterpret_cast<char*>(bytes.data()), size);
     }
     if (!file) return fail(ErrorCode::Io, "could not read scene file '{}'", path);
+
+    // Before tinygltf opens anything a URI names: none may leave the scene's folder. A file
+    // that is no glTF at all is left to tinygltf, whose message says what is wrong with it.
+    if (auto json = gltfJsonOf({reinterpret_cast<const char*>(bytes.data()), bytes.size()}, path)) {
+        if (auto files = referencedFiles(*json, path); !files && files.error().code == ErrorCode::InvalidInput)
+            return std::unexpected(files.error());
+    }
 
     std::string extension = fs::path(path).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -1038,71 +1110,14 @@ Result<Scene> loadSceneUnguarded(const std::string& path, const LoadOptions& opt
 
 }  // namespace
 
-namespace {
-
-/// The JSON text of a .gltf file or of a .glb file's first chunk.
-Result<std::string> gltfJsonText(const std::string& path) {
+Result<std::vector<std::string>> sceneFiles(const std::string& path) {
     std::ifstream file(path, std::ios::binary);
     if (!file) return fail(ErrorCode::NotFound, "cannot open scene file '{}'", path);
-    std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    const std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
     if (file.bad()) return fail(ErrorCode::Io, "could not read scene file '{}'", path);
-    if (bytes.size() < kGlbMagic.size() ||
-        !std::equal(kGlbMagic.begin(), kGlbMagic.end(), bytes.begin()))
-        return bytes;
-    // GLB: 12-byte header, then chunk 0 = u32 length, u32 type "JSON", the JSON text.
-    constexpr size_t kChunkData = 20;
-    uint32_t length = 0;
-    uint32_t type = 0;
-    if (bytes.size() >= kChunkData) {
-        std::memcpy(&length, bytes.data() + 12, 4);
-        std::memcpy(&type, bytes.data() + 16, 4);
-    }
-    constexpr uint32_t kJsonChunk = 0x4E4F534Au;
-    if (bytes.size() < kChunkData || type != kJsonChunk || length > bytes.size() - kChunkData)
-        return fail(ErrorCode::Corrupt, "'{}' is not a valid GLB file (no JSON chunk)", path);
-    return bytes.substr(kChunkData, length);
-}
-
-std::string percentDecoded(const std::string& uri) {
-    std::string out;
-    for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit((unsigned char)uri[i + 1]) &&
-            std::isxdigit((unsigned char)uri[i + 2])) {
-            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-            i += 2;
-        } else {
-            out += uri[i];
-        }
-    }
-    return out;
-}
-
-}  // namespace
-
-Result<std::vector<std::string>> sceneFiles(const std::string& path) {
-    PIC_TRY_ASSIGN(std::string text, gltfJsonText(path));
-    nlohmann::json root = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (!root.is_object())
-        return fail(ErrorCode::Corrupt, "'{}' is not glTF: its JSON does not parse to an object",
-                    path);
-    std::vector<std::string> files{fs::path(path).filename().string()};
-    for (const char* list : {"buffers", "images"}) {
-        auto entries = root.find(list);
-        if (entries == root.end() || !entries->is_array()) continue;
-        for (const auto& entry : *entries) {
-            if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
-            std::string uri = entry["uri"].get<std::string>();
-            if (uri.starts_with("data:")) continue;
-            std::string file = percentDecoded(uri);
-            fs::path relative(file);
-            bool escapes = relative.is_absolute() || file.find("://") != std::string::npos;
-            for (const auto& part : relative) escapes = escapes || part == "..";
-            if (escapes)
-                return fail(ErrorCode::InvalidInput,
-                            "'{}': {} URI \"{}\" leaves the scene's folder", path, list, uri);
-            if (std::find(files.begin(), files.end(), file) == files.end()) files.push_back(file);
-        }
-    }
+    PIC_TRY_ASSIGN(const std::string_view json, gltfJsonOf(bytes, path));
+    PIC_TRY_ASSIGN(std::vector<std::string> files, referencedFiles(json, path));
+    files.insert(files.begin(), fs::path(path).filename().string());
     return files;
 }
 

@@ -17,6 +17,8 @@ struct LoadOptions {
 /// Reads the glTF's default scene: triangles instanced under their node transforms, the
 /// materials they use with decoded linear textures, KHR_lights_punctual lights and perspective
 /// cameras. Same file, same Scene (and hash). Errors name the offending mesh, light or image.
+/// A buffer or image URI that leaves the scene's folder (absolute, "..", a URL) is refused
+/// (InvalidInput) before any file it names is opened.
 Result<Scene> loadScene(const std::string& path, const LoadOptions& options = {});
 
 /// The files a glTF scene consists of, relative to the main file's folder: the main file's

@@ -109,7 +109,7 @@ public:
     Result<void> rejectUnknown() const {
         for (auto it = mObject.begin(); it != mObject.end(); ++it)
             if (!mKnown.contains(it.key()))
-                return fail(ErrorCode::InvalidInput, "{} has unknown key \"{}\"", mPath, it.key());
+                return fail(ErrorCode::InvalidInput, "{} has unknown key \"{}\"", mPath, clipped(it.key()));
         return {};
     }
 
@@ -145,6 +145,9 @@ Result<Light> parseLight(const Json& value, size_t index) {
         if (light.id.size() > kMaxLightIdBytes)
             return fail(ErrorCode::InvalidInput, "{} is {} bytes long; at most {} are allowed",
                         fields.fieldPath("id"), light.id.size(), kMaxLightIdBytes);
+        if (!isLightId(light.id))
+            return fail(ErrorCode::InvalidInput, "{} {} holds a control character",
+                        fields.fieldPath("id"), shown(*id));
     } else {
         light.id = fmt::format("light_{}", index);
     }
@@ -175,6 +178,12 @@ Result<Light> parseLight(const Json& value, size_t index) {
     if (light.intensity < 0.0f)
         return fail(ErrorCode::InvalidInput, "{} must be finite and ≥ 0, got {}",
                     fields.fieldPath("intensity"), light.intensity);
+    const float peak = light.intensity * std::max({light.color.x, light.color.y, light.color.z});
+    if (light.intensity > kMaxLightIntensity || peak > kMaxLightIntensity)
+        return fail(ErrorCode::InvalidInput,
+                    "{} × color is {:g} in its largest channel (intensity {:g}); at most {:g} (W/sr "
+                    "for point and spot lights, W/m² for directional ones)",
+                    fields.fieldPath("intensity"), peak, light.intensity, kMaxLightIntensity);
 
     if (light.type != LightType::Directional) {
         PIC_TRY_ASSIGN(light.position, fields.vec3("position", light.position));
@@ -230,10 +239,10 @@ Result<std::map<std::string, float>> parseEmissiveScale(const Json& value) {
     for (auto it = value.begin(); it != value.end(); ++it) {
         const Json& scale = it.value();
         float value = scale.is_number() ? finiteFloat(scale) : -1.0f;
-        if (!(value >= 0.0f))
+        if (!(value >= 0.0f && value <= kMaxEmissiveScale))
             return fail(ErrorCode::InvalidInput,
-                        "emissiveScale[\"{}\"] must be a finite number ≥ 0, got {}", it.key(),
-                        shown(scale));
+                        "emissiveScale[\"{}\"] must be a finite number in [0, {:g}], got {}",
+                        clipped(it.key()), kMaxEmissiveScale, shown(scale));
         scales[it.key()] = value;
     }
     return scales;
@@ -254,6 +263,11 @@ LightSet defaultLightSet(const Scene& scene) {
     LightSet set;
     set.lights = scene.lights;
     return set;
+}
+
+bool isLightId(std::string_view id) {
+    return !id.empty() && id.size() <= kMaxLightIdBytes &&
+           std::ranges::none_of(id, [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
 }
 
 Result<LightSet> parseLightSet(const std::string& json) {
@@ -282,7 +296,7 @@ Result<LightSet> parseLightSet(const std::string& json) {
             // Sessions address lights by id, so two lights must never share one.
             if (!ids.insert(light.id).second)
                 return fail(ErrorCode::InvalidInput, "lights[{}].id \"{}\" is used twice", i,
-                            light.id);
+                            clipped(light.id));
             set.lights.push_back(std::move(light));
         }
     }
@@ -345,7 +359,7 @@ Result<void> checkLightSet(const LightSet& set, const Scene& scene) {
             return fail(ErrorCode::InvalidInput,
                         "emissiveScale names material \"{}\", which the scene does not have "
                         "(materials: {})",
-                        material, known.empty() ? "none" : known);
+                        clipped(material), known.empty() ? "none" : known);
         }
     }
     return {};

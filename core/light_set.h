@@ -6,6 +6,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -18,6 +19,16 @@ inline constexpr size_t kMaxLights = 256;
 /// Longest light id, in bytes (UTF-8): ids name lights in logs, files and the session
 /// database, not payloads.
 inline constexpr size_t kMaxLightIdBytes = 128;
+/// Largest intensity a light may have, and largest intensity × colour in any channel: W/sr
+/// for point and spot lights, W/m² for directional ones (a million suns). Radiance beyond
+/// the half-float range (65504 W/(m²·sr)) saturates in the streamed caches; below this bound
+/// every pass's arithmetic stays finite.
+inline constexpr float kMaxLightIntensity = 1e9f;
+/// Largest emissive scale of a material.
+inline constexpr float kMaxEmissiveScale = 1e6f;
+
+/// Whether `id` may name a light: 1 to kMaxLightIdBytes bytes without control characters.
+bool isLightId(std::string_view id);
 
 /// The dynamic lighting of a scene: punctual lights plus a scale per emissive material.
 struct LightSet {
@@ -32,11 +43,12 @@ struct LightSet {
 LightSet defaultLightSet(const Scene& scene);
 
 /// Parses and validates a light set from JSON text. Errors (InvalidInput) name the field
-/// and value: unknown type, NaN/Inf anywhere, negative intensity or colour, zero-length
-/// direction for spot/directional lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with
-/// outer > 0, negative range, more than kMaxLights lights, duplicate ids, ids longer than
-/// kMaxLightIdBytes, unknown keys,
-/// negative or non-finite emissive scales. Directions are normalised.
+/// and value: unknown type, NaN/Inf anywhere, negative intensity or colour, an intensity or
+/// intensity × colour above kMaxLightIntensity, zero-length direction for spot/directional
+/// lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with outer > 0, negative range, more
+/// than kMaxLights lights, duplicate ids, ids that isLightId refuses, unknown keys, negative,
+/// non-finite or larger than kMaxEmissiveScale emissive scales. Text from the input is clipped
+/// in messages. Directions are normalised.
 Result<LightSet> parseLightSet(const std::string& json);
 
 /// Reads a light set from a JSON file (NotFound if missing).

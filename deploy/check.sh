@@ -9,7 +9,7 @@
 #
 # What it checks:
 #   - kubectl kustomize renders deploy/k8s, deploy/k8s/bake and deploy/overlays/example (the latter with
-#     db.env.example as its db.env, in a copy)
+#     db.env.example and api-keys.example as its db.env and api-keys, in a copy)
 #   - nginx -t accepts deploy/compose/nginx.conf and deploy/k8s/nginx.conf, run on copies in a
 #     temporary directory where the host names are 127.0.0.1, the paths (pid, temp dirs) lie in
 #     that directory, and, on an nginx older than the config needs, the newer syntax is turned
@@ -69,6 +69,7 @@ check_kustomize() {
     cp -r "$HERE/k8s" "$TMP/kdeploy/k8s"
     cp -r "$HERE/overlays/example" "$TMP/kdeploy/overlays/example"
     cp "$HERE/overlays/example/db.env.example" "$TMP/kdeploy/overlays/example/db.env"
+    cp "$HERE/overlays/example/api-keys.example" "$TMP/kdeploy/overlays/example/api-keys"
     if kubectl kustomize "$TMP/kdeploy/overlays/example" >"$TMP/overlay.yaml" 2>"$out"; then
         pass "kubectl kustomize deploy/overlays/example ($(grep -c '^kind:' "$TMP/overlay.yaml") resources)"
     else
@@ -166,7 +167,7 @@ if set(services) != want:
 for name in ("picserver1", "picserver2", "picserver3"):
     s = services.get(name, {})
     args = s.get("command", [])
-    for flag in ("--bake", "--scene", "--listen", "--metrics-listen", "--db", "--backend"):
+    for flag in ("--bake", "--scene", "--listen", "--metrics-listen", "--db", "--backend", "--api-keys"):
         if flag not in args:
             print(f"compose.yaml: {name} has no {flag}"); bad = True
     if s.get("image") != "pic:latest" or "healthcheck" not in s:

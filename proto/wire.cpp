@@ -170,8 +170,6 @@ grpc::Status toStatus(const Error& error) {
     return grpc::Status(code, error.message);
 }
 
-namespace {
-
 const char* statusName(grpc::StatusCode code) {
     switch (code) {
     case grpc::StatusCode::OK: return "OK";
@@ -194,8 +192,6 @@ const char* statusName(grpc::StatusCode code) {
     default: return "UNKNOWN";
     }
 }
-
-}  // namespace
 
 bool isSessionId(const std::string& id) {
     return id.size() == 16 && id.find_first_not_of("0123456789abcdef") == std::string::npos;

@@ -133,22 +133,26 @@ Result<void> checkRuntimeLights(const LightSet& lights, const Scene& scene) {
         return fail(ErrorCode::InvalidInput, "the light set holds {} lights, at most {} are allowed",
                     lights.lights.size(), kMaxLights);
     for (const Light& light : lights.lights) {
-        if (light.id.size() > kMaxLightIdBytes)
-            return fail(ErrorCode::InvalidInput, "a light id is {} bytes long; at most {} are allowed",
-                        light.id.size(), kMaxLightIdBytes);
+        if (!isLightId(light.id))
+            return fail(ErrorCode::InvalidInput,
+                        "light id \"{}\" ({} bytes) is empty, longer than {} bytes or holds a "
+                        "control character",
+                        clipped(light.id), light.id.size(), kMaxLightIdBytes);
+        const float peak = light.intensity * std::max({light.color.x, light.color.y, light.color.z});
         if (!finite(light.position) || !finite(light.direction) || !finite(light.color) ||
             !std::isfinite(light.intensity) || light.intensity < 0.0f ||
-            glm::any(glm::lessThan(light.color, glm::vec3(0.0f))))
+            glm::any(glm::lessThan(light.color, glm::vec3(0.0f))) ||
+            light.intensity > kMaxLightIntensity || !(peak <= kMaxLightIntensity))
             return fail(ErrorCode::InvalidInput,
                         "light \"{}\" has a non-finite or negative position, direction, colour "
-                        "or intensity (intensity {})",
-                        light.id, light.intensity);
+                        "or intensity, or an intensity × colour above {:g} (intensity {})",
+                        clipped(light.id), kMaxLightIntensity, light.intensity);
     }
     for (const auto& [material, scale] : lights.emissiveScale)
-        if (!std::isfinite(scale) || scale < 0.0f)
+        if (!std::isfinite(scale) || scale < 0.0f || scale > kMaxEmissiveScale)
             return fail(ErrorCode::InvalidInput,
-                        "emissiveScale of material \"{}\" is {}; it must be finite and ≥ 0",
-                        material, scale);
+                        "emissiveScale of material \"{}\" is {}; it must be finite and in [0, {:g}]",
+                        clipped(material), scale, kMaxEmissiveScale);
     return {};
 }
 

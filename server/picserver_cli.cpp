@@ -105,12 +105,53 @@ int picserverMain(int argc, char** argv) {
                           ->check(CLI::ExistingFile);
     certOption->needs(keyOption);
     keyOption->needs(certOption);
+    std::string apiKeysPath;
+    app.add_option("--api-keys", apiKeysPath,
+                   "operator API keys, one per line (16-256 printable characters, '#' comments): "
+                   "CreateSession, ListBakes and GetScene then need one");
+    app.add_flag("--allow-unauthenticated", options.allowUnauthenticated,
+                 "serve a non-loopback --listen without --api-keys (anyone who reaches the port "
+                 "may create sessions and download the scenes)");
+    app.add_option("--set-lights-per-second", options.session.setLightsPerSecond,
+                   "light sets a second one session accepts (as many at once); beyond, "
+                   "RESOURCE_EXHAUSTED with the delay to wait (default 30)")
+        ->check(CLI::Range(0.01, 1e6));
+    app.add_option("--max-sessions-per-client", options.maxSessionsPerClient,
+                   "sessions one API key (without keys: one peer host) may hold; 0: only "
+                   "--max-sessions (default 0)")
+        ->check(CLI::Range(size_t(0), size_t(100000)));
+    app.add_option("--max-streams-per-peer", options.maxStreamsPerPeer,
+                   "Subscribe streams one peer host may hold open (default 1000)")
+        ->check(CLI::Range(size_t(1), size_t(1000000)));
+    double keepaliveSeconds = 30.0, connectionAgeMinutes = 60.0;
+    app.add_option("--keepalive-seconds", keepaliveSeconds,
+                   "ping a client after this long without traffic; one that does not answer "
+                   "within as long (at most 20 s) is disconnected")
+        ->check(CLI::Range(1.0, 86400.0));
+    app.add_option("--max-connection-age-minutes", connectionAgeMinutes,
+                   "ask connections older than this to reconnect (calls in progress finish); 0: "
+                   "never")
+        ->check(CLI::Range(0.0, 1e6));
+    app.add_option("--audit-log", options.auditLog,
+                   "append a JSON line per call here: time, peer, credential id, call, session, "
+                   "outcome (never a token or key)");
     addGlobalFlags(app);
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     if (bakePaths.size() != scenePaths.size())
         return reportError({ErrorCode::InvalidInput,
                             fmt::format("{} --bake but {} --scene; give one scene per bake",
                                         bakePaths.size(), scenePaths.size())});
+    if (!apiKeysPath.empty()) {
+        auto keys = ApiKeys::load(apiKeysPath);
+        if (!keys) return reportError(keys.error());
+        options.apiKeys = std::move(*keys);
+        std::fprintf(stderr, "picserver: %zu API key%s: %s\n", options.apiKeys.size(),
+                     options.apiKeys.size() == 1 ? "" : "s",
+                     fmt::format("{}", fmt::join(options.apiKeys.ids(), ", ")).c_str());
+    }
+    // So is a server open to anyone who reaches its address.
+    if (auto open = checkOpenListen(listen, !options.apiKeys.empty(), options.allowUnauthenticated); !open)
+        return reportError(open.error());
     // A database file that cannot be used is refused before the bakes take seconds to load.
     if (!options.dbPath.empty() && !SessionStore::isPostgres(options.dbPath))
         if (auto usable = SessionStore::checkPath(options.dbPath); !usable)
@@ -162,6 +203,8 @@ int picserverMain(int argc, char** argv) {
         *pem = std::move(*text);
     }
     options.sessionIdle = std::chrono::milliseconds(int64_t(idleMinutes * 60000.0));
+    options.keepalive = std::chrono::milliseconds(int64_t(keepaliveSeconds * 1000.0));
+    options.maxConnectionAge = std::chrono::milliseconds(int64_t(connectionAgeMinutes * 60000.0));
     options.session.log = logUpdate;
     options.onListening = [](const std::string& address) {
         std::printf("listening on %s\n", address.c_str());

@@ -17,6 +17,7 @@
 #include "rays/embree_scene.h"
 #include "render/gpu_runtime.h"
 #include "render/runtime.h"
+#include "server/limits.h"
 
 namespace pic {
 
@@ -58,7 +59,8 @@ public:
 
     /// Relights the scene with `lights` and gives the resulting caches as a frame's half
     /// planes (core/frame_codec.h), one session at a time (the runtime keeps per-light state
-    /// such as shadow maps). When `abandon` is set by the time this session's turn comes, it
+    /// such as shadow maps), in the order the sessions asked (FairMutex: round robin, since
+    /// each session waits for one relight at most). When `abandon` is set by the time this session's turn comes, it
     /// returns at once with an error (Io) instead: a session that is closing waits for no
     /// computation but the one already running.
     Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
@@ -78,7 +80,7 @@ private:
     BakeData mBake;
     std::unique_ptr<EmbreeScene> mRays;
     std::unique_ptr<Runtime> mRuntime;
-    std::mutex mRuntimeMutex;
+    FairMutex mRuntimeMutex;  ///< sessions relight in the order they asked
     std::string mDevice;
     std::string mDirectVisibility;
     double mWarmUpMs = 0.0;

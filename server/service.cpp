@@ -13,23 +13,13 @@
 
 #include "proto/pic.grpc.pb.h"
 #include "proto/wire.h"
+#include "server/audit_log.h"
+#include "server/limits.h"
 #include "server/metrics_http.h"
 #include "server/session_store.h"
 #include "server/token_digest.h"
 
 namespace pic {
-
-namespace {
-
-/// Compares token digests in time independent of where they differ.
-bool sameDigest(const std::string& a, const std::string& b) {
-    if (a.size() != b.size()) return false;
-    unsigned char diff = 0;
-    for (size_t i = 0; i < a.size(); ++i) diff |= (unsigned char)(a[i] ^ b[i]);
-    return diff == 0;
-}
-
-}  // namespace
 
 struct PicServer::State {
     std::vector<std::unique_ptr<ServedBake>> bakes;
@@ -45,6 +35,21 @@ struct PicServer::State {
     std::mutex takeoverMutex;               ///< one session loaded from the database at a time
     grpc::HealthCheckServiceInterface* health = nullptr;
     std::shared_ptr<Metrics> metrics = std::make_shared<Metrics>();
+    std::unique_ptr<AuditLog> audit;        ///< null without --audit-log
+    std::map<std::string, size_t> streamsByPeer;  ///< open Subscribe streams per peer host (under mutex)
+
+    /// The audit line of a call answered with `status` (server/audit_log.h).
+    void recordCall(const grpc::CallbackServerContext& context, std::string_view call,
+                    std::string_view credential, std::string_view session,
+                    const grpc::Status& status) const {
+        if (!audit) return;
+        std::string_view forwardedFor;
+        if (auto it = context.client_metadata().find("x-forwarded-for");
+            it != context.client_metadata().end())
+            forwardedFor = std::string_view(it->second.data(), it->second.size());
+        audit->record({context.peer(), forwardedFor, call, credential, session,
+                       wire::statusName(status.error_code()), status.error_message()});
+    }
 
     /// `call()` on the database, timed and counted in the metrics as `op`.
     template <class Call>
@@ -146,8 +151,9 @@ struct PicServer::State {
     /// Only a caller holding one of its tokens (`digest`) has it loaded.
     grpc::Status takeOver(const std::string& id, const std::string& digest,
                           std::shared_ptr<Session>& out) {
-        const grpc::Status notFound(grpc::StatusCode::NOT_FOUND, fmt::format("no session \"{}\"", id));
-        if (!store) return notFound;
+        const grpc::Status notFound(grpc::StatusCode::NOT_FOUND, fmt::format("no session \"{}\"", clipped(id)));
+        // Ids of another form were never drawn: not worth a database query.
+        if (!store || !wire::isSessionId(id)) return notFound;
         std::lock_guard loading(takeoverMutex);
         for (int attempt = 0; attempt < 3; ++attempt) {
             if ((out = findSession(id))) return grpc::Status::OK;
@@ -157,7 +163,7 @@ struct PicServer::State {
             StoredSession stored = std::move(**found);
             if (!sameDigest(digest, stored.editorDigest) && !sameDigest(digest, stored.viewerDigest))
                 return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
-                                    fmt::format("the token is not one of session \"{}\"", id));
+                                    fmt::format("the token is not one of session \"{}\"", clipped(id)));
             if (const std::string why = unusable(stored); !why.empty())
                 return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                                     fmt::format("session \"{}\" cannot be served here: {}", id, why));
@@ -195,7 +201,7 @@ struct PicServer::State {
             return grpc::Status::OK;
         }
         return grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                            fmt::format("session \"{}\" is moving between servers; retry", id));
+                            fmt::format("session \"{}\" is moving between servers; retry", clipped(id)));
     }
 };
 
@@ -226,8 +232,41 @@ Access authorise(PicServer::State& state, const std::string& id, const std::stri
         access.role = v1::VIEWER;
     else
         access.status = grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
-                                     fmt::format("the token is not one of session \"{}\"", id));
+                                     fmt::format("the token is not one of session \"{}\"", clipped(id)));
     return access;
+}
+
+const char* roleName(v1::Role role) {
+    return role == v1::EDITOR ? "editor" : role == v1::VIEWER ? "viewer" : "none";
+}
+
+/// Whether the caller of operator call `call` (CreateSession, ListBakes, GetScene) presented
+/// one of the server's API keys; `credential` says who it is: the key's id, "anonymous" on a
+/// server without keys, "none" when refused (UNAUTHENTICATED).
+grpc::Status operatorAccess(const PicServer::State& state, const grpc::CallbackServerContext& context,
+                            std::string_view call, std::string& credential) {
+    credential = "none";
+    if (state.options.apiKeys.empty()) {
+        credential = "anonymous";
+        return grpc::Status::OK;
+    }
+    const auto& metadata = context.client_metadata();
+    const auto it = metadata.find(wire::kAuthorizationMetadata);
+    if (it == metadata.end())
+        return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                            fmt::format("{} needs an operator API key (picclient --api-key KEY or "
+                                        "PIC_API_KEY)",
+                                        call));
+    const auto key = bearerKey(std::string_view(it->second.data(), it->second.size()));
+    if (!key)
+        return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                            "the authorization metadata must be \"Bearer KEY\"");
+    const auto id = state.options.apiKeys.find(*key);
+    if (!id)
+        return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                            "the API key is not one of this server's");
+    credential = *id;
+    return grpc::Status::OK;
 }
 
 /// GetScene: the header, then the assets' bytes in chunks, one write at a time.
@@ -272,8 +311,10 @@ private:
 /// flight, so a slow client skips versions and holds at most one frame in the server.
 class FrameWriter final : public grpc::ServerWriteReactor<v1::Frame> {
 public:
-    FrameWriter(std::shared_ptr<Session> session, std::shared_ptr<Metrics> metrics)
-        : mSession(std::move(session)), mMetrics(std::move(metrics)) {
+    /// `onDone` runs once the stream is over.
+    FrameWriter(std::shared_ptr<Session> session, std::shared_ptr<Metrics> metrics,
+                std::function<void()> onDone)
+        : mSession(std::move(session)), mMetrics(std::move(metrics)), mOnDone(std::move(onDone)) {
         // The slot may wake after this reactor is gone (a publish that copied the slot list
         // before unsubscribe); the link tells it so.
         mLink = std::make_shared<Link>();
@@ -313,6 +354,7 @@ public:
             mLink->writer = nullptr;
         }
         mSession->unsubscribe(mSlot.get());
+        if (mOnDone) mOnDone();
         delete this;
     }
 
@@ -361,6 +403,7 @@ private:
 
     std::shared_ptr<Session> mSession;
     std::shared_ptr<Metrics> mMetrics;
+    std::function<void()> mOnDone;
     std::shared_ptr<Link> mLink;
     std::shared_ptr<SubscriberSlot> mSlot;
     std::shared_ptr<const v1::Frame> mInFlight;  ///< alive until its write is done
@@ -377,49 +420,74 @@ public:
     grpc::ServerUnaryReactor* ListBakes(grpc::CallbackServerContext* context,
                                         const v1::ListBakesRequest*,
                                         v1::ListBakesResponse* response) override {
+        Call call{"ListBakes"};
+        if (auto denied = operatorAccess(*mState, *context, call.name, call.credential); !denied.ok())
+            return finish(context, call, denied);
         for (const auto& bake : mState->bakes) *response->add_bakes() = bake->summary();
         response->set_backend(mState->bakes.front()->device().empty() ? "cpu" : "gpu");
         response->set_device(mState->bakes.front()->device());
-        return finish(context, grpc::Status::OK);
+        return finish(context, call, grpc::Status::OK);
     }
 
-    grpc::ServerWriteReactor<v1::SceneChunk>* GetScene(grpc::CallbackServerContext*,
+    grpc::ServerWriteReactor<v1::SceneChunk>* GetScene(grpc::CallbackServerContext* context,
                                                        const v1::GetSceneRequest* request) override {
-        const ServedBake* bake = mState->findBake(request->bake_id());
-        if (!bake)
-            return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::SceneChunk>>(
-                grpc::Status(grpc::StatusCode::NOT_FOUND,
-                             fmt::format("no bake \"{}\"", request->bake_id())));
+        using Refusal = grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::SceneChunk>>;
+        std::string credential;
+        grpc::Status status = operatorAccess(*mState, *context, "GetScene", credential);
+        const ServedBake* bake = status.ok() ? mState->findBake(request->bake_id()) : nullptr;
+        if (status.ok() && !bake)
+            status = grpc::Status(grpc::StatusCode::NOT_FOUND,
+                                  fmt::format("no bake \"{}\"", clipped(request->bake_id())));
+        mState->recordCall(*context, "GetScene", credential, "", status);
+        if (!status.ok()) return new Refusal(status);
         return new SceneWriter(*bake, request->header_only());
     }
 
     grpc::ServerUnaryReactor* CreateSession(grpc::CallbackServerContext* context,
                                             const v1::CreateSessionRequest* request,
                                             v1::CreateSessionResponse* response) override {
+        Call call{"CreateSession"};
+        call.session = request->session();
+        if (auto denied = operatorAccess(*mState, *context, call.name, call.credential); !denied.ok())
+            return finish(context, call, denied);
+        // Whom the session counts against: the key, or without keys the peer's host.
+        const std::string creator = mState->options.apiKeys.empty()
+                                        ? "peer " + peerHost(context->peer())
+                                        : call.credential;
         if (mState->stopping)
-            return finish(context, grpc::Status(grpc::StatusCode::UNAVAILABLE,
+            return finish(context, call, grpc::Status(grpc::StatusCode::UNAVAILABLE,
                                                 "the server is shutting down"));
         ServedBake* bake = mState->findBake(request->bake_id());
         if (!bake)
-            return finish(context, grpc::Status(grpc::StatusCode::NOT_FOUND,
-                                                fmt::format("no bake \"{}\"", request->bake_id())));
+            return finish(context, call, grpc::Status(grpc::StatusCode::NOT_FOUND,
+                                                fmt::format("no bake \"{}\"", clipped(request->bake_id()))));
         // An id the client drew (behind a load balancer: the one it routed by), else ours.
         const std::string& wanted = request->session();
         if (!wanted.empty() && !wire::isSessionId(wanted))
-            return finish(context, grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+            return finish(context, call, grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                                                 fmt::format("session \"{}\" is not 16 lowercase "
                                                             "hex digits",
-                                                            wanted.substr(0, 64))));
+                                                            clipped(wanted))));
         const grpc::Status taken(grpc::StatusCode::ALREADY_EXISTS,
                                  fmt::format("session \"{}\" exists already", wanted));
         {
             std::lock_guard lock(mState->mutex);
-            if (!wanted.empty() && mState->sessions.contains(wanted)) return finish(context, taken);
+            if (!wanted.empty() && mState->sessions.contains(wanted)) return finish(context, call, taken);
             if (!mState->hasRoom())
-                return finish(context,
+                return finish(context, call,
                               grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                                            fmt::format("the server holds its maximum of {} sessions",
                                                        mState->options.maxSessions)));
+            if (const size_t most = mState->options.maxSessionsPerClient; most > 0) {
+                const size_t held = size_t(std::ranges::count_if(
+                    mState->sessions, [&](const auto& entry) { return entry.second->creator() == creator; }));
+                if (held >= most)
+                    return finish(context, call,
+                                  grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                               fmt::format("{} holds {} sessions, the most one client may "
+                                                           "(--max-sessions-per-client)",
+                                                           creator, held)));
+            }
             ++mState->creating;
         }
         // The session is in the database before anyone hears of it; an id of ours that
@@ -464,43 +532,58 @@ public:
             if (status.ok()) {
                 session = std::make_shared<Session>(id, tokenDigest(editorToken),
                                                     tokenDigest(viewerToken), *bake,
-                                                    mState->options.session);
+                                                    mState->options.session,
+                                                    SessionStart{.creator = creator});
                 mState->sessions[id] = session;
             }
         }
-        if (!status.ok()) return finish(context, status);
+        if (!status.ok()) return finish(context, call, status);
         // The only time the tokens leave the server; it keeps their digests.
+        call.session = session->id();
         response->set_session(session->id());
         response->set_editor_token(editorToken);
         response->set_viewer_token(viewerToken);
         response->set_bake_id(bake->id());
         response->set_version(session->latestVersion());
-        return finish(context, grpc::Status::OK);
+        return finish(context, call, grpc::Status::OK);
     }
 
     grpc::ServerUnaryReactor* JoinSession(grpc::CallbackServerContext* context,
                                           const v1::JoinSessionRequest* request,
                                           v1::JoinSessionResponse* response) override {
         Access access = authorise(*mState, request->session(), request->token());
-        if (!access.status.ok()) return finish(context, access.status);
+        const Call call{"JoinSession", roleName(access.role), request->session()};
+        if (!access.status.ok()) return finish(context, call, access.status);
         access.session->touch();
         response->set_role(access.role);
         response->set_bake_id(access.session->bake().id());
         response->set_version(access.session->latestVersion());
         *response->mutable_lights() = wire::toProto(access.session->latestLights());
-        return finish(context, grpc::Status::OK);
+        return finish(context, call, grpc::Status::OK);
     }
 
     grpc::ServerUnaryReactor* SetLights(grpc::CallbackServerContext* context,
                                         const v1::SetLightsRequest* request,
                                         v1::SetLightsResponse* response) override {
         Access access = authorise(*mState, request->session(), request->token());
-        if (!access.status.ok()) return finish(context, access.status);
+        const Call call{"SetLights", roleName(access.role), request->session()};
+        if (!access.status.ok()) return finish(context, call, access.status);
         if (access.role != v1::EDITOR)
-            return finish(context, grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
+            return finish(context, call, grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
                                                 "only an editor token may set lights"));
+        if (const auto wait = access.session->takeSetLightsTurn(); wait.count() > 0) {
+            // The delay goes in the trailing metadata too, for clients that wait and retry.
+            context->AddTrailingMetadata(wire::kRetryAfterMetadata, std::to_string(wait.count()));
+            return finish(context, call,
+                          grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                       fmt::format("session {} takes at most {:g} light sets a second; "
+                                                   "retry in {} ms",
+                                                   access.session->id(),
+                                                   mState->options.session.setLightsPerSecond,
+                                                   wait.count())));
+        }
         auto lights = wire::fromProto(request->lights());
-        if (!lights) return finish(context, wire::toStatus(lights.error()));
+        if (!lights) return finish(context, call, wire::toStatus(lights.error()));
         // Durable before the reply: the set is committed to the database, then queued.
         const std::shared_ptr<Session>& session = access.session;
         bool moved = false;
@@ -524,44 +607,71 @@ public:
         auto version = session->setLights(std::move(*lights), commit);
         if (moved) {
             mState->evict(session);
-            return finish(context,
+            return finish(context, call,
                           grpc::Status(grpc::StatusCode::UNAVAILABLE,
                                        fmt::format("session {} moved to another server; the light "
                                                    "set was not applied, send it again",
                                                    session->id())));
         }
-        if (storeStatus) return finish(context, *storeStatus);
+        if (storeStatus) return finish(context, call, *storeStatus);
         if (!version) {
             if (version.error().code == ErrorCode::Io)  // closed while it was being set
-                return finish(context, grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                return finish(context, call, grpc::Status(grpc::StatusCode::UNAVAILABLE,
                                                     version.error().message));
-            return finish(context, wire::toStatus(version.error()));
+            return finish(context, call, wire::toStatus(version.error()));
         }
         response->set_version(*version);
-        return finish(context, grpc::Status::OK);
+        return finish(context, call, grpc::Status::OK);
     }
 
-    grpc::ServerWriteReactor<v1::Frame>* Subscribe(grpc::CallbackServerContext*,
+    grpc::ServerWriteReactor<v1::Frame>* Subscribe(grpc::CallbackServerContext* context,
                                                    const v1::SubscribeRequest* request) override {
         Access access = authorise(*mState, request->session(), request->token());
+        const std::string peer = peerHost(context->peer());
+        if (access.status.ok()) {
+            std::lock_guard lock(mState->mutex);
+            size_t& open = mState->streamsByPeer[peer];
+            if (open >= mState->options.maxStreamsPerPeer)
+                access.status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                             fmt::format("{} holds {} streams, the most one peer may "
+                                                         "(--max-streams-per-peer)",
+                                                         peer, open));
+            else
+                ++open;
+        }
+        mState->recordCall(*context, "Subscribe", roleName(access.role), request->session(),
+                           access.status);
         if (!access.status.ok())
             return new grpc::internal::FinishOnlyReactor<grpc::ServerWriteReactor<v1::Frame>>(
                 access.status);
-        return new FrameWriter(std::move(access.session), mState->metrics);
+        return new FrameWriter(std::move(access.session), mState->metrics, [state = mState, peer] {
+            std::lock_guard lock(state->mutex);
+            if (auto it = state->streamsByPeer.find(peer); it != state->streamsByPeer.end() && --it->second == 0)
+                state->streamsByPeer.erase(it);
+        });
     }
 
     grpc::ServerUnaryReactor* GetStats(grpc::CallbackServerContext* context,
                                        const v1::GetStatsRequest* request,
                                        v1::SessionStats* response) override {
         Access access = authorise(*mState, request->session(), request->token());
-        if (!access.status.ok()) return finish(context, access.status);
+        const Call call{"GetStats", roleName(access.role), request->session()};
+        if (!access.status.ok()) return finish(context, call, access.status);
         *response = access.session->stats();
-        return finish(context, grpc::Status::OK);
+        return finish(context, call, grpc::Status::OK);
     }
 
 private:
-    static grpc::ServerUnaryReactor* finish(grpc::CallbackServerContext* context,
-                                            grpc::Status status) {
+    /// What the audit log says of a unary call.
+    struct Call {
+        const char* name;
+        std::string credential = "none";
+        std::string session;
+    };
+
+    grpc::ServerUnaryReactor* finish(grpc::CallbackServerContext* context, const Call& call,
+                                     grpc::Status status) {
+        mState->recordCall(*context, call.name, call.credential, call.session, status);
         grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
         reactor->Finish(std::move(status));
         return reactor;
@@ -672,8 +782,13 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     if (colon == std::string::npos || colon == 0 || colon + 1 == listen.size())
         return fail(ErrorCode::InvalidInput, "--listen must be HOST:PORT, got \"{}\"", listen);
 
+    PIC_TRY(checkOpenListen(listen, !options.apiKeys.empty(), options.allowUnauthenticated));
+
     std::unique_ptr<PicServer> server(new PicServer());
     server->mState = std::make_shared<State>();
+    if (!options.auditLog.empty()) {
+        PIC_TRY_ASSIGN(server->mState->audit, AuditLog::open(options.auditLog));
+    }
     server->mState->bakes = std::move(bakes);
     // Every computed version goes into the metrics, then to the caller's log.
     options.session.log = [metrics = server->mState->metrics,
@@ -722,8 +837,20 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     }
     builder.AddListeningPort(listen, credentials, &port);
     builder.RegisterService(server->mService.get());
-    // Scene assets go in 1 MiB chunks, but key frames of large bakes can be bigger.
-    builder.SetMaxSendMessageSize(-1);
+    // Requests are light sets and ids; replies are scene chunks of 1 MiB and key frames.
+    builder.SetMaxReceiveMessageSize(int(wire::kMaxRequestBytes));
+    builder.SetMaxSendMessageSize(int(wire::kMaxReplyBytes));
+    const auto clampMs = [](std::chrono::milliseconds ms) { return int(std::min<int64_t>(ms.count(), INT32_MAX)); };
+    if (options.keepalive.count() < 1000)
+        return fail(ErrorCode::InvalidInput, "keepalive must be at least 1 s, got {} ms", options.keepalive.count());
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, clampMs(options.keepalive));
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, std::min(clampMs(options.keepalive), 20000));
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+    // Clients may ping once a second (picclient --keepalive 1); more often counts as abuse.
+    builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 1000);
+    if (options.maxConnectionAge.count() > 0)
+        builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, clampMs(options.maxConnectionAge));
     server->mServer = builder.BuildAndStart();
     if (!server->mServer || port == 0)
         return fail(ErrorCode::InvalidInput, "cannot listen on \"{}\" (address in use or invalid)",

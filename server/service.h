@@ -15,6 +15,7 @@
 #include <grpcpp/server.h>
 
 #include "core/error.h"
+#include "server/api_keys.h"
 #include "server/metrics_http.h"
 #include "server/served_bake.h"
 #include "server/session.h"
@@ -38,6 +39,24 @@ struct ServerOptions {
     /// The session database (server/session_store.h): an SQLite file or a PostgreSQL URI;
     /// empty: sessions end with the server.
     std::string dbPath;
+    /// Operator keys that CreateSession, ListBakes and GetScene need (server/api_keys.h);
+    /// empty: those calls are open, which start() allows only on a loopback address unless
+    /// allowUnauthenticated.
+    ApiKeys apiKeys;
+    bool allowUnauthenticated = false;
+    /// Where to append the audit log (server/audit_log.h); empty: nowhere.
+    std::string auditLog;
+    /// A ping to a client after this long without traffic; a client that does not answer
+    /// within as long (at most 20 s) is disconnected and its streams end.
+    std::chrono::milliseconds keepalive = std::chrono::seconds(30);
+    /// Sessions one client may hold: one API key, or one peer host on a server without keys
+    /// (counted while this server holds them). 0: only maxSessions.
+    size_t maxSessionsPerClient = 0;
+    /// Subscribe streams one peer host may hold open at once.
+    size_t maxStreamsPerPeer = 1000;
+    /// A connection older than this is asked to go (HTTP/2 GOAWAY): its calls finish, new ones
+    /// take a new connection, so that clients spread over replicas added since. 0: never.
+    std::chrono::milliseconds maxConnectionAge = std::chrono::hours(1);
 };
 
 class PicServer {
@@ -45,8 +64,9 @@ public:
     /// Serves `bakes` (at least one; the first is the default) on `listen` ("HOST:PORT"; port 0
     /// picks a free one), restoring the sessions of an SQLite `options.dbPath` (a shared
     /// PostgreSQL database's sessions are taken over on their first request instead).
-    /// InvalidInput for an address gRPC cannot bind or a database path that cannot hold the
-    /// database, Corrupt for an unreadable database, Io for one that cannot be reached.
+    /// InvalidInput for an address gRPC cannot bind, a non-loopback address without API keys
+    /// (unless allowUnauthenticated), an audit log that cannot be opened or a database path
+    /// that cannot hold the database, Corrupt for an unreadable database, Io for one that cannot be reached.
     static Result<std::unique_ptr<PicServer>> start(std::vector<std::unique_ptr<ServedBake>> bakes,
                                                     const std::string& listen,
                                                     ServerOptions options);

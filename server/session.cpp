@@ -77,7 +77,9 @@ Session::Session(std::string id, std::string editorDigest, std::string viewerDig
       mEditorDigest(std::move(editorDigest)),
       mViewerDigest(std::move(viewerDigest)),
       mBake(bake),
-      mOptions(std::move(options)) {
+      mOptions(std::move(options)),
+      mCreator(std::move(start.creator)),
+      mSetLightsRate(mOptions.setLightsPerSecond, mOptions.setLightsPerSecond) {
     mLatestLights = start.lights ? std::move(*start.lights) : defaultLightSet(bake.scene());
     mNextVersion = std::max<uint64_t>(start.version, 1);
     mStats.set_versions_set(mNextVersion);

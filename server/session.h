@@ -29,6 +29,7 @@
 #include "core/light_set.h"
 #include "proto/pic.pb.h"
 #include "render/runtime.h"
+#include "server/limits.h"
 
 namespace pic {
 
@@ -97,6 +98,9 @@ struct SessionOptions {
     uint32_t keyframeInterval = 32;   ///< every N-th version is broadcast as a key frame
     int zstdLevel = kDefaultZstdLevel;
     std::function<void(const UpdateLog&)> log;  ///< called once per computed update
+    /// Light sets a second the session accepts (burst: as many); beyond, SetLights is refused
+    /// with the time until the next one would be accepted.
+    double setLightsPerSecond = 30.0;
 };
 
 /// Where a session starts: version 1 with the scene's own lights, or, for a session restored
@@ -104,6 +108,9 @@ struct SessionOptions {
 struct SessionStart {
     uint64_t version = 1;
     std::optional<LightSet> lights;
+    /// Who created it, for quotas (an API key's id or a peer's host); empty for a session
+    /// restored or taken over from the database, which counts against nobody.
+    std::string creator;
 };
 
 class Session {
@@ -122,6 +129,11 @@ public:
     const std::string& editorDigest() const { return mEditorDigest; }
     const std::string& viewerDigest() const { return mViewerDigest; }
     ServedBake& bake() const { return mBake; }
+    /// SessionStart::creator.
+    const std::string& creator() const { return mCreator; }
+    /// A light set's turn under SessionOptions::setLightsPerSecond: zero when it may go on,
+    /// else how long until one may.
+    std::chrono::milliseconds takeSetLightsTurn() { return mSetLightsRate.take(); }
 
     /// What makes an accepted light set durable before the session queues it (the server's
     /// database): called with the version the set will produce; its error refuses the set.
@@ -174,6 +186,8 @@ private:
     std::string mViewerDigest;
     ServedBake& mBake;
     SessionOptions mOptions;
+    std::string mCreator;
+    TokenBucket mSetLightsRate;
 
     std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
     std::mutex mCommitMutex;   ///< one light set committed at a time, in version order

@@ -25,4 +25,11 @@ std::string tokenDigest(std::string_view token) {
     return hex;
 }
 
+bool sameDigest(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    unsigned char diff = 0;
+    for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    return diff == 0;
+}
+
 }  // namespace pic

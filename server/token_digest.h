@@ -11,4 +11,7 @@ namespace pic {
 /// SHA-256 of `token`, as 64 lowercase hex digits.
 std::string tokenDigest(std::string_view token);
 
+/// Compares digests in time independent of where they differ.
+bool sameDigest(std::string_view a, std::string_view b);
+
 }  // namespace pic

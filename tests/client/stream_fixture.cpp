@@ -29,6 +29,8 @@ Served serve(const std::string& backend, uint32_t keyframeInterval,
              std::chrono::milliseconds sessionIdle, const std::string& dbPath) {
     ServerOptions options;
     options.session.keyframeInterval = keyframeInterval;
+    // The stream tests push light sets back to back; the rate limit has a test of its own.
+    options.session.setLightsPerSecond = 1e6;
     options.sessionIdle = sessionIdle;
     options.dbPath = dbPath;
     return serveWith(options, backend);
@@ -128,6 +130,18 @@ int Child::wait() {
     if (mPid <= 0) return -1;
     int status = 0;
     waitpid(std::exchange(mPid, -1), &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::optional<int> Child::waitFor(std::chrono::milliseconds timeout) {
+    if (mPid <= 0) return -1;
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    int status = 0;
+    while (waitpid(mPid, &status, WNOHANG) == 0) {
+        if (std::chrono::steady_clock::now() > end) return std::nullopt;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    mPid = -1;
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <utility>
 #include <string>
 #include <thread>
@@ -17,6 +18,7 @@
 #include "client/connection.h"
 #include "core/frame_codec.h"
 #include "core/light_set.h"
+#include "proto/wire.h"
 #include "server/service.h"
 
 namespace pic::test {
@@ -33,7 +35,8 @@ struct Served {
     std::unique_ptr<PicConnection> connection;
 };
 
-/// A server over the test bake on 127.0.0.1 (one bounce), and a connection to it.
+/// A server over the test bake on 127.0.0.1 (one bounce, no light-set rate limit), and a
+/// connection to it.
 Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
              std::chrono::milliseconds sessionIdle = std::chrono::hours(1),
              const std::string& dbPath = "");
@@ -121,9 +124,7 @@ private:
         const grpc::Status status = mStream->status();
         std::lock_guard lock(mMutex);
         mEnded = true;
-        mEndCode = status.error_code() == grpc::StatusCode::UNAVAILABLE ? "UNAVAILABLE"
-                   : status.ok()                                        ? "OK"
-                       : "code " + std::to_string(int(status.error_code()));
+        mEndCode = wire::statusName(status.error_code());
     }
 
     FrameDecoder mDecoder;
@@ -154,6 +155,8 @@ public:
     void signal(int signal) const;
     /// Waits for the exit: its code, or 128 + the signal that ended it.
     int wait();
+    /// The same, waiting at most `timeout`: nothing when it is still running then.
+    std::optional<int> waitFor(std::chrono::milliseconds timeout);
 
 private:
     pid_t mPid = -1;

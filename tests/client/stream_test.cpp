@@ -474,8 +474,11 @@ TEST(Stream, MalformedLightSetsAreInvalidArgumentNamingTheField) {
              }
          }},
         {"emissiveScale", [&](v1::LightSet& s) { (*s.mutable_emissive_scale())["no such material"] = 1.0f; }},
-        // An id is a name, not a payload: a 1 MiB one would go into the database.
-        {"lights[0].id", [&](v1::LightSet& s) { s.mutable_lights(0)->set_id(std::string(1 << 20, 'x')); }},
+        // An id is a name, not a payload: a 64 KiB one would go into the database. (A 1 MiB
+        // request is refused before it is read: access_test.cpp.)
+        {"lights[0].id", [&](v1::LightSet& s) { s.mutable_lights(0)->set_id(std::string(1 << 16, 'x')); }},
+        {"lights[0].id", [&](v1::LightSet& s) { s.mutable_lights(0)->set_id("bell\a"); }},
+        {"lights[0].intensity × color", [&](v1::LightSet& s) { s.mutable_lights(0)->set_intensity(3e38f); }},
     };
     for (const Case& c : cases) {
         v1::SetLightsRequest request;

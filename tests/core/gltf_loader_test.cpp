@@ -713,6 +713,33 @@ TEST_F(GltfLoader, UnreadableImagesAreReported) {
     }
 }
 
+// Before: a buffer or image URI of ../../../../etc/passwd was opened as given.
+TEST_F(GltfLoader, UrisOutsideTheScenesFolderAreRefusedBeforeTheyAreOpened) {
+    std::string outside = "outside the scene's folder";
+    writeBytes(path("outside.png"), outside.data(), outside.size());
+    fs::create_directories(path("scene"));
+    for (const std::string uri : {"../outside.png", "textures/../../outside.png", "%2E%2E/outside.png",
+                                  "/etc/passwd", "../../../../../../etc/passwd", "file:///etc/passwd"}) {
+        SCOPED_TRACE(uri);
+        GltfBuilder b;
+        b.append("images", {{"uri", uri}});
+        b.append("textures", {{"source", 0}});
+        b.append("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+        int mesh = addQuadMesh(b, "Canvas", 0);
+        b.scene({b.append("nodes", {{"mesh", mesh}})});
+        for (const std::string kind : {"gltf", "glb"}) {
+            const fs::path file = path("scene") / ("scene." + kind);
+            kind == "gltf" ? b.writeGltf(file) : b.writeGlb(file);
+            Result<Scene> scene = loadScene(file.string());
+            ASSERT_FALSE(scene) << kind;
+            EXPECT_EQ(scene.error().code, ErrorCode::InvalidInput) << scene.error().message;
+            EXPECT_NE(scene.error().message.find("leaves the scene's folder"), std::string::npos)
+                << scene.error().message;
+            EXPECT_FALSE(sceneFiles(file.string())) << kind;
+        }
+    }
+}
+
 TEST_F(GltfLoader, InterleavedNormalizedAttributes) {
     // One vertex: position float×3, TEXCOORD_0 unorm16×2, COLOR_0 unorm8×4 (20 bytes).
     struct Packed {

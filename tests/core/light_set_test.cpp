@@ -274,6 +274,35 @@ TEST(LightSetValidation, RejectsFieldsTheTypeDoesNotUse) {
                 "lights[0].range does not apply to a directional light");
 }
 
+// Before: an intensity of 3e38 was accepted, and ids and keys of any bytes and length
+// came back in messages.
+TEST(LightSetValidation, BoundsIntensitiesColoursScalesAndIdsAndClipsWhatItEchoes) {
+    EXPECT_TRUE(parseLightSet(oneLight(R"("type":"point","intensity":1e9)")));
+    EXPECT_TRUE(parseLightSet(oneLight(R"("type":"point","intensity":1e6,"color":[1000,1,0])")));
+    expectError(oneLight(R"("type":"point","intensity":3e38)"),
+                "lights[0].intensity × color is 3e+38 in its largest channel (intensity 3e+38); at most 1e+09");
+    expectError(oneLight(R"("type":"directional","intensity":1e7,"color":[0,0,1000])"),
+                "lights[0].intensity × color is 1e+10");
+    EXPECT_TRUE(parseLightSet(R"({"emissiveScale":{"lamp":1e6}})"));
+    expectError(R"({"emissiveScale":{"lamp":1e7}})", "emissiveScale[\"lamp\"] must be a finite number in [0, 1e+06]");
+    expectError(oneLight(R"("type":"point","id":"lamp\n2")"), "lights[0].id \"lamp\\n2\" holds a control character");
+    expectError(oneLight(R"("type":"point","id":"\u0007bell")"), "holds a control character");
+    EXPECT_TRUE(parseLightSet(oneLight(R"("type":"point","id":"Lampe über dem Tisch")")));
+    EXPECT_FALSE(isLightId(""));
+    EXPECT_FALSE(isLightId(std::string(kMaxLightIdBytes + 1, 'x')));
+    EXPECT_FALSE(isLightId("tab\there"));
+    EXPECT_TRUE(isLightId("ok id"));
+
+    // A megabyte of key or material name comes back as 64 bytes and "...".
+    const std::string huge(1 << 20, 'k');
+    for (const std::string& json : {oneLight(R"("type":"point",")" + huge + R"(":1)"),
+                                    R"({"emissiveScale":{")" + huge + R"(":-1}})"}) {
+        const std::string message = parseError(json);
+        EXPECT_LT(message.size(), 400u) << message.substr(0, 400);
+        EXPECT_NE(message.find(std::string(64, 'k') + "..."), std::string::npos) << message.substr(0, 400);
+    }
+}
+
 TEST(LightSetValidation, RejectsTooManyLights) {
     std::string json = "{\"lights\":[";
     for (size_t i = 0; i <= kMaxLights; ++i)
@@ -285,7 +314,7 @@ TEST(LightSetValidation, RejectsTooManyLights) {
 TEST(LightSetValidation, RejectsBadEmissiveScales) {
     expectError(R"({"emissiveScale":[1]})", "emissiveScale must be an object");
     expectError(R"({"emissiveScale":{"light":-1}})",
-                "emissiveScale[\"light\"] must be a finite number ≥ 0, got -1");
+                "emissiveScale[\"light\"] must be a finite number in [0, 1e+06], got -1");
     expectError(R"({"emissiveScale":{"light":"x"}})", "emissiveScale[\"light\"] must be");
     expectError(R"({"emissiveScale":{"light":1e40}})", "emissiveScale[\"light\"] must be");
 }
