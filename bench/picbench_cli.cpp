@@ -11,6 +11,7 @@
 #include "bench/link_error_benchmark.h"
 #include "bench/runtime_benchmark.h"
 #include "bench/stability_benchmark.h"
+#include "bench/soak_benchmark.h"
 #include "bench/stream_benchmark.h"
 #include "bench/sweep_benchmark.h"
 #include "core/cli.h"
@@ -243,6 +244,25 @@ int picbenchMain(int argc, char** argv) {
     stream->add_option("--picserver", streamParams.picserver, "picserver binary (default: the build tree's)");
     stream->add_option("--json", streamParams.jsonPath, "JSON file (default out/stream_benchmark.json)");
 
+    CLI::App* soak = app.add_subcommand(
+        "soak", "the server held under load for a long time: no lost final state, resident "
+                "memory growth, latency");
+    SoakBenchmarkParams soakParams;
+    addSceneOption(*soak, soakParams.scenePath);
+    soak->add_option("--bake", soakParams.bakePath, "serve this bake of the scene (default: bake it at --setting)");
+    addSettingOption(*soak, soakParams.setting);
+    soak->add_option("--backend", soakParams.backend, "server backend (default: gpu)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    soak->add_option("--clients", soakParams.clients, "subscribers (default 200)")->check(CLI::Range(1u, 10000u));
+    soak->add_option("--update-rate", soakParams.updateRate, "light changes per second (default 10)")
+        ->check(CLI::PositiveNumber);
+    soak->add_option("--duration", soakParams.duration, "seconds (default 600)")->check(CLI::PositiveNumber);
+    soak->add_option("--max-rss-growth", soakParams.maxRssGrowthPercent,
+                     "per cent of resident memory the server may grow by after the first tenth (default 5)")
+        ->check(CLI::PositiveNumber);
+    soak->add_option("--picserver", soakParams.picserver, "picserver binary (default: the build tree's)");
+    soak->add_option("--json", soakParams.jsonPath, "JSON file (default out/soak.json), the chart beside it");
+
     CLI::App* stability = app.add_subcommand(
         "stability", "paper 000 §5.2 / 001 §7 failure cases against path tracing, a moving "
                      "light's flicker, random light sets checked for NaN, Inf and negative light");
@@ -341,6 +361,7 @@ int picbenchMain(int argc, char** argv) {
     if (shadows->parsed()) return runShadowBenchmark(shadowParams);
     if (codec->parsed()) return runCodecBenchmark(codecParams);
     if (stream->parsed()) return runStreamBenchmark(streamParams);
+    if (soak->parsed()) return runSoakBenchmark(soakParams);
     if (links->parsed()) {
         linkParams.bake = linkFlags.toOptions();
         return runLinkErrorBenchmark(linkParams);

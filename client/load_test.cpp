@@ -218,6 +218,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
                                  {"key_frames", keyFrames},
                                  {"delta_frames", deltaFrames}};
     report["errors"] = errors.size();
+    report["subscribers_without_last"] = missingLast;
     std::vector<std::string> shownErrors(errors.begin(), errors.begin() + std::min<size_t>(errors.size(), 10));
     report["error_messages"] = shownErrors;
     return report;

@@ -32,6 +32,7 @@ struct LoadOptions {
 
 /// Runs the load test against the server behind `connection` and returns the report:
 /// `latency_ms` {`p50`, `p95`, `p99`, `max`, `mean`}, `updates`, `frames_received`, `errors`,
+/// `subscribers_without_last` (those that never held the last version: lost final states),
 /// `versions_skipped`, `bytes_per_frame` {`key`, `delta`}, `clients`, `duration_s`,
 /// `update_rate`, `session` and the first error messages. The editor moves the first light of
 /// the session's set; InvalidInput when the set has none and updates were asked for.

@@ -203,7 +203,10 @@ Result<Light> parseLight(const Json& value, size_t index) {
         if (!(length > 0.0f) || !std::isfinite(length))
             return fail(ErrorCode::InvalidInput, "{} must have a non-zero length, got [{}, {}, {}]",
                         fields.fieldPath("direction"), direction.x, direction.y, direction.z);
-        light.direction = direction / length;
+        // Normalised once: a direction already of unit length (one parseLightSet wrote) keeps
+        // its bits, so that a set written by toJson reads back the same (the session database
+        // stores sets as JSON; renormalising moved their last bits at each restore).
+        light.direction = std::abs(length - 1.0f) > 1e-6f ? direction / length : direction;
     } else {
         if (auto rejected = rejectInapplicable(fields, light.type, {"direction"}); !rejected)
             return std::unexpected(rejected.error());

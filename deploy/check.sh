@@ -214,7 +214,7 @@ EOF
 check_containerfile_sources() {
     local dir missing=()
     while read -r dir; do
-        [[ "$dir" == tests ]] && continue   # the image builds with PIC_BUILD_TESTS=OFF
+        [[ "$dir" == tests || "$dir" == fuzz ]] && continue   # the image builds with PIC_BUILD_TESTS=OFF
         grep -q "^COPY $dir/ $dir/" "$HERE/Containerfile" || missing+=("$dir")
     done < <(sed -n 's/^[[:space:]]*add_subdirectory(\([^/)[:space:]]*\).*/\1/p' "$REPO/CMakeLists.txt" | sort -u)
     if ((${#missing[@]})); then

@@ -15,6 +15,8 @@ PACKAGES=(
   libcli11-dev libspdlog-dev libfmt-dev libzstd-dev
   libplplot-dev plplot-driver-cairo
   libsqlite3-dev libpq-dev postgresql nginx libcivetweb-dev
+  # libFuzzer (bench/run_fuzz.sh): clang 19, whose libstdc++ mode has std::expected.
+  clang-19 libclang-rt-19-dev
 )
 
 missing=()

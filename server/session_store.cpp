@@ -47,7 +47,9 @@ Result<std::unique_ptr<SessionStore>> SessionStore::open(const std::string& spec
 Result<std::vector<StoredSession>> parseJsonSessions(const std::string& text,
                                                      const std::string& path) {
     const Json root = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-    const int format = root.is_object() ? root.value("format", 0) : 0;
+    // Any type where the format should be (found by fuzzing: an array here threw from value()).
+    const auto stated = root.is_object() ? root.find("format") : root.end();
+    const int format = stated != root.end() && stated->is_number_integer() ? stated->get<int>() : 0;
     if ((format != 1 && format != 2) || !root.contains("sessions") || !root["sessions"].is_array())
         return fail(ErrorCode::Corrupt,
                     "{} is not a pic session database (SQLite, or JSON of format 1 or 2); move "

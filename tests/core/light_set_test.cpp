@@ -170,6 +170,22 @@ TEST(LightSetParse, RoundTripsThroughJsonExactly) {
     EXPECT_EQ(parsed->lights[1].range, kInf);
 }
 
+// Found by the light-set fuzz target: directions were normalised again at every read, so a set
+// written by toJson did not read back to the same text (0.28221625 became 0.28221628).
+TEST(LightSetParse, WhatToJsonWritesReadsBackToTheSameText) {
+    auto lights = parseLightSet(R"({"lights":[{"type":"directional","direction":[0.3,-1,0.2]},
+                                              {"type":"spot","direction":[1,2,3]}]})");
+    ASSERT_TRUE(lights);
+    std::string json = toJson(*lights);
+    for (int round = 0; round < 3; ++round) {
+        auto again = parseLightSet(json);
+        ASSERT_TRUE(again);
+        EXPECT_EQ(toJson(*again), json) << round;
+        json = toJson(*again);
+    }
+    EXPECT_NEAR(glm::length(lights->lights[0].direction), 1.0f, 1e-6f);
+}
+
 TEST(LightSetParse, ReadsFilesAndReportsMissingOnes) {
     auto missing = readLightSet("/nonexistent/lights.json");
     ASSERT_FALSE(missing);

@@ -1,0 +1,37 @@
+#pragma once
+/// picserver as a child process for the benchmarks that measure it from outside: started on a
+/// free loopback port, its update log drained, stopped (SIGTERM) when the object goes.
+
+#include <string>
+#include <vector>
+
+#include <sys/types.h>
+
+#include "core/error.h"
+
+namespace pic {
+
+struct ServerProcess {
+    pid_t pid = -1;
+    FILE* out = nullptr;
+    std::string address;  ///< "127.0.0.1:PORT" once started
+
+    ServerProcess() = default;
+    ServerProcess(const ServerProcess&) = delete;
+    ServerProcess& operator=(const ServerProcess&) = delete;
+    ~ServerProcess();
+};
+
+/// Runs `args` (args[0] the binary) and waits for its "listening on" line.
+Result<void> startServer(ServerProcess& server, const std::vector<std::string>& args);
+
+/// User + system CPU seconds of process `pid` (/proc/PID/stat).
+double cpuSeconds(pid_t pid);
+
+/// Resident memory of process `pid` in bytes (/proc/PID/status VmRSS); 0 when gone.
+uint64_t residentBytes(pid_t pid);
+
+/// The picserver of this build tree (beside picbench's folder).
+std::string siblingPicserver();
+
+}  // namespace pic
