@@ -306,7 +306,14 @@ TEST(Stream, MetricsCountWhatTheServerDid) {
     ASSERT_TRUE(served.connection->setLights(session->session(), session->editor_token(), pointLight(0.1f)));
     ASSERT_TRUE(reader.waitFor(2));
 
-    const HttpReply reply = httpGet(address, "/metrics");
+    // A version reaches the metrics just after its subscribers (Session::publish logs it once
+    // the slots hold it): read them until they count it.
+    const std::string computed = "pic_session_versions_computed_total{session=\"" + session->session() + "\"}";
+    HttpReply reply = httpGet(address, "/metrics");
+    for (int attempt = 0; attempt < 500 && metricValue(reply.body, computed) < 2.0; ++attempt) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        reply = httpGet(address, "/metrics");
+    }
     ASSERT_EQ(reply.status, "HTTP/1.1 200 OK") << reply.body;
     const std::string& text = reply.body;
     EXPECT_EQ(metricValue(text, "pic_sessions"), 1.0) << text;
