@@ -422,20 +422,9 @@ Result<void> BakeJoiner::add(BakePart part, const std::string& name) {
         mBake = std::move(part.bake);
         if (part.count > 1) {
             // Room for every cache's links; this part's go in their place below.
-            LinkSet& links = mBake->links;
-            LinkSet own = std::move(links);
-            links = LinkSet{own.mode, own.linksPerCache, own.bands};
-            const size_t nLinks = nC * own.linksPerCache;
-            if (own.mode == LinkMode::Rtp) {
-                links.rtp.assign(nLinks, RtpLink{0, 0.0f, 0, 0.0f});
-            } else {
-                links.shNodes.assign(nLinks, 0u);
-                links.shCoefficients.assign(nLinks * own.bands * own.bands, 0u);
-            }
-            links.tint.assign(nLinks, 0u);
-            links.offset.assign(nLinks * 3, 0u);
-            links.spreadShare.assign(nLinks, 0u);
-            placeLinks(links, own, begin);
+            LinkSet own = std::move(mBake->links);
+            mBake->links = paddingLinks(own.mode, own.linksPerCache, own.bands, nC);
+            placeLinks(mBake->links, own, begin);
         }
     } else {
         placeLinks(mBake->links, part.bake.links, begin);

@@ -750,6 +750,24 @@ double discShareOnSurface(const EmbreeScene& rays, const std::vector<Surfel>& su
     return double(sum) / (double(kDiscParts) * double(count));
 }
 
+LinkSet paddingLinks(LinkMode mode, uint32_t linksPerCache, uint32_t bands, size_t caches) {
+    LinkSet links;
+    links.mode = mode;
+    links.linksPerCache = linksPerCache;
+    links.bands = mode == LinkMode::Sh ? bands : 0;
+    const size_t n = caches * linksPerCache;
+    links.tint.assign(n, 0u);  // padding: no light
+    links.offset.assign(n * 3, 0u);
+    links.spreadShare.assign(n, 0u);
+    if (mode == LinkMode::Rtp) {
+        links.rtp.assign(n, RtpLink{0, 0.0f, 0, 0.0f});
+    } else {
+        links.shNodes.assign(n, 0u);
+        links.shCoefficients.assign(n * size_t(shCount(int(links.bands))), 0);
+    }
+    return links;
+}
+
 Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surfel>& surfels,
                                  const std::vector<Node>& nodes, const std::vector<Cache>& caches,
                                  const LinkParams& params, const std::vector<float>& weights) {
@@ -783,19 +801,8 @@ Result<LinkResult> generateLinks(const EmbreeScene& rays, const std::vector<Surf
     const int coefficients = shCount(bands);
 
     LinkResult result;
+    result.links = paddingLinks(params.mode, nL, params.bands, nC);
     LinkSet& links = result.links;
-    links.mode = params.mode;
-    links.linksPerCache = nL;
-    links.bands = params.mode == LinkMode::Sh ? params.bands : 0;
-    links.tint.assign(nC * nL, 0u);  // padding: no light
-    links.offset.assign(nC * nL * 3, 0u);
-    links.spreadShare.assign(nC * nL, 0u);
-    if (params.mode == LinkMode::Rtp) {
-        links.rtp.assign(nC * nL, RtpLink{0, 0.0f, 0, 0.0f});
-    } else {
-        links.shNodes.assign(nC * nL, 0u);
-        links.shCoefficients.assign(nC * nL * coefficients, 0);
-    }
     result.visibleSolidAngle.assign(nC * nL, 0.0f);
 
     CacheLinker linker(rays, surfels, nodes, params, fluxWeight);

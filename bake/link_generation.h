@@ -49,6 +49,10 @@ struct LinkResult {
     std::vector<float> visibleSolidAngle;  ///< per link (nC·nL of the range), sr; 0 for padding
 };
 
+/// The links of `caches` caches, every one padding (node 0, no light): what generateLinks
+/// fills, and what a sharded bake's parts are placed into. `bands` counts in SH mode only.
+LinkSet paddingLinks(LinkMode mode, uint32_t linksPerCache, uint32_t bands, size_t caches);
+
 /// Builds the links of every cache against the hierarchy (surfels in leaf order). A link reads
 /// the flux Φ_r of a node r as spread over its surfels by `weights` (bake/surfel_exposure.h:
 /// one per surfel; empty for uniform): the radiance it carries from visible surfel j is

@@ -31,12 +31,7 @@ Result<void> startServer(ServerProcess& server, const std::vector<std::string>& 
         dup2(fds[1], STDOUT_FILENO);
         close(fds[0]);
         close(fds[1]);
-        std::vector<char*> argv;
-        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(argv[0], argv.data());
-        std::fprintf(stderr, "picbench: cannot run %s\n", argv[0]);
-        _exit(127);
+        execChild(args);
     }
     close(fds[1]);
     server.out = fdopen(fds[0], "r");
@@ -80,10 +75,19 @@ uint64_t residentBytes(pid_t pid) {
     return 0;
 }
 
-std::string siblingPicserver() {
+void execChild(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    std::fprintf(stderr, "picbench: cannot run %s\n", argv[0]);
+    _exit(127);
+}
+
+std::string siblingProgram(const char* folder, const char* name) {
     std::error_code ec;
     const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    return (self.parent_path().parent_path() / "server" / "picserver").string();
+    return (self.parent_path().parent_path() / folder / name).string();
 }
 
 }  // namespace pic

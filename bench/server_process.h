@@ -1,6 +1,7 @@
 #pragma once
-/// picserver as a child process for the benchmarks that measure it from outside: started on a
-/// free loopback port, its update log drained, stopped (SIGTERM) when the object goes.
+/// The pic programs as child processes of picbench: picserver for the benchmarks that measure
+/// it from outside (started on a free loopback port, its update log drained, stopped with
+/// SIGTERM when the object goes), and the exec step every child shares.
 
 #include <string>
 #include <vector>
@@ -31,7 +32,11 @@ double cpuSeconds(pid_t pid);
 /// Resident memory of process `pid` in bytes (/proc/PID/status VmRSS); 0 when gone.
 uint64_t residentBytes(pid_t pid);
 
-/// The picserver of this build tree (beside picbench's folder).
-std::string siblingPicserver();
+/// In a forked child: runs `args` (args[0] the binary); on failure says so and exits 127.
+[[noreturn]] void execChild(const std::vector<std::string>& args);
+
+/// A program of this build tree, beside picbench's folder: siblingProgram("server", "picserver")
+/// is build/server/picserver for build/bench/picbench.
+std::string siblingProgram(const char* folder, const char* name);
 
 }  // namespace pic

@@ -40,7 +40,7 @@ int runSoakBenchmark(const SoakBenchmarkParams& params) {
         bakePath = madeBake.string();
     }
 
-    const std::string picserver = params.picserver.empty() ? siblingPicserver() : params.picserver;
+    const std::string picserver = params.picserver.empty() ? siblingProgram("server", "picserver") : params.picserver;
     ServerProcess server;
     // The editor's rate, not the server's limit, is what the soak sets.
     const double limit = std::max(30.0, 2.0 * params.updateRate);

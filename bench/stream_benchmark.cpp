@@ -35,7 +35,7 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
     if (auto written = writeBakeFile(bakePath.string(), *bake); !written)
         return reportError(written.error());
 
-    const std::string picserver = params.picserver.empty() ? siblingPicserver() : params.picserver;
+    const std::string picserver = params.picserver.empty() ? siblingProgram("server", "picserver") : params.picserver;
     ServerProcess server;
     auto started = startServer(server, {picserver, "--bake", bakePath.string(), "--scene",
                                         params.scenePath, "--listen", "127.0.0.1:0", "--backend",

@@ -21,6 +21,7 @@
 #include "bake/ref/probes.h"
 #include "bake/target_error.h"
 #include "bench/bench_common.h"
+#include "bench/server_process.h"
 #include "bench/chart.h"
 #include "bench/light_propagation_volume.h"
 #include "bench/traced_probes.h"
@@ -72,13 +73,6 @@ std::optional<Json> readJson(const fs::path& path) {
     return json;
 }
 
-/// The build tree's picbake beside picbench (build/bench/picbench → build/bake/picbake).
-std::string siblingPicbake() {
-    std::error_code ec;
-    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    return (self.parent_path().parent_path() / "bake" / "picbake").string();
-}
-
 /// Runs `args` as a child process with stdout and stderr into `logPath`; fails naming the
 /// command and the log when it does not exit with 0.
 Result<void> runChild(const std::vector<std::string>& args, const fs::path& logPath) {
@@ -90,12 +84,7 @@ Result<void> runChild(const std::vector<std::string>& args, const fs::path& logP
             dup2(fileno(log), STDOUT_FILENO);
             dup2(fileno(log), STDERR_FILENO);
         }
-        std::vector<char*> argv;
-        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(argv[0], argv.data());
-        std::fprintf(stderr, "picbench: cannot run %s\n", argv[0]);
-        _exit(127);
+        execChild(args);
     }
     int status = 0;
     if (waitpid(pid, &status, 0) < 0) return fail(ErrorCode::Internal, "waitpid failed for {}", args.front());
@@ -358,7 +347,7 @@ Json paramsJson(const BakeData& bake) {
 /// Bakes one setting with picbake (a child process, so that its peak memory is its own).
 Result<Json> bakeSetting(const SweepContext& context, const SweepSetting& setting, const fs::path& bakePath) {
     const SweepParams& params = context.params;
-    std::vector<std::string> args{params.picbake.empty() ? siblingPicbake() : params.picbake, "bake",
+    std::vector<std::string> args{params.picbake.empty() ? siblingProgram("bake", "picbake") : params.picbake, "bake",
                                   params.scenePath, "-o", bakePath.string()};
     const std::vector<std::string> flags = mergeFlags(params.baseBakeArgs, setting.bakeArgs);
     args.insert(args.end(), flags.begin(), flags.end());

@@ -10,18 +10,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const auto bake = readBakeFile(path);
     const auto info = inspectBakeFile(path);
     // The summary validates exactly what the reader validates.
-    PIC_FUZZ_CHECK(bool(bake) == bool(info));
+    PIC_CHECK(bool(bake) == bool(info));
     if (bake) {
-        PIC_FUZZ_CHECK(info->caches == bake->caches.size() && info->surfels == bake->surfels.size());
+        PIC_CHECK(info->caches == bake->caches.size() && info->surfels == bake->surfels.size());
         // What the reader accepts, the writer writes again (the same checks both ways).
         const std::string copy = path + ".copy";
-        PIC_FUZZ_CHECK(writeBakeFile(copy, *bake));
-        PIC_FUZZ_CHECK(readBakeFile(copy));
+        PIC_CHECK(writeBakeFile(copy, *bake));
+        PIC_CHECK(readBakeFile(copy));
     }
     if (const auto part = readBakePart(path)) {
-        PIC_FUZZ_CHECK(!bake);  // a file is a bake or a part, never both
-        PIC_FUZZ_CHECK(part->cacheBegin <= part->cacheEnd && part->cacheEnd <= part->bake.caches.size());
-        PIC_FUZZ_CHECK(part->seesSurfel.size() == part->cacheEnd - part->cacheBegin);
+        PIC_CHECK(!bake);  // a file is a bake or a part, never both
+        PIC_CHECK(part->cacheBegin <= part->cacheEnd && part->cacheEnd <= part->bake.caches.size());
+        PIC_CHECK(part->seesSurfel.size() == part->cacheEnd - part->cacheBegin);
     }
     return 0;
 }

@@ -21,9 +21,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (int t = 0; t < kFramePlanes; ++t) frame.planes[size_t(t)].assign(expected[t], uint16_t(0x3C00));
     const HalfFrame before = frame;
     if (!decodeFrame(*encoded, frame)) {
-        PIC_FUZZ_CHECK(frame == before);
+        PIC_CHECK(frame == before);
         return 0;
     }
-    for (int t = 0; t < kFramePlanes; ++t) PIC_FUZZ_CHECK(frame.planes[size_t(t)].size() == expected[t]);
+    for (int t = 0; t < kFramePlanes; ++t) PIC_CHECK(frame.planes[size_t(t)].size() == expected[t]);
     return 0;
 }

@@ -1,24 +1,15 @@
 #pragma once
 /// What the fuzz targets share. Each target is one file defining LLVMFuzzerTestOneInput over
 /// bytes an attacker could send or place (fuzz/README.md); it returns 0 for every input and
-/// aborts (PIC_FUZZ_CHECK) when an invariant the code promises breaks, so that libFuzzer, or
+/// aborts (PIC_CHECK) when an invariant the code promises breaks, so that libFuzzer, or
 /// the corpus replay CTest runs, reports it as a crash.
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 
-/// Aborts naming the broken promise.
-#define PIC_FUZZ_CHECK(cond)                                                               \
-    do {                                                                                   \
-        if (!(cond)) {                                                                     \
-            std::fprintf(stderr, "fuzz: %s:%d: promise broken: %s\n", __FILE__, __LINE__, #cond); \
-            std::abort();                                                                  \
-        }                                                                                  \
-    } while (0)
+#include "core/error.h"
 
 namespace pic::fuzz {
 

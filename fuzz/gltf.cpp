@@ -13,17 +13,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (auto scene = loadScene(path)) {
         // What the bake and the runtime index without checking.
         for (const Triangle& t : scene->triangles)
-            for (uint32_t v : t.v) PIC_FUZZ_CHECK(v < scene->vertices.size());
+            for (uint32_t v : t.v) PIC_CHECK(v < scene->vertices.size());
         for (const Vertex& v : scene->vertices)
-            PIC_FUZZ_CHECK(std::isfinite(v.position.x) && std::isfinite(v.position.y) &&
+            PIC_CHECK(std::isfinite(v.position.x) && std::isfinite(v.position.y) &&
                            std::isfinite(v.position.z));
     }
     // The files a server hands to thin clients: never outside the scene's folder.
     if (auto files = sceneFiles(path))
         for (const std::string& file : *files) {
             const std::filesystem::path relative(file);
-            PIC_FUZZ_CHECK(!file.empty() && !relative.is_absolute());
-            for (const auto& part : relative) PIC_FUZZ_CHECK(part != "..");
+            PIC_CHECK(!file.empty() && !relative.is_absolute());
+            for (const auto& part : relative) PIC_CHECK(part != "..");
         }
     return 0;
 }

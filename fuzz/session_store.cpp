@@ -9,8 +9,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const auto sessions = parseJsonSessions(std::string(fuzz::text(data, size)), "sessions.json");
     if (!sessions) return 0;
     for (const StoredSession& session : *sessions) {
-        PIC_FUZZ_CHECK(session.version >= 1);
-        PIC_FUZZ_CHECK(session.editorDigest.size() == 64 && session.viewerDigest.size() == 64);
+        PIC_CHECK(session.version >= 1);
+        PIC_CHECK(session.editorDigest.size() == 64 && session.viewerDigest.size() == 64);
     }
     return 0;
 }
