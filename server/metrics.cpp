@@ -68,6 +68,11 @@ void Metrics::recordStore(const std::string& op, double ms, bool failed) {
     if (failed) ++mStoreErrors[op];
 }
 
+void Metrics::recordCall(std::string_view call, std::string_view code) {
+    std::lock_guard lock(mMutex);
+    ++mCalls[{std::string(call), std::string(code)}];
+}
+
 void Metrics::recordSent(uint64_t bytes) {
     std::lock_guard lock(mMutex);
     ++mFramesSent;
@@ -98,6 +103,11 @@ std::string Metrics::render() const {
     header(out, "pic_store_up", "gauge",
            "1 while the session database answers, 0 while it fails (health NOT_SERVING).");
     out += fmt::format("pic_store_up {}\n", gauges.storeFailing ? 0 : 1);
+    header(out, "pic_relight_threads", "gauge", "Threads that compute the sessions' versions.");
+    out += fmt::format("pic_relight_threads {}\n", gauges.relightThreads);
+    header(out, "pic_relight_queued", "gauge",
+           "Sessions with a light set waiting for a relight thread or for their bake.");
+    out += fmt::format("pic_relight_queued {}\n", gauges.relightQueued);
 
     std::lock_guard lock(mMutex);
     header(out, "pic_updates_total", "counter", "Versions computed and encoded.");
@@ -127,6 +137,11 @@ std::string Metrics::render() const {
     header(out, "pic_store_errors_total", "counter", "Session database calls that failed.");
     for (const auto& [op, count] : mStoreErrors)
         out += fmt::format("pic_store_errors_total{{op=\"{}\"}} {}\n", op, count);
+    header(out, "pic_calls_total", "counter",
+           "Calls answered, by method and gRPC status: refusals show as UNAUTHENTICATED, "
+           "PERMISSION_DENIED, RESOURCE_EXHAUSTED (quotas, rates) and INVALID_ARGUMENT.");
+    for (const auto& [key, count] : mCalls)
+        out += fmt::format("pic_calls_total{{call=\"{}\",code=\"{}\"}} {}\n", key.first, key.second, count);
     return out;
 }
 

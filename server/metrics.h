@@ -11,6 +11,8 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace pic {
@@ -40,6 +42,8 @@ public:
         size_t subscribers = 0;
         uint64_t versionsSkipped = 0;  ///< by the subscribers of the sessions held now
         bool storeFailing = false;
+        unsigned relightThreads = 0;
+        size_t relightQueued = 0;  ///< sessions waiting for a relight thread
     };
 
     /// One computed version of `session`: its pass times, update and encode ms, frame bytes.
@@ -49,6 +53,8 @@ public:
     void forgetSession(const std::string& session);
     /// One call of the session database `op` (create, save, find, remove, ping).
     void recordStore(const std::string& op, double ms, bool failed);
+    /// A call answered with the gRPC status `code` (its name: "OK", "UNAUTHENTICATED", …).
+    void recordCall(std::string_view call, std::string_view code);
     /// A frame written to a subscriber.
     void recordSent(uint64_t bytes);
     /// How the gauges are read (the server's state).
@@ -70,6 +76,7 @@ private:
     MsHistogram mEncodeMs;
     std::map<std::string, MsHistogram> mStoreMs;
     std::map<std::string, uint64_t> mStoreErrors;
+    std::map<std::pair<std::string, std::string>, uint64_t> mCalls;  ///< by (call, code)
     std::function<Gauges()> mGauges;
 };
 

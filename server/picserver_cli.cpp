@@ -123,6 +123,14 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--max-streams-per-peer", options.maxStreamsPerPeer,
                    "Subscribe streams one peer host may hold open (default 1000)")
         ->check(CLI::Range(size_t(1), size_t(1000000)));
+    std::vector<std::string> trustedProxies;
+    app.add_option("--trusted-proxy", trustedProxies,
+                   "a load balancer's ADDRESS or ADDRESS/PREFIX (repeatable): for calls through "
+                   "it, per-peer quotas count the client address it appends to X-Forwarded-For");
+    app.add_option("--relight-threads", options.relightThreads,
+                   "threads that compute the sessions' versions, taking the sessions in turns, "
+                   "whatever their number; 0: one per bake plus one (default 0)")
+        ->check(CLI::Range(0u, 256u));
     double keepaliveSeconds = 30.0, connectionAgeMinutes = 60.0;
     app.add_option("--keepalive-seconds", keepaliveSeconds,
                    "ping a client after this long without traffic; one that does not answer "
@@ -149,6 +157,8 @@ int picserverMain(int argc, char** argv) {
                      options.apiKeys.size() == 1 ? "" : "s",
                      fmt::format("{}", fmt::join(options.apiKeys.ids(), ", ")).c_str());
     }
+    for (const std::string& proxy : trustedProxies)
+        if (auto added = options.trustedProxies.add(proxy); !added) return reportError(added.error());
     // So is a server open to anyone who reaches its address.
     if (auto open = checkOpenListen(listen, !options.apiKeys.empty(), options.allowUnauthenticated); !open)
         return reportError(open.error());

@@ -126,10 +126,8 @@ Result<void> ServedBake::warmUp() {
     return {};
 }
 
-Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
-                                 const std::atomic<bool>* abandon) {
+Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame) {
     std::lock_guard lock(mRuntimeMutex);
-    if (abandon && *abandon) return fail(ErrorCode::Io, "abandoned: the session is closing");
     PIC_TRY_ASSIGN(const CacheValues* values, mRuntime->setLights(lights, &stats));
     frame = halfFrameOf(*values);
     return {};

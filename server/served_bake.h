@@ -17,7 +17,6 @@
 #include "rays/embree_scene.h"
 #include "render/gpu_runtime.h"
 #include "render/runtime.h"
-#include "server/limits.h"
 
 namespace pic {
 
@@ -58,13 +57,10 @@ public:
     double warmUpMs() const { return mWarmUpMs; }
 
     /// Relights the scene with `lights` and gives the resulting caches as a frame's half
-    /// planes (core/frame_codec.h), one session at a time (the runtime keeps per-light state
-    /// such as shadow maps), in the order the sessions asked (FairMutex: round robin, since
-    /// each session waits for one relight at most). When `abandon` is set by the time this session's turn comes, it
-    /// returns at once with an error (Io) instead: a session that is closing waits for no
-    /// computation but the one already running.
-    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
-                         const std::atomic<bool>* abandon = nullptr);
+    /// planes (core/frame_codec.h), one call at a time (the runtime keeps per-light state such
+    /// as shadow maps). The server's relight pool calls it for one session of the bake at a
+    /// time already, taking them in turns (server/relight_pool.h).
+    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame);
 
 private:
     ServedBake() = default;
@@ -80,7 +76,7 @@ private:
     BakeData mBake;
     std::unique_ptr<EmbreeScene> mRays;
     std::unique_ptr<Runtime> mRuntime;
-    FairMutex mRuntimeMutex;  ///< sessions relight in the order they asked
+    std::mutex mRuntimeMutex;  ///< one relight at a time
     std::string mDevice;
     std::string mDirectVisibility;
     double mWarmUpMs = 0.0;

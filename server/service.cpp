@@ -16,6 +16,7 @@
 #include "server/audit_log.h"
 #include "server/limits.h"
 #include "server/metrics_http.h"
+#include "server/relight_pool.h"
 #include "server/session_store.h"
 #include "server/token_digest.h"
 
@@ -24,6 +25,8 @@ namespace pic {
 struct PicServer::State {
     std::vector<std::unique_ptr<ServedBake>> bakes;
     ServerOptions options;
+    /// Computes every session's versions (declared before the sessions: they leave it first).
+    std::unique_ptr<RelightPool> pool;
     mutable std::mutex mutex;
     std::map<std::string, std::shared_ptr<Session>> sessions;
     size_t creating = 0;  ///< sessions being written to the database, counted against the cap
@@ -38,16 +41,26 @@ struct PicServer::State {
     std::unique_ptr<AuditLog> audit;        ///< null without --audit-log
     std::map<std::string, size_t> streamsByPeer;  ///< open Subscribe streams per peer host (under mutex)
 
+    /// The X-Forwarded-For header of a call, empty without one.
+    static std::string_view forwardedFor(const grpc::CallbackServerContext& context) {
+        auto it = context.client_metadata().find("x-forwarded-for");
+        if (it == context.client_metadata().end()) return {};
+        return std::string_view(it->second.data(), it->second.size());
+    }
+
+    /// The host a call counts against for per-peer quotas: its peer's, or behind a trusted
+    /// load balancer the client's it forwarded.
+    std::string clientHost(const grpc::CallbackServerContext& context) const {
+        return options.trustedProxies.clientHost(context.peer(), forwardedFor(context));
+    }
+
     /// The audit line of a call answered with `status` (server/audit_log.h).
     void recordCall(const grpc::CallbackServerContext& context, std::string_view call,
                     std::string_view credential, std::string_view session,
                     const grpc::Status& status) const {
+        metrics->recordCall(call, wire::statusName(status.error_code()));
         if (!audit) return;
-        std::string_view forwardedFor;
-        if (auto it = context.client_metadata().find("x-forwarded-for");
-            it != context.client_metadata().end())
-            forwardedFor = std::string_view(it->second.data(), it->second.size());
-        audit->record({context.peer(), forwardedFor, call, credential, session,
+        audit->record({context.peer(), forwardedFor(context), call, credential, session,
                        wire::statusName(status.error_code()), status.error_message()});
     }
 
@@ -193,7 +206,7 @@ struct PicServer::State {
                 return grpc::Status::OK;
             }
             out = std::make_shared<Session>(id, stored.editorDigest, stored.viewerDigest,
-                                            *findBake(stored.bakeId), options.session,
+                                            *findBake(stored.bakeId), *pool, options.session,
                                             SessionStart{version, std::move(stored.lights)});
             sessions[id] = out;
             std::fprintf(stderr, "picserver: session %s taken over from the database at version %llu\n",
@@ -452,7 +465,7 @@ public:
             return finish(context, call, denied);
         // Whom the session counts against: the key, or without keys the peer's host.
         const std::string creator = mState->options.apiKeys.empty()
-                                        ? "peer " + peerHost(context->peer())
+                                        ? "peer " + mState->clientHost(*context)
                                         : call.credential;
         if (mState->stopping)
             return finish(context, call, grpc::Status(grpc::StatusCode::UNAVAILABLE,
@@ -532,7 +545,7 @@ public:
             if (status.ok()) {
                 session = std::make_shared<Session>(id, tokenDigest(editorToken),
                                                     tokenDigest(viewerToken), *bake,
-                                                    mState->options.session,
+                                                    *mState->pool, mState->options.session,
                                                     SessionStart{.creator = creator});
                 mState->sessions[id] = session;
             }
@@ -627,7 +640,7 @@ public:
     grpc::ServerWriteReactor<v1::Frame>* Subscribe(grpc::CallbackServerContext* context,
                                                    const v1::SubscribeRequest* request) override {
         Access access = authorise(*mState, request->session(), request->token());
-        const std::string peer = peerHost(context->peer());
+        const std::string peer = mState->clientHost(*context);
         if (access.status.ok()) {
             std::lock_guard lock(mState->mutex);
             size_t& open = mState->streamsByPeer[peer];
@@ -756,7 +769,7 @@ Result<void> restore(PicServer::State& state) {
         }
         state.sessions[entry.id] = std::make_shared<Session>(
             entry.id, entry.editorDigest, entry.viewerDigest, *state.findBake(entry.bakeId),
-            state.options.session, SessionStart{entry.version + 1, std::move(entry.lights)});
+            *state.pool, state.options.session, SessionStart{entry.version + 1, std::move(entry.lights)});
         ++restored;
     }
     if (stored.empty()) return {};
@@ -790,6 +803,8 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
         PIC_TRY_ASSIGN(server->mState->audit, AuditLog::open(options.auditLog));
     }
     server->mState->bakes = std::move(bakes);
+    server->mState->pool = std::make_unique<RelightPool>(
+        options.relightThreads > 0 ? options.relightThreads : unsigned(server->mState->bakes.size() + 1));
     // Every computed version goes into the metrics, then to the caller's log.
     options.session.log = [metrics = server->mState->metrics,
                            log = std::move(options.session.log)](const UpdateLog& entry) {
@@ -811,6 +826,8 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
             gauges.versionsSkipped += stats.versions_skipped();
         }
         gauges.storeFailing = state->storeFailing;
+        gauges.relightThreads = state->pool->threads();
+        gauges.relightQueued = state->pool->queued();
         return gauges;
     });
     if (!options.metricsListen.empty()) {

@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "server/api_keys.h"
+#include "server/limits.h"
 #include "server/metrics_http.h"
 #include "server/served_bake.h"
 #include "server/session.h"
@@ -52,11 +53,18 @@ struct ServerOptions {
     /// Sessions one client may hold: one API key, or one peer host on a server without keys
     /// (counted while this server holds them). 0: only maxSessions.
     size_t maxSessionsPerClient = 0;
+    /// Load balancers in front of this server: for a call through one of them, the peer host
+    /// that quotas count is the client address in X-Forwarded-For (server/limits.h).
+    TrustedProxies trustedProxies;
     /// Subscribe streams one peer host may hold open at once.
     size_t maxStreamsPerPeer = 1000;
     /// A connection older than this is asked to go (HTTP/2 GOAWAY): its calls finish, new ones
     /// take a new connection, so that clients spread over replicas added since. 0: never.
     std::chrono::milliseconds maxConnectionAge = std::chrono::hours(1);
+    /// Threads that compute the sessions' versions (server/relight_pool.h), whatever the
+    /// number of sessions; 0: one per bake plus one, so that every bake can relight while
+    /// another version is encoded.
+    unsigned relightThreads = 0;
 };
 
 class PicServer {

@@ -72,11 +72,12 @@ bool SubscriberSlot::closed() const {
 }
 
 Session::Session(std::string id, std::string editorDigest, std::string viewerDigest,
-                 ServedBake& bake, SessionOptions options, SessionStart start)
+                 ServedBake& bake, RelightPool& pool, SessionOptions options, SessionStart start)
     : mId(std::move(id)),
       mEditorDigest(std::move(editorDigest)),
       mViewerDigest(std::move(viewerDigest)),
       mBake(bake),
+      mPool(pool),
       mOptions(std::move(options)),
       mCreator(std::move(start.creator)),
       mSetLightsRate(mOptions.setLightsPerSecond, mOptions.setLightsPerSecond) {
@@ -84,16 +85,17 @@ Session::Session(std::string id, std::string editorDigest, std::string viewerDig
     mNextVersion = std::max<uint64_t>(start.version, 1);
     mStats.set_versions_set(mNextVersion);
     mPending = Pending{mNextVersion++, mLatestLights, std::chrono::system_clock::now()};
-    mWorker = std::thread([this] { run(); });
+    mPool.ready(*this, &mBake);
 }
 
 Session::~Session() {
     {
         std::lock_guard lock(mMutex);
         mStopping = true;
+        mPending.reset();
     }
     mChanged.notify_all();
-    mWorker.join();
+    mPool.forget(*this);
 }
 
 Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
@@ -119,6 +121,7 @@ Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
         mPending = Pending{version, std::move(lights), std::chrono::system_clock::now()};
     }
     mChanged.notify_all();
+    mPool.ready(*this, &mBake);
     return version;
 }
 
@@ -130,7 +133,6 @@ void Session::close() {
         mPending.reset();
         slots = mSlots;
     }
-    mAbandon = true;
     mChanged.notify_all();
     for (const auto& slot : slots) slot->close();
 }
@@ -237,65 +239,64 @@ void Session::publish(std::shared_ptr<const Update> update) {
     if (mOptions.log) mOptions.log(UpdateLog{mId, update.get(), slots.size()});
 }
 
-void Session::run() {
-    std::shared_ptr<const HalfFrame> previous;
-    uint64_t previousVersion = 0;
-    uint32_t deltasSinceKey = 0;
-    for (;;) {
-        Pending job;
-        {
-            std::unique_lock lock(mMutex);
-            mChanged.wait(lock, [&] { return mStopping || mPending; });
-            if (mStopping) return;
-            job = std::move(*mPending);
-            mPending.reset();
-        }
-
-        auto update = std::make_shared<Update>();
-        update->version = job.version;
-        update->zstdLevel = mOptions.zstdLevel;
-        update->keysOnDemand = mKeysOnDemand;
-        auto frame = std::make_shared<HalfFrame>();
-        const auto start = Clock::now();
-        if (auto relit = mBake.relight(job.lights, update->stats, *frame, &mAbandon); !relit) {
-            if (mAbandon) return;
-            std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
-                         (unsigned long long)job.version, relit.error().message.c_str());
-            continue;
-        }
-        const double updateMs = millisecondsSince(start);
-
-        const bool key = !previous || deltasSinceKey + 1 >= mOptions.keyframeInterval;
-        const auto encodeStart = Clock::now();
-        auto encoded = encodeFrame(*frame, key ? nullptr : previous.get(), mOptions.zstdLevel);
-        if (!encoded) {
-            std::fprintf(stderr, "picserver: session %s: encoding version %llu failed: %s\n",
-                         mId.c_str(), (unsigned long long)job.version,
-                         encoded.error().message.c_str());
-            continue;
-        }
-        auto wireFrame = std::make_shared<v1::Frame>();
-        wireFrame->set_version(update->version);
-        wireFrame->set_bake_id(mBake.id());
-        wireFrame->set_base_version(key ? 0 : previousVersion);
-        wire::toProto(*encoded, *wireFrame);
-        update->encodeMs = millisecondsSince(encodeStart);
-        wireFrame->set_bounces(uint32_t(update->stats.bounces));
-        for (const auto& [pass, ms] : update->stats.passMs) (*wireFrame->mutable_pass_ms())[pass] = ms;
-        wireFrame->set_update_ms(updateMs);
-        wireFrame->set_encode_ms(update->encodeMs);
-        wireFrame->set_lights_set_unix_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                              job.accepted.time_since_epoch())
-                                              .count());
-
-        update->baseVersion = wireFrame->base_version();
-        update->frame = frame;
-        update->broadcast = std::move(wireFrame);
-        previous = std::move(frame);
-        previousVersion = update->version;
-        deltasSinceKey = key ? 0 : deltasSinceKey + 1;
-        publish(std::move(update));
+void Session::compute() {
+    mStep.job.reset();
+    {
+        std::lock_guard lock(mMutex);
+        if (mStopping || !mPending) return;
+        mStep.job = std::move(*mPending);
+        mPending.reset();
     }
+    const Pending& job = *mStep.job;
+    mStep.update = std::make_shared<Update>();
+    mStep.update->version = job.version;
+    mStep.update->zstdLevel = mOptions.zstdLevel;
+    mStep.update->keysOnDemand = mKeysOnDemand;
+    mStep.frame = std::make_shared<HalfFrame>();
+    const auto start = Clock::now();
+    if (auto relit = mBake.relight(job.lights, mStep.update->stats, *mStep.frame); !relit) {
+        std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
+                     (unsigned long long)job.version, relit.error().message.c_str());
+        mStep.job.reset();
+        return;
+    }
+    mStep.updateMs = millisecondsSince(start);
+}
+
+void Session::finish() {
+    if (!mStep.job) return;
+    const Pending job = *std::exchange(mStep.job, std::nullopt);
+    auto update = std::move(mStep.update);
+    auto frame = std::move(mStep.frame);
+
+    const bool key = !mStep.previous || mStep.deltasSinceKey + 1 >= mOptions.keyframeInterval;
+    const auto encodeStart = Clock::now();
+    auto encoded = encodeFrame(*frame, key ? nullptr : mStep.previous.get(), mOptions.zstdLevel);
+    if (!encoded) {
+        std::fprintf(stderr, "picserver: session %s: encoding version %llu failed: %s\n",
+                     mId.c_str(), (unsigned long long)job.version, encoded.error().message.c_str());
+        return;
+    }
+    auto wireFrame = std::make_shared<v1::Frame>();
+    wireFrame->set_version(update->version);
+    wireFrame->set_bake_id(mBake.id());
+    wireFrame->set_base_version(key ? 0 : mStep.previousVersion);
+    wire::toProto(*encoded, *wireFrame);
+    update->encodeMs = millisecondsSince(encodeStart);
+    wireFrame->set_bounces(uint32_t(update->stats.bounces));
+    for (const auto& [pass, ms] : update->stats.passMs) (*wireFrame->mutable_pass_ms())[pass] = ms;
+    wireFrame->set_update_ms(mStep.updateMs);
+    wireFrame->set_encode_ms(update->encodeMs);
+    wireFrame->set_lights_set_unix_ns(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(job.accepted.time_since_epoch()).count());
+
+    update->baseVersion = wireFrame->base_version();
+    update->frame = frame;
+    update->broadcast = std::move(wireFrame);
+    mStep.previous = std::move(frame);
+    mStep.previousVersion = update->version;
+    mStep.deltasSinceKey = key ? 0 : mStep.deltasSinceKey + 1;
+    publish(std::move(update));
 }
 
 }  // namespace pic

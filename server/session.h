@@ -2,9 +2,10 @@
 /// A design-review session (ARCHITECTURE §1): one light set at a time on one bake, versions
 /// computed once and encoded once, handed to every subscriber through a latest-wins slot.
 ///
-/// Versions. Every accepted light set gets the next version number. One worker per session
-/// relights: while an update computes, newer sets replace the pending one (coalescing), so
-/// only the newest pending version is computed and the ones it replaced are never produced.
+/// Versions. Every accepted light set gets the next version number. The server's relight pool
+/// (server/relight_pool.h) computes a session's versions one at a time, taking the sessions in
+/// turns: while an update waits or computes, newer sets replace the pending one (coalescing),
+/// so only the newest pending version is computed and the ones it replaced are never produced.
 ///
 /// Frames. Each computed version is encoded once as the frame every subscriber holding the
 /// previous version receives: a delta against it, or a key frame every keyframeInterval
@@ -21,7 +22,6 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "core/error.h"
@@ -30,6 +30,7 @@
 #include "proto/pic.pb.h"
 #include "render/runtime.h"
 #include "server/limits.h"
+#include "server/relight_pool.h"
 
 namespace pic {
 
@@ -113,14 +114,14 @@ struct SessionStart {
     std::string creator;
 };
 
-class Session {
+class Session : private RelightPool::Job {
 public:
-    /// Starts the session's worker and queues its first version.
+    /// Queues the session's first version on `pool`, with the session's bake as its group.
     /// The tokens come as their digests (tokenDigest): the session never holds a token.
     Session(std::string id, std::string editorDigest, std::string viewerDigest, ServedBake& bake,
-            SessionOptions options, SessionStart start = SessionStart());
-    /// Stops the worker (an update in progress finishes first).
-    ~Session();
+            RelightPool& pool, SessionOptions options, SessionStart start = SessionStart());
+    /// Leaves the pool (an update in progress finishes first; a pending one is dropped).
+    ~Session() override;
     Session(const Session&) = delete;
     Session& operator=(const Session&) = delete;
 
@@ -148,7 +149,7 @@ public:
 
     /// Closes the session for good (it is removed from this server): its subscribers' slots
     /// close, the pending version is dropped and a computation not yet started is abandoned.
-    /// Does not wait; the destructor joins the worker.
+    /// Does not wait; the destructor waits for a computation in progress.
     void close();
     /// The newest accepted version and light set.
     uint64_t latestVersion() const;
@@ -178,20 +179,23 @@ public:
     bool waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const;
 
 private:
-    void run();
+    /// The pool's step: compute() relights the pending version (the bake's runtime is this
+    /// session's meanwhile), finish() encodes and publishes it.
+    void compute() override;
+    void finish() override;
     void publish(std::shared_ptr<const Update> update);
 
     std::string mId;
     std::string mEditorDigest;
     std::string mViewerDigest;
     ServedBake& mBake;
+    RelightPool& mPool;
     SessionOptions mOptions;
     std::string mCreator;
     TokenBucket mSetLightsRate;
 
     std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
     std::mutex mCommitMutex;   ///< one light set committed at a time, in version order
-    std::atomic<bool> mAbandon{false};  ///< closed: computations not yet started are skipped
     mutable std::mutex mMutex;
     mutable std::condition_variable mChanged;
     bool mStopping = false;
@@ -212,7 +216,18 @@ private:
     double mEncodeMsTotal = 0.0;
     /// Key frames encoded on demand, counted by the updates themselves.
     std::shared_ptr<std::atomic<uint64_t>> mKeysOnDemand = std::make_shared<std::atomic<uint64_t>>(0);
-    std::thread mWorker;
+
+    /// Between compute() and finish(), and from one step to the next: touched by the pool's
+    /// step only.
+    struct Step {
+        std::optional<Pending> job;           ///< what compute() took; empty: nothing to do
+        std::shared_ptr<Update> update;       ///< its update, once relit
+        std::shared_ptr<HalfFrame> frame;
+        double updateMs = 0.0;
+        std::shared_ptr<const HalfFrame> previous;  ///< the last published version's caches
+        uint64_t previousVersion = 0;
+        uint32_t deltasSinceKey = 0;
+    } mStep;
 };
 
 }  // namespace pic

@@ -218,7 +218,7 @@ start_replica() {
     local i="$1" pid
     local out="$STATE_DIR/replica-$i.out" err="$STATE_DIR/replica-$i.err"
     nohup "$PICSERVER" --bake "$BAKE" --scene "$SCENE" --backend "$BACKEND" \
-        --listen 127.0.0.1:0 --db "$DSN" --metrics-listen 127.0.0.1:0 --quiet \
+        --listen 127.0.0.1:0 --db "$DSN" --metrics-listen 127.0.0.1:0 --trusted-proxy 127.0.0.1 --quiet \
         "${EXTRA_ARGS[@]}" </dev/null >"$out" 2>"$err" &
     pid=$!
     printf '%s\n' "$pid" >"$STATE_DIR/replica-$i.pid"

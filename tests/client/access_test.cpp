@@ -290,6 +290,87 @@ TEST(Access, QuotasPerKeyAndPeerAndARateOfLightSets) {
     ADD_FAILURE() << "no stream after the first two ended";
 }
 
+/// CreateSession on a raw stub, with `forwardedFor` as X-Forwarded-For: the status.
+grpc::Status createForwarded(const std::string& address, const std::string& forwardedFor) {
+    auto stub = v1::Pic::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+    grpc::ClientContext context;
+    context.AddMetadata("x-forwarded-for", forwardedFor);
+    v1::CreateSessionRequest request;
+    v1::CreateSessionResponse response;
+    return stub->CreateSession(&context, request, &response);
+}
+
+// Behind a load balancer every client came from the balancer's address, so one client's
+// sessions used up the per-peer share of all. A trusted balancer names the client instead; any
+// other peer's X-Forwarded-For is ignored, or a client could pick its own address.
+TEST(Access, PerPeerQuotasCountTheClientATrustedBalancerNames) {
+    for (const bool trusted : {true, false}) {
+        SCOPED_TRACE(trusted ? "trusted" : "not trusted");
+        ServerOptions options;
+        options.maxSessionsPerClient = 1;
+        if (trusted) {
+            ASSERT_TRUE(options.trustedProxies.add("127.0.0.0/8"));
+        }
+        Served served = serveWith(options);
+        ASSERT_TRUE(served.connection);
+        const std::string address = served.server->address();
+        EXPECT_TRUE(createForwarded(address, "198.51.100.1").ok());
+        const grpc::Status again = createForwarded(address, "203.0.113.7, 198.51.100.1");
+        EXPECT_EQ(again.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << again.error_message();
+        EXPECT_NE(again.error_message().find(trusted ? "peer 198.51.100.1" : "peer 127.0.0.1"),
+                  std::string::npos)
+            << again.error_message();
+        const grpc::Status other = createForwarded(address, "198.51.100.2");
+        EXPECT_EQ(other.ok(), trusted) << other.error_message();
+    }
+}
+
+/// Threads of this process now.
+size_t threadCount() {
+    size_t count = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator("/proc/self/task")) ++count;
+    return count;
+}
+
+// Before the relight pool, every session had a thread of its own: 40 sessions, 40 threads.
+// Now a fixed pool computes them all, and the metrics count the pool and every refusal.
+TEST(Access, SessionsShareAFixedPoolOfRelightThreadsAndRefusalsAreCounted) {
+    ServerOptions options;
+    options.apiKeys = *ApiKeys::parse(std::string(kKey) + "\n", "keys");
+    options.relightThreads = 2;
+    options.metricsListen = "127.0.0.1:0";
+    Served served = serveWith(options);
+    ASSERT_TRUE(served.connection);
+    auto keyed = PicConnection::connect(served.server->address(), {.apiKey = kKey});
+    ASSERT_TRUE(keyed);
+    // The channel's and the server's own threads, with one session computed through them.
+    auto first = (*keyed)->createSession();
+    ASSERT_TRUE(first);
+    ASSERT_TRUE(served.server->session(first->session())->waitForVersion(1, std::chrono::seconds(60)));
+    const size_t before = threadCount();
+
+    std::vector<std::string> ids;
+    for (int i = 0; i < 40; ++i) {
+        auto created = (*keyed)->createSession();
+        ASSERT_TRUE(created) << created.error().message;
+        ids.push_back(created->session());
+    }
+    for (const std::string& id : ids)
+        ASSERT_TRUE(served.server->session(id)->waitForVersion(1, std::chrono::seconds(60))) << id;
+    const size_t after = threadCount();
+    EXPECT_LT(after, before + 8) << before << " threads before 40 more sessions, " << after << " after";
+
+    // A call without a key, refused, and counted.
+    EXPECT_FALSE(served.connection->createSession());
+    const HttpReply reply = httpGet(served.server->metricsAddress(), "/metrics");
+    EXPECT_EQ(metricValue(reply.body, "pic_relight_threads"), 2.0) << reply.body;
+    EXPECT_EQ(metricValue(reply.body, "pic_calls_total{call=\"CreateSession\",code=\"UNAUTHENTICATED\"}"), 1.0)
+        << reply.body;
+    EXPECT_EQ(metricValue(reply.body, "pic_calls_total{call=\"CreateSession\",code=\"OK\"}"), 41.0)
+        << reply.body;
+    EXPECT_GE(metricValue(reply.body, "pic_relight_queued"), 0.0) << reply.body;
+}
+
 // Both sides cap what they accept: a peer cannot make the other buffer an arbitrary amount.
 TEST(Access, RequestsOverAMebibyteAreRefused) {
     Served served = serve();

@@ -1,4 +1,4 @@
-// The fairness and rate primitives of server/limits.h.
+// The rate primitives of server/limits.h.
 
 #include "server/limits.h"
 
@@ -14,60 +14,6 @@ namespace pic {
 namespace {
 
 using namespace std::chrono_literals;
-
-// Threads that ask for the lock get it in the order they asked. std::mutex makes no such
-// promise: there the thread that unlocks may take it again at once, which starved the other
-// sessions of a bake while one session's worker relit back to back.
-TEST(FairMutex, HandsItselfOverInTheOrderAsked) {
-    FairMutex mutex;
-    std::vector<int> order;
-    std::mutex orderMutex;
-    mutex.lock();
-    std::vector<std::thread> waiters;
-    std::atomic<int> asked{0};
-    for (int i = 0; i < 4; ++i) {
-        // Each waiter asks only after the one before it has asked (and is blocked).
-        while (asked.load() < i) std::this_thread::yield();
-        waiters.emplace_back([&, i] {
-            asked.fetch_add(1);
-            mutex.lock();
-            {
-                std::lock_guard lock(orderMutex);
-                order.push_back(i);
-            }
-            mutex.unlock();
-        });
-        std::this_thread::sleep_for(20ms);  // let it block in lock()
-    }
-    mutex.unlock();
-    for (auto& t : waiters) t.join();
-    EXPECT_EQ(order, (std::vector<int>{0, 1, 2, 3}));
-}
-
-// Two workers, one relocking at once in a loop: with the fair lock the other gets every
-// second turn.
-TEST(FairMutex, AWorkerThatRelocksAtOnceDoesNotStarveAnother) {
-    FairMutex mutex;
-    std::atomic<bool> stop{false}, counting{false};
-    std::atomic<int> greedy{0}, patient{0};
-    std::thread hog([&] {
-        while (!stop) {
-            std::lock_guard lock(mutex);
-            if (counting) ++greedy;
-            std::this_thread::sleep_for(1ms);
-        }
-    });
-    std::this_thread::sleep_for(5ms);
-    counting = true;  // the hog's turns from the patient worker's first request on
-    for (int i = 0; i < 20; ++i) {
-        std::lock_guard lock(mutex);
-        ++patient;
-    }
-    stop = true;
-    hog.join();
-    EXPECT_EQ(patient.load(), 20);
-    EXPECT_LE(greedy.load(), 2 * 20 + 10) << "the other worker waited for many turns of the first";
-}
 
 TEST(TokenBucket, AllowsABurstThenTellsHowLongToWait) {
     TokenBucket bucket(10.0, 3.0);  // 10 a second, 3 at once
@@ -85,6 +31,42 @@ TEST(PeerHost, DropsThePort) {
     EXPECT_EQ(peerHost("ipv6:[::1]:5123"), "::1");
     EXPECT_EQ(peerHost("ipv6:[fe80::1%eth0]:80"), "fe80::1%eth0");
     EXPECT_EQ(peerHost("unix:/tmp/socket"), "unix:/tmp/socket");
+}
+
+// Behind a load balancer every client has the balancer's address: per-peer quotas then count
+// them all as one peer unless the balancer is trusted to name the client.
+TEST(TrustedProxies, TheClientIsTheRightmostAddressNoTrustedProxyAppended) {
+    TrustedProxies proxies;
+    ASSERT_TRUE(proxies.add("127.0.0.1"));
+    ASSERT_TRUE(proxies.add("10.0.0.0/8"));
+    ASSERT_TRUE(proxies.add("fd00::/8"));
+    EXPECT_TRUE(proxies.contains("10.200.3.4"));
+    EXPECT_FALSE(proxies.contains("11.0.0.1"));
+    EXPECT_TRUE(proxies.contains("fd12::7"));
+    EXPECT_FALSE(proxies.contains("fe80::1"));
+    EXPECT_FALSE(proxies.contains("127.0.0.2"));
+    EXPECT_FALSE(proxies.contains("not an address"));
+
+    // An untrusted peer's header is ignored.
+    EXPECT_EQ(proxies.clientHost("ipv4:192.0.2.5:4000", "198.51.100.1"), "192.0.2.5");
+    // Through the balancer: the address it appended.
+    EXPECT_EQ(proxies.clientHost("ipv4:127.0.0.1:4000", "198.51.100.1"), "198.51.100.1");
+    // A client that writes its own header cannot pick its address: the balancer appends the
+    // real one last, and only the proxies' own entries are skipped.
+    EXPECT_EQ(proxies.clientHost("ipv4:127.0.0.1:4000", "203.0.113.9, 198.51.100.1, 10.1.2.3"),
+              "198.51.100.1");
+    EXPECT_EQ(proxies.clientHost("ipv6:[fd00::1]:4000", "2001:db8::5"), "2001:db8::5");
+    // Nothing usable: the proxy itself.
+    EXPECT_EQ(proxies.clientHost("ipv4:127.0.0.1:4000", ""), "127.0.0.1");
+    EXPECT_EQ(proxies.clientHost("ipv4:127.0.0.1:4000", "garbage"), "127.0.0.1");
+    EXPECT_EQ(proxies.clientHost("ipv4:127.0.0.1:4000", "198.51.100.1, garbage"), "127.0.0.1");
+
+    for (const char* bad : {"", "10.0.0.0/33", "fd00::/129", "10.0.0.0/", "10.0.0.0/x", "host.example", "10.0.0.1/-1"}) {
+        TrustedProxies refused;
+        const auto added = refused.add(bad);
+        ASSERT_FALSE(added) << bad;
+        EXPECT_NE(added.error().message.find("trusted proxy"), std::string::npos) << added.error().message;
+    }
 }
 
 }  // namespace
