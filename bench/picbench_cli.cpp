@@ -289,6 +289,13 @@ int picbenchMain(int argc, char** argv) {
     stability->add_option("--moving-probe-samples", stabilityParams.movingProbeSamples,
                           "directions per ideal cache at each moving-light step; 0: no ideal "
                           "sequence (default 128)");
+    stability->add_option("--blend-intervals", stabilityParams.blendIntervals,
+                          "blend times of a client drawing the moving light, in update "
+                          "intervals (default 0 1 2 4)")
+        ->check(CLI::NonNegativeNumber);
+    stability->add_option("--frames-per-update", stabilityParams.framesPerUpdate,
+                          "frames the blending client draws per version (default 4)")
+        ->check(CLI::Range(1u, 64u));
     stability->add_option("--random-sets", stabilityParams.randomSets,
                           "random light sets, spread over the scenes in turn (default 1000)");
     stability->add_option("--random-scenes", stabilityParams.randomScenes,

@@ -51,9 +51,9 @@ run_case() {
     [ -f "$ref" ] || "$PICREF" --quiet "$scene" --lights "$lights" --camera "$camera" --size "$size" \
       --spp "$SPP" "${bounces[@]}" --component "$component" --out "$ref"
     "$PICREF" shade --quiet "$scene" --bake "$bake" --lights "$lights" --camera "$camera" \
-      --size "$size" --component "$component" --out "$OUT/${name}_${component}_cpu.exr" 2> /dev/null
+      --size "$size" --component "$component" --spp 1 --out "$OUT/${name}_${component}_cpu.exr" 2> /dev/null
     "$PICCLIENT" render --server "$address" --session "$session" --token "$token" \
-      --lights "$lights" --camera "$camera" --size "$size" --component "$component" \
+      --lights "$lights" --camera "$camera" --size "$size" --component "$component" --samples 1 \
       --cache-dir "$OUT/client_cache" --out "$OUT/${name}_${component}_gpu.exr" 2> /dev/null
     for path in cpu gpu; do
       echo "== $name $component, $path shading against picref $SPP spp"

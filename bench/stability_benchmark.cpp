@@ -15,6 +15,7 @@
 #include "bake/ref/path_tracer.h"
 #include "bake/ref/probes.h"
 #include "bench/bench_common.h"
+#include "core/cache_blend.h"
 #include "core/color.h"
 #include "core/gltf_loader.h"
 #include "core/progress.h"
@@ -181,6 +182,7 @@ Result<FlickerSeries> flickerSeries(const std::vector<Image>& frames) {
         // Two black frames do not change.
         series.change.push_back(level > 0.0 ? change / level : 0.0);
         series.index += series.change.back();
+        series.peak = std::max(series.peak, series.change.back());
     }
     series.index /= double(frames.size() - 1);
     for (size_t t = 1; t + 1 < frames.size(); ++t) {
@@ -218,10 +220,15 @@ std::vector<glm::vec3> movingLightPath(const Scene& scene, uint64_t seed, uint32
 
 Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& rays,
                                          const BakeData& bake, const Camera& camera, uint32_t steps,
-                                         uint64_t pathSeed, const StabilitySettings& settings) {
+                                         uint64_t pathSeed, const StabilitySettings& settings,
+                                         const std::vector<double>& blendIntervals,
+                                         uint32_t framesPerUpdate) {
     if (steps < 2)
         return fail(ErrorCode::InvalidInput, "the moving light needs at least 2 steps, got {}",
                     steps);
+    if (framesPerUpdate < 1)
+        return fail(ErrorCode::InvalidInput, "frames per update must be at least 1, got 0");
+    for (const double intervals : blendIntervals) PIC_TRY(CacheBlend::check(intervals));
     MovingLightResult result;
     result.path = movingLightPath(scene, pathSeed, steps);
     PIC_TRY_ASSIGN(std::unique_ptr<Runtime> runtime,
@@ -238,6 +245,7 @@ Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& 
     probe.samples = settings.probeSamples;
     probe.seed = settings.seed;
     std::vector<Image> linked, ideal;
+    std::vector<CacheValues> versions;  // for the blending client
     Progress progress("moving light", steps);
     for (uint32_t k = 0; k < steps; ++k) {
         lights.lights[0].position = result.path[k];
@@ -245,6 +253,7 @@ Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& 
         PIC_TRY_ASSIGN(Image image,
                        shadeFromCaches(scene, rays, bake, *values, lights, camera, shade));
         linked.push_back(std::move(image));
+        if (!blendIntervals.empty()) versions.push_back(*values);
         if (settings.probeSamples > 0) {
             PIC_TRY_ASSIGN(CacheValues probes, pathTraceProbes(scene, rays, bake, lights, probe));
             PIC_TRY_ASSIGN(Image idealImage,
@@ -257,6 +266,40 @@ Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& 
     PIC_TRY_ASSIGN(result.linked, flickerSeries(linked));
     if (!ideal.empty()) {
         PIC_TRY_ASSIGN(result.ideal, flickerSeries(ideal));
+    }
+    // The client: version k arrives at time k (in update intervals) and frame j of its
+    // interval is drawn at k + j / framesPerUpdate. Only the cache term is drawn, so the
+    // light's own position is that of the newest version throughout.
+    for (const double intervals : blendIntervals) {
+        CacheBlend blend(intervals);
+        std::vector<Image> frames;
+        double lag = 0.0;
+        Progress blending(fmt::format("moving light, blend {} intervals", intervals),
+                          steps * framesPerUpdate);
+        for (uint32_t k = 0; k < steps; ++k) {
+            lights.lights[0].position = result.path[k];
+            PIC_TRY(blend.push(versions[k], double(k)));
+            for (uint32_t j = 0; j < framesPerUpdate; ++j) {
+                const CacheValues* shown = blend.at(double(k) + double(j) / framesPerUpdate);
+                PIC_TRY_ASSIGN(Image frame,
+                               shadeFromCaches(scene, rays, bake, *shown, lights, camera, shade));
+                const double newest = meanLuminance(linked[k]);
+                double distance = 0.0;
+                for (size_t i = 0; i < frame.pixels.size(); ++i)
+                    distance += std::abs(double(luminance(frame.pixels[i])) -
+                                         double(luminance(linked[k].pixels[i])));
+                distance /= double(frame.pixels.size());
+                lag += newest > 0.0 ? distance / newest : 0.0;
+                frames.push_back(std::move(frame));
+                blending.advance();
+            }
+        }
+        blending.finish();
+        BlendedFlicker out;
+        out.intervals = intervals;
+        PIC_TRY_ASSIGN(out.frames, flickerSeries(frames));
+        out.lag = lag / double(frames.size());
+        result.blended.push_back(std::move(out));
     }
     result.firstLinked = std::move(linked.front());
     return result;
@@ -617,7 +660,8 @@ struct Runner {
         settings.probeSamples = params.movingProbeSamples;
         PIC_TRY_ASSIGN(MovingLightResult moving,
                        runMovingLight(loaded->scene, *loaded->rays, loaded->bake, camera,
-                                      params.steps, params.settings.seed, settings));
+                                      params.steps, params.settings.seed, settings,
+                                      params.blendIntervals, params.framesPerUpdate));
         Json out{{"scene", params.movingScene},
                  {"bake", bakeJson(loaded->bake, loaded->bakeSeconds)},
                  {"steps", params.steps},
@@ -667,6 +711,22 @@ struct Runner {
                         params.movingScene.c_str(), moving.linked.index);
         }
         out["linked_roughness"] = moving.linked.roughness;
+        out["linked_peak"] = moving.linked.peak;
+        Json blended = Json::array();
+        for (const BlendedFlicker& b : moving.blended) {
+            blended.push_back({{"blend_intervals", b.intervals},
+                               {"frames_per_update", params.framesPerUpdate},
+                               {"flicker", b.frames.index},
+                               {"roughness", b.frames.roughness},
+                               {"peak", b.frames.peak},
+                               {"lag", b.lag},
+                               {"change", b.frames.change}});
+            std::printf("  moving %-15s client blending over %g intervals, %u frames per "
+                        "version: flicker %.5f, roughness %.5f, largest change %.5f, lag %.5f\n",
+                        params.movingScene.c_str(), b.intervals, params.framesPerUpdate,
+                        b.frames.index, b.frames.roughness, b.frames.peak, b.lag);
+        }
+        out["blended"] = std::move(blended);
         out["frames"] = {{"linked_mean", moving.linked.mean},
                          {"linked_change", moving.linked.change}};
         if (moving.ideal) {

@@ -100,6 +100,7 @@ struct FlickerSeries {
     std::vector<double> change;
     double index = 0.0;
     double roughness = 0.0;
+    double peak = 0.0;  ///< the largest frame-to-frame change: the worst jump
 };
 
 /// The flicker series of `frames` (all the same size; at least two).
@@ -114,17 +115,33 @@ std::vector<glm::vec3> movingLightPath(const Scene& scene, uint64_t seed, uint32
 /// 2 W/sr × (diagonal / 5 m)², rendered at each position of movingLightPath: the linked
 /// indirect sequence and, when settings.probeSamples > 0, the ideal-cache sequence (the same
 /// probe seed every step, so its Monte Carlo noise does not flicker by itself).
+/// How a client that blends cache versions (core/cache_blend.h) sees the moving light: a
+/// version arrives every update interval, the client draws `framesPerUpdate` frames per
+/// interval, evenly spaced from the arrival on.
+struct BlendedFlicker {
+    double intervals = 0.0;  ///< blend time in update intervals (0: every version at once)
+    FlickerSeries frames;    ///< over every drawn frame
+    /// Mean over the frames of the drawn caches' distance from the newest version (mean
+    /// absolute luminance difference of the images over the newest's mean): the lag.
+    double lag = 0.0;
+};
+
 struct MovingLightResult {
     std::vector<glm::vec3> path;
     FlickerSeries linked;
     std::optional<FlickerSeries> ideal;
+    std::vector<BlendedFlicker> blended;  ///< one per blend time asked for
     Image firstLinked;  ///< the first linked frame, for people
 };
 
-/// Moves the light `steps` steps along movingLightPath(scene, pathSeed) seen from `camera`.
+/// Moves the light `steps` steps along movingLightPath(scene, pathSeed) seen from `camera`;
+/// with `blendIntervals`, also draws the linked caches as a blending client would at each
+/// blend time, `framesPerUpdate` frames per version.
 Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& rays,
                                          const BakeData& bake, const Camera& camera, uint32_t steps,
-                                         uint64_t pathSeed, const StabilitySettings& settings);
+                                         uint64_t pathSeed, const StabilitySettings& settings,
+                                         const std::vector<double>& blendIntervals = {},
+                                         uint32_t framesPerUpdate = 4);
 
 /// Why cache values are invalid, or nullopt when they are valid: every coefficient finite;
 /// each RGB channel's band 0 (its mean radiance) ≥ 0; the luma evaluated in 256 directions
@@ -164,6 +181,9 @@ struct StabilityParams {
     uint32_t steps = 60;  ///< moving light
     std::string movingScene = "furnished_room";
     uint32_t movingProbeSamples = 128;  ///< directions per ideal cache at each moving-light step
+    /// Blend times of a client drawing the moving light, in update intervals (BlendedFlicker).
+    std::vector<double> blendIntervals{0.0, 1.0, 2.0, 4.0};
+    uint32_t framesPerUpdate = 4;  ///< frames the blending client draws per version
     uint32_t randomSets = 1000;
     glm::uvec2 randomSize{32, 24};
     std::vector<std::string> randomScenes{"cornell",    "cornell_area",    "closed_box",

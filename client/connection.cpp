@@ -492,6 +492,14 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
         return fail(ErrorCode::Corrupt,
                     "frame of version {} is a delta against version {}, but version {} is held",
                     frame.version(), frame.base_version(), mVersion);
+    std::optional<LightSet> lights;
+    if (frame.has_lights()) {
+        auto parsed = wire::fromProto(frame.lights());
+        if (!parsed)
+            return fail(ErrorCode::Corrupt, "frame of version {}: its light set: {}",
+                        frame.version(), parsed.error().message);
+        lights = std::move(*parsed);
+    }
     PIC_TRY_ASSIGN(EncodedFrame encoded, wire::planesFromProto(frame));
     for (int t = 0; t < kFramePlanes; ++t)
         if (encoded.planes[size_t(t)].values != mExpected[size_t(t)])
@@ -510,6 +518,7 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
         PIC_TRY(decodeFrame(encoded, mFrame));
     }
     mVersion = frame.version();
+    if (lights) mLights = std::move(*lights);
     return {};
 }
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -157,15 +158,20 @@ public:
     /// hold that bake's caches is refused before anything is allocated for it.
     explicit FrameDecoder(const v1::SceneHeader& header);
     /// Decodes `frame` (its bytes are moved out). Corrupt when it is a delta against a version
-    /// other than the one held, or does not decode; the held version is then unchanged.
+    /// other than the one held, does not decode or carries a light set that does not parse;
+    /// the held version is then unchanged.
     Result<void> apply(v1::Frame& frame);
     /// The version held, 0 before the first key frame.
     uint64_t version() const { return mVersion; }
     const HalfFrame& frame() const { return mFrame; }
+    /// The light set of the newest frame that carried one (null before): the direct light and
+    /// indirect scales to shade the held caches with.
+    const LightSet* lights() const { return mLights ? &*mLights : nullptr; }
 
 private:
     HalfFrame mFrame;
     uint64_t mVersion = 0;
+    std::optional<LightSet> mLights;
     std::array<size_t, kFramePlanes> mExpected{};  ///< values per plane
 };
 

@@ -220,6 +220,7 @@ struct RenderCommand {
     ImageOutputFlags output;
     std::string device;
     uint32_t shadowMapSize = 1024;
+    uint32_t samples = 4;
     std::string cacheDir;
     double waitSeconds = 60;
 };
@@ -310,6 +311,9 @@ int runRender(const Common& common, const RenderCommand& command) {
                                              command.waitSeconds)});
     }
     if (!textures) return reportError(textures.error());
+    // The frame names the light set its caches were computed for: the newest version may be
+    // newer than the one pushed or joined.
+    if (decoder.lights()) lights = *decoder.lights();
 
     gpu::ContextOptions contextOptions;
     contextOptions.deviceName = command.device;
@@ -321,7 +325,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!renderer) return reportError(renderer.error());
     if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
     RenderTimings timings;
-    auto image = (*renderer)->render(lights, *camera, command.shade.toParams(view->size), &timings);
+    auto image = (*renderer)->render(lights, *camera,
+                                     command.shade.toParams(view->size, command.samples), &timings);
     if (!image) return reportError(image.error());
     if (auto written = command.output.write(*image); !written) return reportError(written.error());
 
@@ -333,12 +338,13 @@ int runRender(const Common& common, const RenderCommand& command) {
         stderr,
         "picclient render: scene %s in %.0f ms (%s); version %llu: %s %.1f ms (server update + "
         "encode %.1f ms, %zu bytes, decode %.1f ms, textures %.1f ms); "
-        "render %ux%u %s on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
+        "render %ux%u %s, %u samples per pixel, on \"%s\" %.1f ms (%s); total %.0f ms -> %s\n",
         downloaded ? "downloaded" : "kept", sceneMs, client->folder.c_str(),
         (unsigned long long)decoder.version(),
         pushed ? "light change to decoded frame" : "current frame received and decoded in",
         latencyMs, serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y,
-        command.shade.component().c_str(), (*context)->deviceName().c_str(), timings.totalMs,
+        command.shade.component().c_str(), command.samples, (*context)->deviceName().c_str(),
+        timings.totalMs,
         passes.c_str(), since(start), command.output.path().c_str());
     std::printf("%s\n", command.output.path().c_str());
     return 0;
@@ -416,6 +422,11 @@ int picclientMain(int argc, char** argv) {
     renderCommand->add_option("--shadow-map-size", render.shadowMapSize,
                               "texels per side of each shadow-map layer")
         ->check(CLI::Range(16u, 16384u));
+    renderCommand->add_option("--samples", render.samples,
+                              "subsamples per pixel, averaged: anti-aliasing, each costs a "
+                              "G-buffer and a shading pass (default 4; 1: pixel centres; "
+                              "picref shade --spp N is the CPU counterpart)")
+        ->check(CLI::Range(1u, kMaxSamplesPerPixel));
     renderCommand->add_option("--cache-dir", render.cacheDir, "where downloaded scenes are kept");
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);

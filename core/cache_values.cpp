@@ -167,6 +167,18 @@ RadianceSh blendCaches(const CacheValues& values, const CacheStencil& stencil) {
     return out;
 }
 
+void scaleLumaChroma(RadianceSh& radiance, float y, float cocg) {
+    const int count = int(shCount(int(radiance.bands)));
+    for (int i = 0; i < count; ++i) {
+        glm::vec3 v = rgbToYCoCg({radiance.rgb[0][i], radiance.rgb[1][i], radiance.rgb[2][i]});
+        v *= glm::vec3(y, cocg, cocg);
+        const glm::vec3 rgb = yCoCgToRgb(v);
+        radiance.rgb[0][i] = rgb.r;
+        radiance.rgb[1][i] = rgb.g;
+        radiance.rgb[2][i] = rgb.b;
+    }
+}
+
 glm::vec3 irradiance(const RadianceSh& radiance, const glm::vec3& normal) {
     glm::vec3 e;
     for (int c = 0; c < 3; ++c) e[c] = shIrradiance(int(radiance.bands), radiance.rgb[c], normal);

@@ -74,6 +74,11 @@ RadianceSh lookupSurfaceRadiance(const BakeData& bake, const CacheValues& values
 RadianceSh lookupGridRadiance(const BakeData& bake, const CacheValues& values,
                               const glm::vec3& position);
 
+/// Scales the luma Y of every coefficient by `y` and its chroma Co, Cg by `cocg` (paper 001
+/// §4's artistic control, core/light_set.h IndirectScale): YCoCg is linear in RGB, so this is
+/// the same as scaling the reconstructed light's Y and CoCg.
+void scaleLumaChroma(RadianceSh& radiance, float y, float cocg);
+
 /// Irradiance (W/m², RGB) from interpolated radiance on a surface with unit normal n:
 /// E = Σ K_l L_lm y_lm(n) per channel (clamped-cosine convolution, paper 000 §3.2).
 glm::vec3 irradiance(const RadianceSh& radiance, const glm::vec3& normal);

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "core/sampling.h"
+
 namespace pic {
 
 namespace {
@@ -106,6 +108,11 @@ CameraRays::CameraRays(const Camera& camera, uint32_t width, uint32_t height)
     mRight = glm::normalize(glm::cross(mForward, camera.up));
     mUp = glm::cross(mRight, mForward);
     PIC_CHECK(std::isfinite(mRight.x + mRight.y + mRight.z) && std::isfinite(mTanHalfFovy));
+}
+
+glm::vec2 subsampleOffset(uint32_t s, uint32_t n) {
+    const float shifted = float(radicalInverse(2, s)) + 0.5f / float(n);
+    return {(float(s) + 0.5f) / float(n), shifted - std::floor(shifted)};
 }
 
 glm::vec3 CameraRays::direction(float x, float y) const {

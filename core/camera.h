@@ -2,6 +2,7 @@
 /// Pinhole cameras from the command line (`--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy`) or the
 /// scene (`--scene-camera N`), and their primary rays.
 
+#include <cstdint>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -23,6 +24,12 @@ Result<void> checkCamera(const Camera& camera);
 
 /// The scene's N-th camera (0-based); InvalidInput if it has fewer.
 Result<Camera> sceneCamera(const Scene& scene, int index);
+
+/// Offset of subsample s of n inside a pixel, in [0, 1)² from its top-left corner: the pixel
+/// centre for n = 1, else a Hammersley set shifted by half a stratum, the same in every pixel
+/// so that images depend on nothing but their inputs. Both the thin client's renderer and its
+/// CPU counterpart (`picref shade --spp`) average a pixel over these. s < n.
+glm::vec2 subsampleOffset(uint32_t s, uint32_t n);
 
 /// A pixel's footprint on a surface: the hit point's changes per pixel along x and along y.
 struct PixelFootprint {

@@ -251,6 +251,22 @@ Result<std::map<std::string, float>> parseEmissiveScale(const Json& value) {
     return scales;
 }
 
+Result<IndirectScale> parseIndirectScale(const Json& value) {
+    if (!value.is_object())
+        return fail(ErrorCode::InvalidInput, "indirectScale must be an object, got {}",
+                    shown(value));
+    FieldReader fields(value, "indirectScale");
+    IndirectScale scale;
+    PIC_TRY_ASSIGN(scale.y, fields.number("y", 1.0f));
+    PIC_TRY_ASSIGN(scale.cocg, fields.number("cocg", 1.0f));
+    for (const auto& [key, factor] : {std::pair{"y", scale.y}, std::pair{"cocg", scale.cocg}})
+        if (!(factor >= 0.0f && factor <= kMaxIndirectScale))
+            return fail(ErrorCode::InvalidInput, "indirectScale.{} must be in [0, {:g}], got {:g}",
+                        key, kMaxIndirectScale, factor);
+    PIC_TRY(fields.rejectUnknown());
+    return scale;
+}
+
 FloatJson vec3Json(const glm::vec3& v) {
     return FloatJson::array({v.x, v.y, v.z});
 }
@@ -306,6 +322,9 @@ Result<LightSet> parseLightSet(const std::string& json) {
     if (const Json* scales = fields.find("emissiveScale")) {
         PIC_TRY_ASSIGN(set.emissiveScale, parseEmissiveScale(*scales));
     }
+    if (const Json* scale = fields.find("indirectScale")) {
+        PIC_TRY_ASSIGN(set.indirectScale, parseIndirectScale(*scale));
+    }
     if (auto known = fields.rejectUnknown(); !known) return std::unexpected(known.error());
     return set;
 }
@@ -348,6 +367,8 @@ std::string toJson(const LightSet& set) {
     FloatJson scales = FloatJson::object();
     for (const auto& [material, scale] : set.emissiveScale) scales[material] = scale;
     root["emissiveScale"] = std::move(scales);
+    if (set.indirectScale != IndirectScale{})
+        root["indirectScale"] = {{"y", set.indirectScale.y}, {"cocg", set.indirectScale.cocg}};
     return root.dump(2);
 }
 

@@ -2,7 +2,8 @@
 /// Light sets (ARCHITECTURE.md §4): the lights and emissive scales a client sets, read from
 /// and written to the JSON form
 /// {"lights":[{"id","type","position","direction","color","intensity","innerConeAngle",
-///  "outerConeAngle","range"}], "emissiveScale":{"<material name>": s}}.
+///  "outerConeAngle","range"}], "emissiveScale":{"<material name>": s},
+///  "indirectScale":{"y": s, "cocg": s}}.
 
 #include <map>
 #include <string>
@@ -27,6 +28,19 @@ inline constexpr float kMaxLightIntensity = 1e9f;
 /// Largest emissive scale of a material.
 inline constexpr float kMaxEmissiveScale = 1e6f;
 
+/// Largest artistic scale of the cache term's luma or chroma (IndirectScale).
+inline constexpr float kMaxIndirectScale = 16.0f;
+
+/// Artistic control of the cache term (paper 001 §4): factors on its luma Y, the indirect
+/// light's "presence", and on its chroma Co and Cg, its colour bleeding. Clients apply them
+/// where they reconstruct the cache term from the caches; the caches, and the light they
+/// pass on to further bounces, stay physical. 1 and 1 leave the light as computed.
+struct IndirectScale {
+    float y = 1.0f;
+    float cocg = 1.0f;
+    friend bool operator==(const IndirectScale&, const IndirectScale&) = default;
+};
+
 /// Whether `id` may name a light: 1 to kMaxLightIdBytes bytes without control characters.
 bool isLightId(std::string_view id);
 
@@ -34,6 +48,7 @@ bool isLightId(std::string_view id);
 struct LightSet {
     std::vector<Light> lights;
     std::map<std::string, float> emissiveScale;  ///< material name → factor on its emission (default 1)
+    IndirectScale indirectScale;                 ///< on the cache term where clients shade
 
     /// Emission scale of a material (1 when not listed).
     float emissiveScaleOf(const std::string& material) const;
@@ -47,7 +62,8 @@ LightSet defaultLightSet(const Scene& scene);
 /// intensity × colour above kMaxLightIntensity, zero-length direction for spot/directional
 /// lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with outer > 0, negative range, more
 /// than kMaxLights lights, duplicate ids, ids that isLightId refuses, unknown keys, negative,
-/// non-finite or larger than kMaxEmissiveScale emissive scales. Text from the input is clipped
+/// non-finite or larger than kMaxEmissiveScale emissive scales, indirect scales outside
+/// [0, kMaxIndirectScale] or with other keys than y and cocg. Text from the input is clipped
 /// in messages. Directions are normalised.
 Result<LightSet> parseLightSet(const std::string& json);
 

@@ -81,6 +81,7 @@ struct Light {
     float innerConeAngle = 0.0f;                   ///< radians, half-angle
     float outerConeAngle = 0.7853981634f;          ///< radians, half-angle
     float range = std::numeric_limits<float>::infinity();  ///< metres; infinity = no cut-off
+    friend bool operator==(const Light&, const Light&) = default;
 };
 
 /// A pinhole camera.

@@ -97,6 +97,10 @@ v1::LightSet toProto(const LightSet& lights) {
     }
     for (const auto& [material, scale] : lights.emissiveScale)
         (*out.mutable_emissive_scale())[material] = scale;
+    if (lights.indirectScale != IndirectScale{}) {
+        out.mutable_indirect_scale()->set_y(lights.indirectScale.y);
+        out.mutable_indirect_scale()->set_cocg(lights.indirectScale.cocg);
+    }
     return out;
 }
 
@@ -116,6 +120,19 @@ Result<LightSet> fromProto(const v1::LightSet& lights) {
         scales[material] = scale;
     }
     root["emissiveScale"] = std::move(scales);
+    if (lights.has_indirect_scale()) {
+        const v1::IndirectScale& wire = lights.indirect_scale();
+        Json scale = Json::object();
+        if (wire.has_y()) {
+            PIC_TRY(checkFinite(wire.y(), "indirectScale.y"));
+            scale["y"] = wire.y();
+        }
+        if (wire.has_cocg()) {
+            PIC_TRY(checkFinite(wire.cocg(), "indirectScale.cocg"));
+            scale["cocg"] = wire.cocg();
+        }
+        root["indirectScale"] = std::move(scale);
+    }
     return parseLightSet(root.dump());
 }
 

@@ -17,7 +17,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Timestamp pairs one frame may hold: shadow maps, G-buffer, shading.
+/// Timestamp pairs one frame may hold: shadow maps, G-buffer, shading, further subsamples.
 constexpr uint32_t kTimedPasses = 4;
 
 bool finite(const glm::vec3& v) {
@@ -102,16 +102,6 @@ Result<void> checkTextures(const CacheTextures& t, const ClientLayout& layout) {
     return check(t.lightmapCoverage, texels, "light-map", "coverage", true);
 }
 
-/// Shading parameters this renderer handles: any checkShadeParams accepts, at pixel centres.
-Result<void> checkParams(const ShadeParams& params) {
-    PIC_TRY(checkShadeParams(params));
-    if (params.samplesPerPixel != 1)
-        return fail(ErrorCode::InvalidInput,
-                    "samples per pixel {}: the renderer shades pixel centres only (1)",
-                    params.samplesPerPixel);
-    return {};
-}
-
 }  // namespace
 
 ClientLayout clientLayoutOf(const BakeData& bake) {
@@ -167,7 +157,7 @@ Result<void> Renderer::setCaches(const CacheTextures& textures) {
 Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
                                const ShadeParams& params, RenderTimings* timings) {
     const Clock::time_point start = Clock::now();
-    PIC_TRY(checkParams(params));
+    PIC_TRY(checkShadeParams(params));
     PIC_TRY(checkCamera(camera));
     if (lights.lights.size() > kMaxLights)
         return fail(ErrorCode::InvalidInput, "{} lights, at most {} are supported",
@@ -196,8 +186,6 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     }
 
     const float near = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
-    const gpu::GbufferPush gbufferPush =
-        gpu::gbufferPushOf(camera, params.width, params.height, near);
 
     gpu::CacheShadingPush push{};
     push.eye = camera.eye;
@@ -216,6 +204,8 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     // The CPU twin adds the lobe only when both its exponent and weight are positive.
     const bool glossy = params.glossyExponent > 0.0f && params.glossyWeight > 0.0f;
     push.glossyWeight = glossy ? params.glossyWeight : 0.0f;
+    push.yScale = lights.indirectScale.y;
+    push.cocgScale = lights.indirectScale.cocg;
     for (int l = 0; l < kMaxShBands; ++l)
         push.glossyLobe[l / 4][l % 4] = glossy ? cosineLobeFactor(l, params.glossyExponent) : 0.0f;
 
@@ -225,10 +215,28 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
                 mTimer.begin(cmd, "shadow_maps");
                 mShadows->record(cmd);
             }
-            mTimer.begin(cmd, "gbuffer");
-            mGbuffer->record(cmd, gbufferPush);
-            mTimer.begin(cmd, "cache_shading");
-            mShading->record(cmd, push);
+            // One G-buffer and one shading pass per subsample (the CPU twin's offsets and
+            // footprints, render/cpu/cache_shading.h), each adding to the pixel's sum.
+            const uint32_t n = params.samplesPerPixel;
+            for (uint32_t s = 0; s < n; ++s) {
+                if (s == 1) mTimer.begin(cmd, "subsamples");
+                if (s == 0) mTimer.begin(cmd, "gbuffer");
+                mGbuffer->record(cmd, gpu::gbufferPushOf(camera, params.width, params.height,
+                                                         near, subsampleOffset(s, n),
+                                                         1.0f / std::sqrt(float(n))));
+                if (s == 0) mTimer.begin(cmd, "cache_shading");
+                if (s > 0) {
+                    // The previous subsample's sums are written before this one adds to them.
+                    VkMemoryBarrier sums{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+                    sums.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+                    sums.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+                    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &sums, 0,
+                                         nullptr, 0, nullptr);
+                }
+                push.accumulate = s > 0 ? 1u : 0u;
+                mShading->record(cmd, push);
+            }
             // The shader's writes are visible to the host's read of the radiance.
             VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
             toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
@@ -241,7 +249,9 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     std::vector<glm::vec4> radiance(size_t{params.width} * params.height);
     PIC_TRY(mContext.download(mRadiance, radiance.data(), radianceBytes));
     Image image(params.width, params.height);
-    for (size_t i = 0; i < radiance.size(); ++i) image.pixels[i] = glm::vec3(radiance[i]);
+    // The CPU twin's average: the sum over subsamples divided by their number.
+    const float n = float(params.samplesPerPixel);
+    for (size_t i = 0; i < radiance.size(); ++i) image.pixels[i] = glm::vec3(radiance[i]) / n;
 
     if (timings) {
         timings->passMs.clear();

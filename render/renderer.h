@@ -3,8 +3,10 @@
 /// a scene shaded from cache textures (core/cache_textures.h: the client writes them from the
 /// caches the server streams), on any Vulkan 1.3 device (lavapipe without a GPU). A rasterised G-buffer, direct light from shadow maps
 /// (render/passes/shadow_map_pass.h), the cache term from the light map (bilinear) on
-/// light-mapped surfaces and the grid (trilinear) elsewhere (paper 000 §3.2), emission; the
-/// image holds the radiance at pixel centres. The CPU twin is render/cpu/cache_shading.h:
+/// light-mapped surfaces and the grid (trilinear) elsewhere (paper 000 §3.2), emission; each
+/// pixel holds the radiance at its centre, or with n subsamples the mean over n fixed points
+/// of the pixel (supersampling: a G-buffer and a shading pass per subsample, core/camera.h
+/// subsampleOffset). The CPU twin is render/cpu/cache_shading.h:
 /// the cache term matches it to half-float precision of the textures; direct light differs
 /// where shadow-map texels straddle a shadow edge.
 
@@ -90,10 +92,11 @@ public:
     /// Renders `camera`'s view lit by `lights` as `params` asks: params.component selects
     /// full (visible emission + direct + cache term), direct or indirect (the cache term,
     /// with the glossy lobe when glossyWeight and glossyExponent are > 0); misses are black.
-    /// Pixel centres only (samplesPerPixel must be 1). Never NaN, infinite or negative for
-    /// accepted inputs. InvalidInput for sizes outside 1..16384, other sample counts, bad
-    /// glossy parameters, an invalid camera, or lights that checkRuntimeLights refuses or
-    /// that number more than kMaxLights.
+    /// samplesPerPixel subsamples per pixel, averaged (1: the pixel centre); the frame's cost
+    /// grows with them, shadow maps aside. Never NaN, infinite or negative for accepted
+    /// inputs. InvalidInput for sizes outside 1..16384, sample counts outside
+    /// 1..kMaxSamplesPerPixel, bad glossy parameters, an invalid camera, or lights that
+    /// checkRuntimeLights refuses or that number more than kMaxLights.
     Result<Image> render(const LightSet& lights, const Camera& camera, const ShadeParams& params,
                          RenderTimings* timings = nullptr);
 

@@ -254,6 +254,14 @@ void Session::compute() {
     mStep.update->keysOnDemand = mKeysOnDemand;
     mStep.frame = std::make_shared<HalfFrame>();
     const auto start = Clock::now();
+    // A set that changes only what clients apply (the indirect scales) has the caches of the
+    // last version: they are reused, and no pass runs.
+    if (mStep.previous && job.lights.lights == mStep.previousLights.lights &&
+        job.lights.emissiveScale == mStep.previousLights.emissiveScale) {
+        *mStep.frame = *mStep.previous;
+        mStep.updateMs = millisecondsSince(start);
+        return;
+    }
     if (auto relit = mBake.relight(job.lights, mStep.update->stats, *mStep.frame); !relit) {
         std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
                      (unsigned long long)job.version, relit.error().message.c_str());
@@ -289,12 +297,14 @@ void Session::finish() {
     wireFrame->set_encode_ms(update->encodeMs);
     wireFrame->set_lights_set_unix_ns(
         std::chrono::duration_cast<std::chrono::nanoseconds>(job.accepted.time_since_epoch()).count());
+    *wireFrame->mutable_lights() = wire::toProto(job.lights);
 
     update->baseVersion = wireFrame->base_version();
     update->frame = frame;
     update->broadcast = std::move(wireFrame);
     mStep.previous = std::move(frame);
     mStep.previousVersion = update->version;
+    mStep.previousLights = job.lights;
     mStep.deltasSinceKey = key ? 0 : mStep.deltasSinceKey + 1;
     publish(std::move(update));
 }

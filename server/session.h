@@ -226,6 +226,7 @@ private:
         double updateMs = 0.0;
         std::shared_ptr<const HalfFrame> previous;  ///< the last published version's caches
         uint64_t previousVersion = 0;
+        LightSet previousLights;                    ///< and its light set
         uint32_t deltasSinceKey = 0;
     } mStep;
 };

@@ -5,6 +5,8 @@
 // (light map: 4 texels bilinearly; grid: 8 vertices trilinearly; texels and vertices without
 // a cache take no weight and the others are renormalised, core/cache_values.h), plus the
 // glossy lobe about the mirror direction; emission in the full component. Misses are black.
+// With subsamples the renderer runs it once per subsample's G-buffer, each run adding to the
+// pixel's sum (pc.accumulate).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_shader_16bit_storage : require
@@ -37,7 +39,7 @@ layout(std430, binding = 12) readonly buffer LightmapCo { float16_t lightmapCo[]
 layout(std430, binding = 13) readonly buffer LightmapCg { float16_t lightmapCg[]; };
 layout(std430, binding = 14) readonly buffer LightmapCoverage { float16_t lightmapCoverage[]; };
 layout(std140, binding = 15) uniform Sh { ShTables sh; };
-layout(std430, binding = 16) writeonly buffer Radiance { vec4 radiance[]; };  // width·height
+layout(std430, binding = 16) buffer Radiance { vec4 radiance[]; };  // width·height
 layout(push_constant) uniform Push { CacheShadingPush pc; };
 
 #include "lib/sh.glsl"
@@ -141,7 +143,7 @@ void main() {
     const vec4 albedoHit = texelFetch(gbufferAlbedo, xy, 0);
     // The pixel sees nothing: black.
     if (albedoHit.w == 0.0) {
-        radiance[pixel] = vec4(0.0);
+        if (pc.accumulate == 0u) radiance[pixel] = vec4(0.0);
         return;
     }
     const vec3 position = positionU.xyz;
@@ -216,7 +218,9 @@ void main() {
                 e.yz += chroma * (y[c] * w);
             }
         }
-        result += albedo * (1.0 / kPi) * max(yCoCgToRgb(e), vec3(0.0));
+        // The light set's artistic scales (paper 001 §4) on the reconstructed luma and chroma.
+        const vec3 scale = vec3(pc.yScale, pc.cocgScale, pc.cocgScale);
+        result += albedo * (1.0 / kPi) * max(yCoCgToRgb(scale * e), vec3(0.0));
 
         if (pc.glossyWeight > 0.0) {
             // The normalised cosine lobe about the mirror direction of the view ray averages
@@ -234,8 +238,8 @@ void main() {
                     g.yz += chroma * (y[c] * w);
                 }
             }
-            result += pc.glossyWeight * max(yCoCgToRgb(g), vec3(0.0));
+            result += pc.glossyWeight * max(yCoCgToRgb(scale * g), vec3(0.0));
         }
     }
-    radiance[pixel] = vec4(result, 0.0);
+    radiance[pixel] = pc.accumulate != 0u ? radiance[pixel] + vec4(result, 0.0) : vec4(result, 0.0);
 }

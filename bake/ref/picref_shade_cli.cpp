@@ -40,7 +40,7 @@ struct ShadeCommand {
     ViewFlags view;
     ShadeFlags shade;
     int bounces = -1;
-    uint32_t spp = 1;
+    uint32_t spp = 4;  // picclient render --samples' default
     ImageOutputFlags output;
 };
 
@@ -132,8 +132,10 @@ int picrefShadeMain(int argc, char** argv) {
     app.add_option("--bounces", command.bounces,
                    "cache passes: 0 = direct light only, B = up to B reflections (default: until "
                    "a bounce adds < 0.5 % of the flux, at most 8)");
-    app.add_option("--spp", command.spp, "subsamples per pixel (box filter)")
-        ->check(CLI::Range(1u, 4096u));
+    app.add_option("--spp", command.spp,
+                   "subsamples per pixel, averaged (default 4, as picclient render --samples; "
+                   "1: pixel centres)")
+        ->check(CLI::Range(1u, kMaxSamplesPerPixel));
     addGlobalFlags(app);
     command.output.addTo(app);
 

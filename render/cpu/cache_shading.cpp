@@ -9,7 +9,6 @@
 
 #include "core/camera.h"
 #include "core/parallel.h"
-#include "core/sampling.h"
 #include "core/sh.h"
 
 namespace pic {
@@ -66,14 +65,6 @@ Result<void> validate(const Scene& scene, const BakeData& bake, const CacheValue
                     grid.dims.y, grid.dims.z, grid.cacheIndex.size());
     if (auto ok = checkCacheIndices(map.cacheIndex, caches, "light-map texel"); !ok) return ok;
     return checkCacheIndices(grid.cacheIndex, caches, "grid vertex");
-}
-
-/// Offset of subsample s of n inside a pixel, in [0, 1)²: the pixel centre for n = 1, else a
-/// Hammersley set shifted by half a stratum, the same in every pixel so that images do not
-/// depend on anything but their inputs.
-glm::vec2 subsampleOffset(uint32_t s, uint32_t n) {
-    const float shifted = float(radicalInverse(2, s)) + 0.5f / float(n);
-    return {(float(s) + 0.5f) / float(n), shifted - std::floor(shifted)};
 }
 
 /// Everything one pixel's shading reads, resolved once per image.
@@ -135,8 +126,10 @@ glm::vec3 shadeRay(const ShadingContext& context, const glm::vec3& origin,
     }
 
     if (params.component != ShadeComponent::Direct) {
-        const RadianceSh incident = lookupSurfaceRadiance(
-            context.bake, context.values, hit->triangle, hit->b1, hit->b2, position);
+        RadianceSh incident = lookupSurfaceRadiance(context.bake, context.values, hit->triangle,
+                                                    hit->b1, hit->b2, position);
+        const IndirectScale& scale = context.lights.indirectScale;
+        if (scale != IndirectScale{}) scaleLumaChroma(incident, scale.y, scale.cocg);
         // A truncated SH expansion rings: on the dark side of a bright cache its clamped-cosine
         // convolution can dip below zero. Irradiance never does, so each channel is cut at 0.
         const glm::vec3 e = glm::max(irradiance(incident, normal), glm::vec3(0.0f));

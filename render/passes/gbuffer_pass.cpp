@@ -53,13 +53,22 @@ glm::mat4 clipFromWorldOf(const Camera& camera, uint32_t width, uint32_t height,
     return m;
 }
 
-GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near) {
+GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near,
+                          glm::vec2 offset, float footprintScale) {
     GbufferPush push{};
     push.clipFromWorld = clipFromWorldOf(camera, width, height, near);
+    // Framebuffer x is (ndc x + 1)·width/2, as CameraRays' image x, and likewise y: adding
+    // 2·(½ − offset)/size to ndc (times w in clip space) moves the point on the ray through
+    // x + offset onto the pixel centre x + ½.
+    const glm::vec2 shift = 2.0f * (glm::vec2(0.5f) - offset) / glm::vec2(width, height);
+    for (int c = 0; c < 4; ++c) {
+        push.clipFromWorld[c][0] += shift.x * push.clipFromWorld[c][3];
+        push.clipFromWorld[c][1] += shift.y * push.clipFromWorld[c][3];
+    }
     push.eye = camera.eye;
     const CameraRays rays(camera, width, height);
-    push.directionPerPixelX = glm::vec4(rays.directionPerPixelX(), 0.0f);
-    push.directionPerPixelY = glm::vec4(rays.directionPerPixelY(), 0.0f);
+    push.directionPerPixelX = glm::vec4(footprintScale * rays.directionPerPixelX(), 0.0f);
+    push.directionPerPixelY = glm::vec4(footprintScale * rays.directionPerPixelY(), 0.0f);
     return push;
 }
 

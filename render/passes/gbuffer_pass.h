@@ -32,8 +32,12 @@ glm::mat4 clipFromWorldOf(const Camera& camera, uint32_t width, uint32_t height,
 
 /// Both raster stages' push constants for the camera's width × height view: clipFromWorldOf,
 /// the eye, and how its rays turn per pixel (CameraRays), from which the fragment shader
-/// measures texture footprints exactly as the CPU twin does.
-GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near);
+/// measures texture footprints exactly as the CPU twin does. For one subsample of a pixel,
+/// `offset` (in [0, 1)², core/camera.h subsampleOffset) moves the image so that each pixel
+/// centre sees CameraRays::direction(x + offset.x, y + offset.y), and `footprintScale`
+/// shrinks the texture footprint to the subsample's share of the pixel (1/√n of its sides).
+GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height, float near,
+                          glm::vec2 offset = glm::vec2(0.5f), float footprintScale = 1.0f);
 
 /// Rasterises the G-buffer of one camera view per frame; the targets are resized on demand.
 class GbufferPass {

@@ -25,12 +25,16 @@ struct CacheShadingPush {
     uint lightmapWidth;   // texels (0: no light map; every surface reads the grid)
     uint lightmapHeight;  // texels
     float epsilon;        // metres: the CPU twin's ray offset along the normal
-    uint pad0;
+    uint accumulate;      // 0: write the pixel's radiance, 1: add to it (subsamples)
     float glossyWeight;   // factor on the glossy lobe (0: diffuse only)
     uint firstPixel;      // pixel of invocation 0 (large images take several dispatches)
     vec4 glossyLobe[2];   // s_l(n) of band l at [l / 4][l % 4] (core/sh.h cosineLobeFactor)
+    float yScale;         // on the cache term's luma (core/light_set.h IndirectScale)
+    float cocgScale;      // on its chroma
+    uint pad1;
+    uint pad2;
 };
-PIC_STRUCT_CHECK(CacheShadingPush, 112);
+PIC_STRUCT_CHECK(CacheShadingPush, 128);
 PIC_OFFSET_CHECK(CacheShadingPush, component, 12);
 PIC_OFFSET_CHECK(CacheShadingPush, gridCellSize, 28);
 PIC_OFFSET_CHECK(CacheShadingPush, lightCount, 44);

@@ -262,6 +262,42 @@ TEST(StabilitySuite, MovingLightFlickersNoMoreThanIdealCaches) {
     EXPECT_LT(moving->linked.roughness, 1.3 * moving->ideal->roughness);
 }
 
+// A client that blends cache versions (core/cache_blend.h, paper 001 §3) draws the moving
+// light without jumps: without blending, one frame per version carries the whole change and
+// the others none; blending over an update interval spreads it over the interval's frames,
+// and longer blends also average the versions' noise, at the cost of lagging behind.
+TEST(StabilitySuite, BlendingClientsSpreadTheMovingLightsChanges) {
+    const test::BakedScene& b = small("furnished_room");
+    ASSERT_TRUE(b.ok);
+    const StabilitySettings settings = linkedOnly({32, 24});
+    auto moving = runMovingLight(b.scene, *b.rays, b.bake, b.scene.cameras[0], 10, 1, settings,
+                                 {0.0, 1.0, 4.0}, 4);
+    ASSERT_TRUE(moving) << moving.error().message;
+    ASSERT_EQ(moving->blended.size(), 3u);
+    const BlendedFlicker& none = moving->blended[0];
+    const BlendedFlicker& one = moving->blended[1];
+    const BlendedFlicker& four = moving->blended[2];
+    ASSERT_EQ(none.frames.mean.size(), 40u);
+    // Unblended, the client shows each version as it arrives: the same jumps as the versions.
+    EXPECT_NEAR(none.frames.peak, moving->linked.peak, 1e-9);
+    // 39 frame-to-frame changes of which 9 are the versions' and the rest none.
+    EXPECT_NEAR(none.frames.index * 39.0, moving->linked.index * 9.0,
+                1e-6 * moving->linked.index * 9.0);
+    EXPECT_EQ(none.lag, 0.0);
+    // Blending over one interval: the jumps are spread over the interval's four frames.
+    EXPECT_LT(one.frames.peak, 0.5 * none.frames.peak);
+    EXPECT_LT(one.frames.roughness, none.frames.roughness);
+    EXPECT_GT(one.lag, 0.0);
+    // Over four intervals: smoother still, and further behind.
+    EXPECT_LT(four.frames.peak, one.frames.peak);
+    EXPECT_LT(four.frames.index, one.frames.index);
+    EXPECT_GT(four.lag, one.lag);
+    for (const BlendedFlicker& b : moving->blended)
+        std::printf("[ measured ] blend %g intervals: flicker %.5f, roughness %.5f, largest "
+                    "change %.5f, lag %.5f\n",
+                    b.intervals, b.frames.index, b.frames.roughness, b.frames.peak, b.lag);
+}
+
 TEST(StabilitySuite, RandomLightSetsGiveNoNanInfOrNegativeLight) {
     // 99 seeded light sets, 11 per small scene; the full 1,000 are `picbench stability`'s.
     const std::vector<std::string> scenes{"cornell",    "cornell_area",    "closed_box",

@@ -92,6 +92,11 @@ public:
         std::lock_guard lock(mMutex);
         return mDecoder.frame();
     }
+    /// The light set of the newest frame that carried one.
+    std::optional<LightSet> lights() {
+        std::lock_guard lock(mMutex);
+        return mDecoder.lights() ? std::optional<LightSet>(*mDecoder.lights()) : std::nullopt;
+    }
     std::vector<std::string> errors() {
         std::lock_guard lock(mMutex);
         return mErrors;

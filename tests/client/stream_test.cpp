@@ -641,6 +641,47 @@ TEST(Stream, GpuBackendServesTheSameProtocol) {
     EXPECT_TRUE(reader.frame() == *served.server->session(session->session())->latestUpdate()->frame);
 }
 
+// Every frame names the light set its caches were computed for, so that every client shades
+// with the same direct light and indirect scales. A set that changes only the indirect scales
+// (applied where clients shade, core/light_set.h IndirectScale) reuses the caches: no pass
+// runs and the frame's planes are the previous version's.
+TEST(Stream, FramesCarryTheirLightSetAndScaleOnlyChangesReuseTheCaches) {
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    LightSet lights = pointLight(0.1f);
+    auto first = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(first);
+    ASSERT_TRUE(reader.waitFor(*first));
+    const auto relit = served.server->session(session->session())->latestUpdate();
+    ASSERT_EQ(relit->version, *first);
+    EXPECT_GT(relit->broadcast->bounces(), 0u);
+    ASSERT_TRUE(reader.lights());
+    EXPECT_EQ(reader.lights()->lights, lights.lights);
+    EXPECT_EQ(reader.lights()->indirectScale, IndirectScale{});
+
+    lights.indirectScale = {0.5f, 2.0f};
+    auto scaled = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(scaled);
+    ASSERT_TRUE(reader.waitFor(*scaled));
+    const auto reused = served.server->session(session->session())->latestUpdate();
+    ASSERT_EQ(reused->version, *scaled);
+    EXPECT_EQ(reused->broadcast->bounces(), 0u);
+    EXPECT_TRUE(*reused->frame == *relit->frame);
+    EXPECT_EQ(reader.lights()->indirectScale, (IndirectScale{0.5f, 2.0f}));
+    EXPECT_TRUE(reader.frame() == *relit->frame);
+
+    // A light that moves is relit again.
+    lights.lights[0].position.x += 0.1f;
+    auto moved = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(moved);
+    ASSERT_TRUE(reader.waitFor(*moved));
+    EXPECT_GT(served.server->session(session->session())->latestUpdate()->broadcast->bounces(), 0u);
+    EXPECT_TRUE(reader.errors().empty());
+}
+
 TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
@@ -752,9 +793,30 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
                                exit);
     EXPECT_EQ(exit, 0) << rendered;
     EXPECT_NE(rendered.find("light change to decoded frame"), std::string::npos) << rendered;
+    EXPECT_NE(rendered.find("4 samples per pixel"), std::string::npos) << rendered;
     auto read = readImage(image.string());
     ASSERT_TRUE(read) << rendered;
     EXPECT_EQ(read->width, 63);
+    // `picref shade` is the client's CPU counterpart: the same relight (one bounce, CPU), the
+    // same 4 subsamples per pixel by default, shaded from the caches without the stream's
+    // compression in between.
+    const fs::path shaded = dir / "shaded.exr";
+    std::string shade = run(std::string(PIC_PICREF) + " shade --quiet " + kScene + " --bake " +
+                                bakePath() + " --backend cpu --bounces 1 --lights " +
+                                lightsFile.string() +
+                                " --scene-camera 0 --size 63x56 --component indirect --out " +
+                                shaded.string() + " 2>&1",
+                            exit);
+    EXPECT_EQ(exit, 0) << shade;
+    auto cpu = readImage(shaded.string());
+    ASSERT_TRUE(cpu) << shade;
+    auto error = compareImages(*read, *cpu);
+    ASSERT_TRUE(error) << error.error().message;
+    std::printf("picclient render against picref shade, 4 subsamples: relative RMSE %.5f, "
+                "mean ratio %.5f\n",
+                error->relativeRmse, error->meanRatio);
+    EXPECT_LE(error->relativeRmse, 0.01);
+    EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
     std::string viewerPush = run(client + " render --server " + address + " --session " + session +
                                      " --token " + viewer + " --lights " + lightsFile.string() +
                                      " --scene-camera 0 --size 8x8 --cache-dir " + cacheDir.string() +

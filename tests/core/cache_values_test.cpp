@@ -352,5 +352,29 @@ TEST(CacheRadiance, IrradianceOfALobeMatchesQuadrature) {
     }
 }
 
+// Paper 001 §4: scaling the luma and chroma of every coefficient scales the reconstructed
+// light's Y and CoCg alike (YCoCg is linear), and chroma 0 leaves grey light of the same Y.
+TEST(ScaleLumaChroma, ScalesTheIrradiancesYAndCoCg) {
+    RadianceSh radiance;
+    radiance.bands = 3;
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 9; ++i) radiance.rgb[c][i] = 0.1f * float(c + 1) + 0.03f * float(i);
+    const glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.8f, -0.2f));
+    const glm::vec3 before = rgbToYCoCg(irradiance(radiance, n));
+    for (const auto& [y, cocg] : {std::pair{0.5f, 2.0f}, std::pair{1.0f, 0.0f}, std::pair{3.0f, 3.0f}}) {
+        RadianceSh scaled = radiance;
+        scaleLumaChroma(scaled, y, cocg);
+        const glm::vec3 after = rgbToYCoCg(irradiance(scaled, n));
+        EXPECT_NEAR(after.x, y * before.x, 1e-5f) << y << " " << cocg;
+        EXPECT_NEAR(after.y, cocg * before.y, 1e-5f) << y << " " << cocg;
+        EXPECT_NEAR(after.z, cocg * before.z, 1e-5f) << y << " " << cocg;
+    }
+    RadianceSh grey = radiance;
+    scaleLumaChroma(grey, 1.0f, 0.0f);
+    const glm::vec3 rgb = irradiance(grey, n);
+    EXPECT_NEAR(rgb.r, rgb.g, 1e-5f);
+    EXPECT_NEAR(rgb.g, rgb.b, 1e-5f);
+}
+
 }  // namespace
 }  // namespace pic

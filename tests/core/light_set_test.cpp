@@ -335,6 +335,33 @@ TEST(LightSetValidation, RejectsBadEmissiveScales) {
     expectError(R"({"emissiveScale":{"light":1e40}})", "emissiveScale[\"light\"] must be");
 }
 
+TEST(LightSetParse, ReadsIndirectScalesAndWritesThemBackOnlyWhenSet) {
+    auto scaled = parseLightSet(R"({"indirectScale":{"y":0.5,"cocg":2}})");
+    ASSERT_TRUE(scaled) << scaled.error().message;
+    EXPECT_EQ(scaled->indirectScale, (IndirectScale{0.5f, 2.0f}));
+    auto again = parseLightSet(toJson(*scaled));
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_EQ(again->indirectScale, scaled->indirectScale);
+    // Either key alone; the other stays 1.
+    auto lumaOnly = parseLightSet(R"({"indirectScale":{"y":0}})");
+    ASSERT_TRUE(lumaOnly);
+    EXPECT_EQ(lumaOnly->indirectScale, (IndirectScale{0.0f, 1.0f}));
+    // A set without scales writes none, so existing files read and write as before.
+    auto plain = parseLightSet(R"({"lights":[]})");
+    ASSERT_TRUE(plain);
+    EXPECT_EQ(plain->indirectScale, IndirectScale{});
+    EXPECT_EQ(toJson(*plain).find("indirectScale"), std::string::npos);
+}
+
+TEST(LightSetValidation, RejectsBadIndirectScales) {
+    expectError(R"({"indirectScale":2})", "indirectScale must be an object");
+    expectError(R"({"indirectScale":{"y":-0.5}})", "indirectScale.y must be in [0, 16], got -0.5");
+    expectError(R"({"indirectScale":{"cocg":17}})", "indirectScale.cocg must be in [0, 16], got 17");
+    expectError(R"({"indirectScale":{"y":"bright"}})", "indirectScale.y must be a number");
+    expectError(R"({"indirectScale":{"y":1e39}})", "indirectScale.y must be finite");
+    expectError(R"({"indirectScale":{"presence":1}})", "indirectScale has unknown key \"presence\"");
+}
+
 TEST(LightSetCheck, NamesUnknownMaterials) {
     Scene scene;
     scene.materials.resize(2);

@@ -164,9 +164,12 @@ TEST(Renderer, RefusesBadInputsAsInvalidInput) {
     ShadeParams huge = params;
     huge.width = 20000;
     expectInvalid(renderer.render(lights, camera, huge), "huge width");
-    ShadeParams subsamples = params;
-    subsamples.samplesPerPixel = 4;
-    expectInvalid(renderer.render(lights, camera, subsamples), "subsamples");
+    ShadeParams noSubsamples = params;
+    noSubsamples.samplesPerPixel = 0;
+    expectInvalid(renderer.render(lights, camera, noSubsamples), "0 subsamples");
+    ShadeParams tooManySubsamples = params;
+    tooManySubsamples.samplesPerPixel = kMaxSamplesPerPixel + 1;
+    expectInvalid(renderer.render(lights, camera, tooManySubsamples), "too many subsamples");
     ShadeParams negativeGloss = params;
     negativeGloss.glossyWeight = -1.0f;
     expectInvalid(renderer.render(lights, camera, negativeGloss), "negative glossy weight");
