@@ -4,6 +4,7 @@
 
 #include "bake/bake_options_cli.h"
 #include "bench/accuracy_benchmark.h"
+#include "bench/glossy_benchmark.h"
 #include "bench/bake_benchmark.h"
 #include "bench/bench_common.h"
 #include "bench/codec_benchmark.h"
@@ -126,6 +127,32 @@ int picbenchMain(int argc, char** argv) {
         ->expected(1, -1)
         ->check(CLI::Range(1u, 4096u));
     accuracyFlags.addTo(*accuracy);
+
+    CLI::App* glossy = app.add_subcommand(
+        "glossy", "the glossy lobe from SH caches against the same lobe path-traced, over the "
+                  "lobe's exponent and the SH bands (a table, JSON and a PNG chart)");
+    GlossyParams glossyParams;
+    BakeOptionFlags glossyFlags;
+    addSceneOption(*glossy, glossyParams.scenePath);
+    addLightsOption(*glossy, glossyParams.lightsPath);
+    ViewFlags glossyView;
+    glossyView.addTo(*glossy, {.size = "96x96", .sceneCamera = 0});
+    glossy->add_option("--spp", glossyParams.spp, "reference samples per pixel (default 1024)")
+        ->check(CLI::Range(2u, 1u << 20));
+    glossy->add_option("--probe-samples", glossyParams.probeSamples,
+                       "path-traced directions per ideal cache (default 2048)")
+        ->check(CLI::PositiveNumber);
+    glossy->add_option("--shade-spp", glossyParams.shadeSpp,
+                       "subsamples per pixel shading from the caches (default 4)")
+        ->check(CLI::Range(1u, 4096u));
+    glossy->add_option("--truncate-bands", glossyParams.bands, "lY of the truncated ideal caches (default 1-8)")
+        ->expected(1, -1);
+    glossy->add_option("--exponents", glossyParams.exponents,
+                       "Phong exponents (default 1 2 5 10 20 30)")
+        ->expected(1, -1);
+    glossy->add_option("--json", glossyParams.jsonPath, "JSON file; the PNG goes beside it (default out/glossy/glossy.json)");
+    glossy->add_option("--ref-seed", glossyParams.seed, "path tracer and probe seed (default 1)");
+    glossyFlags.addTo(*glossy);
 
     CLI::App* links = app.add_subcommand(
         "links", "decompose the linked caches' one-bounce error against path-traced radiance");
@@ -363,6 +390,13 @@ int picbenchMain(int argc, char** argv) {
         accuracyParams.view = *view;
         accuracyParams.bake = accuracyFlags.toOptions();
         return runAccuracyBenchmark(accuracyParams);
+    }
+    if (glossy->parsed()) {
+        auto view = glossyView.toView();
+        if (!view) return reportError(view.error());
+        glossyParams.view = *view;
+        glossyParams.bake = glossyFlags.toOptions();
+        return runGlossyBenchmark(glossyParams);
     }
     if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
     if (shadows->parsed()) return runShadowBenchmark(shadowParams);

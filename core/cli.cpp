@@ -132,8 +132,10 @@ Result<void> ImageOutputFlags::write(const Image& image) const {
 }
 
 void ShadeFlags::addTo(CLI::App& command) {
-    command.add_option("--component", mComponent, "what the image holds (default full)")
-        ->check(CLI::IsMember({"full", "direct", "indirect"}));
+    command.add_option("--component", mComponent,
+                       "what the image holds: full (default), direct, indirect, or glossy (the "
+                       "--glossy lobe's part of the indirect light alone)")
+        ->check(CLI::IsMember({"full", "direct", "indirect", "glossy"}));
     auto* glossy = command.add_option("--glossy", mGlossyExponent,
                                       "Phong exponent of an added glossy lobe (> 0)")
                        ->check(CLI::PositiveNumber);
@@ -150,6 +152,7 @@ ShadeParams ShadeFlags::toParams(glm::uvec2 size, uint32_t samplesPerPixel) cons
     params.height = size.y;
     params.component = mComponent == "direct"     ? ShadeComponent::Direct
                        : mComponent == "indirect" ? ShadeComponent::Indirect
+                       : mComponent == "glossy"   ? ShadeComponent::Glossy
                                                   : ShadeComponent::Full;
     params.glossyExponent = mGlossyExponent;
     params.glossyWeight = mGlossyWeight;

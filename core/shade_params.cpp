@@ -20,6 +20,11 @@ Result<void> checkShadeParams(const ShadeParams& params) {
     if (!(std::isfinite(params.glossyWeight) && params.glossyWeight >= 0.0f))
         return fail(ErrorCode::InvalidInput, "glossy weight {} is not a finite number ≥ 0",
                     params.glossyWeight);
+    if (params.component == ShadeComponent::Glossy &&
+        !(params.glossyExponent > 0.0f && params.glossyWeight > 0.0f))
+        return fail(ErrorCode::InvalidInput,
+                    "the glossy component needs a lobe: exponent {} and weight {} must be > 0",
+                    params.glossyExponent, params.glossyWeight);
     return {};
 }
 

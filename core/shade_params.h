@@ -14,6 +14,7 @@ enum class ShadeComponent {
     Full,      ///< directly visible emission + direct + indirect
     Direct,    ///< punctual lights reflected once, with exact visibility
     Indirect,  ///< the cache term (it holds the emitters' light too, paper 000 §4.4)
+    Glossy,    ///< the glossy lobe's part of the cache term alone (needs a lobe)
 };
 
 /// What to shade and how.
@@ -30,7 +31,8 @@ struct ShadeParams {
 inline constexpr uint32_t kMaxSamplesPerPixel = 4096;
 
 /// `params` in range: sides 1..kMaxImageSide (core/image.h), 1..kMaxSamplesPerPixel
-/// subsamples, glossy exponent and weight finite and ≥ 0. InvalidInput naming the value.
+/// subsamples, glossy exponent and weight finite and ≥ 0, both > 0 for the Glossy component.
+/// InvalidInput naming the value.
 Result<void> checkShadeParams(const ShadeParams& params);
 
 }  // namespace pic

@@ -165,7 +165,8 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
     PIC_TRY(checkRuntimeLights(lights, mScene));
 
     // Direct light needs the lights' shadow maps; the cache term alone needs none.
-    const bool direct = params.component != ShadeComponent::Indirect;
+    const bool direct =
+        params.component == ShadeComponent::Full || params.component == ShadeComponent::Direct;
     bool reallocated = false;
     if (direct) PIC_TRY(mShadows->prepare(lights, reallocated));
     bool resized = false;
@@ -189,9 +190,10 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
 
     gpu::CacheShadingPush push{};
     push.eye = camera.eye;
-    push.component = params.component == ShadeComponent::Full     ? gpu::kShadeFull
-                     : params.component == ShadeComponent::Direct ? gpu::kShadeDirect
-                                                                  : gpu::kShadeIndirect;
+    push.component = params.component == ShadeComponent::Full       ? gpu::kShadeFull
+                     : params.component == ShadeComponent::Direct   ? gpu::kShadeDirect
+                     : params.component == ShadeComponent::Indirect ? gpu::kShadeIndirect
+                                                                    : gpu::kShadeGlossy;
     push.gridOrigin = mLayout.gridOrigin;
     push.gridCellSize = mLayout.gridCellSize;
     push.gridDims = mLayout.gridDims;

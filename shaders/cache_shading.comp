@@ -153,7 +153,7 @@ void main() {
 
     if (pc.component == kShadeFull) result += texelFetch(gbufferEmission, xy, 0).rgb;
 
-    if (pc.component != kShadeIndirect) {
+    if (pc.component == kShadeFull || pc.component == kShadeDirect) {
         vec3 irradiance = vec3(0.0);
         for (uint k = 0u; k < pc.lightCount; ++k) {
             const GpuLight light = lights[k];
@@ -220,7 +220,8 @@ void main() {
         }
         // The light set's artistic scales (paper 001 §4) on the reconstructed luma and chroma.
         const vec3 scale = vec3(pc.yScale, pc.cocgScale, pc.cocgScale);
-        result += albedo * (1.0 / kPi) * max(yCoCgToRgb(scale * e), vec3(0.0));
+        if (pc.component != kShadeGlossy)
+            result += albedo * (1.0 / kPi) * max(yCoCgToRgb(scale * e), vec3(0.0));
 
         if (pc.glossyWeight > 0.0) {
             // The normalised cosine lobe about the mirror direction of the view ray averages

@@ -54,11 +54,26 @@ glm::vec3 sampleCosineHemisphere(const glm::vec3& n, float u1, float u2) {
     return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * n);
 }
 
+bool hasLobe(const PathTraceParams& params) {
+    return params.glossyExponent > 0.0f && params.glossyWeight > 0.0f;
+}
+
 float maxComponent(const glm::vec3& v) {
     return std::max(v.x, std::max(v.y, v.z));
 }
 
 }  // namespace
+
+glm::vec3 samplePhongLobe(const glm::vec3& axis, float exponent, float u1, float u2) {
+    // The lobe's density over cos α = c is (n+1)·c^n on [0, 1] (the azimuth uniform), whose
+    // inverse CDF is c = u^(1/(n+1)).
+    const float c = std::pow(u1, 1.0f / (exponent + 1.0f));
+    const float r = std::sqrt(std::max(0.0f, 1.0f - c * c));
+    const float phi = 2.0f * kPi * u2;
+    glm::vec3 t, b;
+    orthonormalBasis(axis, t, b);
+    return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + c * axis);
+}
 
 bool isValidRadiance(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && v.x >= 0.0f &&
@@ -327,6 +342,24 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
     return radiance;
 }
 
+glm::vec3 PathTracer::traceGlossy(const glm::vec3& origin, const glm::vec3& direction,
+                                  float exponent, int maxReflections, Rng& rng) const {
+    const std::optional<RayHit> hit =
+        mRays->intersect(origin, direction, 0.0f, std::numeric_limits<float>::infinity());
+    if (!hit) return glm::vec3(0.0f);
+    // The side the camera sees reflects, as in the client (render/cpu/cache_shading.h).
+    const glm::vec3 normal = hit->backFace ? -hit->geometricNormal : hit->geometricNormal;
+    const glm::vec3 position = origin + hit->t * direction;
+    const glm::vec3 mirror = glm::reflect(direction, normal);
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const glm::vec3 incoming = samplePhongLobe(mirror, exponent, u1, u2);
+    // The surface itself blocks the directions below it.
+    if (glm::dot(incoming, normal) <= 0.0f) return glm::vec3(0.0f);
+    const int further = maxReflections < 0 ? -1 : maxReflections - 1;
+    return traceRadiance(position + mRays->epsilon() * normal, incoming, further,
+                         PathTraceParams::Component::Full, rng);
+}
+
 Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
                         const Camera& camera, const PathTraceParams& params,
                         PathTraceStats* stats) {
@@ -338,6 +371,17 @@ Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const Light
     if (params.bounces < -1)
         return fail(ErrorCode::InvalidInput, "bounces must be -1 (unlimited) or >= 0, got {}",
                     params.bounces);
+    if (!(params.glossyExponent >= 0.0f && std::isfinite(params.glossyExponent) &&
+          params.glossyWeight >= 0.0f && std::isfinite(params.glossyWeight)))
+        return fail(ErrorCode::InvalidInput,
+                    "glossy exponent {} and weight {} must be finite and ≥ 0",
+                    params.glossyExponent, params.glossyWeight);
+    using Component = PathTraceParams::Component;
+    if (params.component == Component::Glossy && !hasLobe(params))
+        return fail(ErrorCode::InvalidInput,
+                    "the glossy component needs a lobe: exponent and weight > 0, got {} and {}",
+                    params.glossyExponent, params.glossyWeight);
+    const bool lobe = hasLobe(params) && params.component != Component::Direct;
 
     auto start = std::chrono::steady_clock::now();
     PathTracer tracer(scene, rays, lights);
@@ -360,8 +404,15 @@ Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const Light
                     Rng rng(params.seed, pixel * params.spp + s);
                     float jx = rng.uniform(), jy = rng.uniform();
                     glm::vec3 direction = cameraRays.direction(float(x) + jx, float(y) + jy);
-                    glm::vec3 radiance = tracer.traceRadiance(
-                        cameraRays.origin(), direction, maxReflections, params.component, rng);
+                    glm::vec3 radiance =
+                        params.component == Component::Glossy
+                            ? glm::vec3(0.0f)
+                            : tracer.traceRadiance(cameraRays.origin(), direction,
+                                                   maxReflections, params.component, rng);
+                    if (lobe)
+                        radiance += params.glossyWeight *
+                                    tracer.traceGlossy(cameraRays.origin(), direction,
+                                                       params.glossyExponent, maxReflections, rng);
                     if (!isValidRadiance(radiance)) {
                         ++rejected;
                         continue;

@@ -30,8 +30,8 @@ struct PathTraceParams {
     /// Direct = exactly one reflection, Indirect = k ≥ 2 reflections, Cached = k ≥ 1
     /// reflections less the punctual lights' single reflection: what pic's caches carry (the
     /// indirect light and the emitting surfaces' first reflection, paper 000 §4.4), equal to
-    /// Indirect where no surface emits.
-    enum class Component { Full, Direct, Indirect, Cached };
+    /// Indirect where no surface emits. Glossy = the glossy lobe's term alone.
+    enum class Component { Full, Direct, Indirect, Cached, Glossy };
 
     uint32_t width = 0;
     uint32_t height = 0;
@@ -39,7 +39,19 @@ struct PathTraceParams {
     int bounces = -1;  ///< B ≥ 0 keeps paths of at most B + 1 reflections; −1: unlimited
     Component component = Component::Full;
     uint64_t seed = 1;
+    /// A Phong lobe at the camera-visible surface, as the thin client adds it
+    /// (core/shade_params.h): glossyWeight · ∫ L(ω) (n+1)/(2π) max(0, r·ω)^n dω over the
+    /// directions above the surface, r the view ray's mirror direction about the normal facing
+    /// the camera and L the radiance arriving from the scene's surfaces (a punctual light,
+    /// being a point, is never inside a lobe). Added to Full, Indirect and Cached, where the
+    /// client adds it to the cache term; Glossy is this term alone. Both 0: no lobe.
+    float glossyExponent = 0.0f;
+    float glossyWeight = 0.0f;
 };
+
+/// A direction drawn from the normalised Phong lobe (n+1)/(2π) max(0, axis·ω)^n about unit
+/// `axis` with `exponent` n ≥ 0, from two uniform numbers in [0, 1): its density is the lobe.
+glm::vec3 samplePhongLobe(const glm::vec3& axis, float exponent, float u1, float u2);
 
 /// What a run of the path tracer did.
 struct PathTraceStats {
@@ -72,6 +84,14 @@ public:
     /// callers on a surface offset it. Never NaN, infinite or negative unless the scene is.
     glm::vec3 traceRadiance(const glm::vec3& origin, const glm::vec3& direction, int maxReflections,
                             PathTraceParams::Component component, Rng& rng) const;
+
+    /// One-sample estimate of the glossy lobe's term (PathTraceParams::glossyExponent, weight 1)
+    /// at the surface the ray from `origin` along unit `direction` meets: one direction drawn
+    /// from the lobe, the radiance arriving along it by paths of at most `maxReflections` − 1
+    /// further reflections (−1: unlimited). 0 where the ray misses or the direction is below
+    /// the surface.
+    glm::vec3 traceGlossy(const glm::vec3& origin, const glm::vec3& direction, float exponent,
+                          int maxReflections, Rng& rng) const;
 
     /// Number of triangles that emit (with a non-zero emissive scale).
     size_t emitterCount() const { return mEmitters.size(); }
@@ -137,7 +157,8 @@ bool isValidRadiance(const glm::vec3& radiance);
 
 /// Path-traces an image of `camera` with one independent random stream per pixel sample, so
 /// the image depends on the seed only, not on the thread count. InvalidInput for zero sizes or
-/// spp, bounces < −1. Progress per row on stderr; `stats` (if given) receives the counts.
+/// spp, bounces < −1, a negative or non-finite glossy exponent or weight, or the Glossy
+/// component without a lobe. Progress per row on stderr; `stats` (if given) receives the counts.
 Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
                         const Camera& camera, const PathTraceParams& params,
                         PathTraceStats* stats = nullptr);

@@ -61,6 +61,8 @@ struct RenderArgs {
     uint32_t spp = 0;
     int bounces = -1;
     std::string component = "full";
+    float glossyExponent = 0.0f;
+    float glossyWeight = 0.0f;
     std::string lightsPath;
     uint64_t seed = 1;
     ImageOutputFlags output;
@@ -69,6 +71,9 @@ struct RenderArgs {
 int runRender(const RenderArgs& args) {
     if (args.spp == 0)
         return reportError({ErrorCode::InvalidInput, "--spp must be at least 1, got 0"});
+    if (args.component == "glossy" && args.glossyExponent <= 0.0f)
+        return reportError({ErrorCode::InvalidInput,
+                            "--component glossy needs the lobe: --glossy N --glossy-weight W"});
     if (args.bounces < -1)
         return reportError(
             {ErrorCode::InvalidInput,
@@ -92,8 +97,11 @@ int runRender(const RenderArgs& args) {
     params.component = args.component == "direct"     ? PathTraceParams::Component::Direct
                        : args.component == "indirect" ? PathTraceParams::Component::Indirect
                        : args.component == "cached"   ? PathTraceParams::Component::Cached
+                       : args.component == "glossy"   ? PathTraceParams::Component::Glossy
                                                       : PathTraceParams::Component::Full;
     params.seed = args.seed;
+    params.glossyExponent = args.glossyExponent;
+    params.glossyWeight = args.glossyWeight;
     PathTraceStats stats;
     auto image = pathTrace(*scene, **rays, *lights, *camera, params, &stats);
     if (!image) return reportError(image.error());
@@ -228,14 +236,25 @@ int picrefMain(int argc, char** argv) {
         app.add_option("--bounces", render.bounces,
                        "indirect bounces B: 0 = direct light only, -1 = unlimited (default)"),
         app.add_option("--component", render.component,
-                       "full (default), direct, indirect, or cached (what pic's caches carry: the "
-                       "indirect light and the emitting surfaces' first reflection)")
-            ->check(CLI::IsMember({"full", "direct", "indirect", "cached"})),
+                       "full (default), direct, indirect, cached (what pic's caches carry: the "
+                       "indirect light and the emitting surfaces' first reflection), or glossy "
+                       "(the --glossy lobe's term alone)")
+            ->check(CLI::IsMember({"full", "direct", "indirect", "cached", "glossy"})),
+        app.add_option("--glossy", render.glossyExponent,
+                       "Phong exponent of a glossy lobe at the visible surface, as picclient "
+                       "render --glossy adds it (> 0)")
+            ->check(CLI::PositiveNumber),
+        app.add_option("--glossy-weight", render.glossyWeight,
+                       "factor on the glossy lobe's radiance (≥ 0)")
+            ->check(CLI::NonNegativeNumber),
         addLightsOption(app, render.lightsPath),
         app.add_option("--seed", render.seed, "random seed (default 1)"),
         app.get_option("--exposure"),
         app.get_option("--out"),
     };
+
+    app.get_option("--glossy")->needs(app.get_option("--glossy-weight"));
+    app.get_option("--glossy-weight")->needs(app.get_option("--glossy"));
 
     CLI::App* probesCommand =
         app.add_subcommand("probes", "path-traced incident radiance SH at every cache of a bake");

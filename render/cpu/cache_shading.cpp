@@ -108,7 +108,7 @@ glm::vec3 shadeRay(const ShadingContext& context, const glm::vec3& origin,
                     context.scene.emissionAt(hit->triangle, hit->b1, hit->b2);
     }
 
-    if (params.component != ShadeComponent::Indirect) {
+    if (params.component == ShadeComponent::Full || params.component == ShadeComponent::Direct) {
         const float epsilon = context.rays.epsilon();
         // Shadow rays start just above the surface so that they do not hit its own triangle.
         const glm::vec3 shadowOrigin = position + epsilon * normal;
@@ -132,8 +132,10 @@ glm::vec3 shadeRay(const ShadingContext& context, const glm::vec3& origin,
         if (scale != IndirectScale{}) scaleLumaChroma(incident, scale.y, scale.cocg);
         // A truncated SH expansion rings: on the dark side of a bright cache its clamped-cosine
         // convolution can dip below zero. Irradiance never does, so each channel is cut at 0.
-        const glm::vec3 e = glm::max(irradiance(incident, normal), glm::vec3(0.0f));
-        radiance += albedo * kInvPi * e;
+        if (params.component != ShadeComponent::Glossy) {
+            const glm::vec3 e = glm::max(irradiance(incident, normal), glm::vec3(0.0f));
+            radiance += albedo * kInvPi * e;
+        }
         if (params.glossyExponent > 0.0f && params.glossyWeight > 0.0f) {
             // The lobe is centred on the mirror direction of the view ray; its average incident
             // radiance is clamped like the irradiance, for the same ringing.

@@ -12,10 +12,11 @@ PIC_CONST(uint, kCacheShadingGroup, 64u);
 PIC_CONST(uint, kShadeFull, 0u);      // emission + direct + indirect
 PIC_CONST(uint, kShadeDirect, 1u);    // punctual lights, shadow-mapped
 PIC_CONST(uint, kShadeIndirect, 2u);  // the cache term
+PIC_CONST(uint, kShadeGlossy, 3u);    // the cache term's glossy lobe alone
 
 struct CacheShadingPush {
     vec3 eye;             // metres: the camera (the glossy lobe's view direction)
-    uint component;       // kShadeFull, kShadeDirect, kShadeIndirect
+    uint component;       // kShadeFull, kShadeDirect, kShadeIndirect, kShadeGlossy
     vec3 gridOrigin;      // metres, grid vertex (0, 0, 0)
     float gridCellSize;   // metres; 0: no grid (the grid term is zero)
     uvec3 gridDims;       // grid vertices per axis

@@ -54,6 +54,13 @@ TEST(ShadeParams, EachOutOfRangeFieldIsRefusedByName) {
     cases.push_back({with([](ShadeParams& p) { p.glossyExponent = -1.0f; }), "glossy exponent -1"});
     cases.push_back({with([&](ShadeParams& p) { p.glossyWeight = inf; }), "glossy weight inf"});
     cases.push_back({with([](ShadeParams& p) { p.glossyWeight = -0.5f; }), "glossy weight -0.5"});
+    cases.push_back({with([](ShadeParams& p) { p.component = ShadeComponent::Glossy; }),
+                     "the glossy component needs a lobe"});
+    cases.push_back({with([](ShadeParams& p) {
+                         p.component = ShadeComponent::Glossy;
+                         p.glossyExponent = 10.0f;
+                     }),
+                     "weight 0 must be > 0"});
     for (const Case& c : cases) {
         const std::string message = refusal(c.params);
         EXPECT_NE(message.find(c.names), std::string::npos) << message << " / " << c.names;

@@ -241,6 +241,58 @@ TEST_F(PathTracerTest, CachedLeavesOutThePunctualLightsReflectedOnce) {
     EXPECT_GT(sum, 0.0);
 }
 
+// The normalised Phong lobe's sampler: E[cos α] = ∫ cos α · (n+1)/(2π) cos^n α dω =
+// (n+1)/(n+2), E[cos² α] = (n+1)/(n+3), and no direction leaves the lobe's hemisphere.
+TEST(PhongLobe, SamplesHaveTheLobesMoments) {
+    const glm::vec3 axis = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+    for (const float n : {1.0f, 10.0f, 30.0f}) {
+        Rng rng(3, uint64_t(n));
+        constexpr int kSamples = 200000;
+        double first = 0.0, second = 0.0;
+        for (int i = 0; i < kSamples; ++i) {
+            const float u1 = rng.uniform(), u2 = rng.uniform();
+            const glm::vec3 w = samplePhongLobe(axis, n, u1, u2);
+            ASSERT_NEAR(glm::length(w), 1.0f, 1e-5f);
+            const double c = glm::dot(w, axis);
+            ASSERT_GE(c, -1e-6);
+            first += c;
+            second += c * c;
+        }
+        EXPECT_NEAR(first / kSamples, (n + 1.0) / (n + 2.0), 2e-3) << n;
+        EXPECT_NEAR(second / kSamples, (n + 1.0) / (n + 3.0), 3e-3) << n;
+    }
+}
+
+TEST_F(PathTracerTest, GlossyLobeInTheFurnaceIsItsWeightTimesTheRadiance) {
+    // Every direction above a furnace wall brings L_e/(1 − ρ). Seen nearly head-on (a narrow
+    // view at the far wall), the whole lobe of exponent 20 lies above the surface (its part
+    // more than 76° from the mirror direction is below 10⁻¹²), so the lobe's term is
+    // w·L_e/(1 − ρ). Full adds it to what the camera sees without a lobe.
+    Scene scene = furnaceScene();
+    Camera camera;
+    camera.eye = {0.0f, 0.0f, 0.9f};
+    camera.target = {0.0f, 0.0f, -1.0f};
+    camera.fovyDegrees = 20.0f;
+    PathTraceParams glossy = params(24, 32, Component::Glossy);
+    glossy.glossyExponent = 20.0f;
+    glossy.glossyWeight = 0.5f;
+    Image lobe = render(scene, LightSet{}, camera, glossy);
+    expectConverged(pixelStatistics(lobe), 0.5 * furnaceRadianceTotal(), 0.005, "glossy");
+    PathTraceParams full = glossy;
+    full.component = Component::Full;
+    Image both = render(scene, LightSet{}, camera, full);
+    expectConverged(pixelStatistics(both), 1.5 * furnaceRadianceTotal(), 0.005, "full + glossy");
+    // The glossy component needs a lobe.
+    auto rays = EmbreeScene::create(scene);
+    ASSERT_TRUE(rays);
+    PathTraceParams noLobe = glossy;
+    noLobe.glossyWeight = 0.0f;
+    auto refused = pathTrace(scene, **rays, LightSet{}, camera, noLobe);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(refused.error().message.find("needs a lobe"), std::string::npos);
+}
+
 TEST_F(PathTracerTest, BounceLimitKeepsPathsOfAtMostBPlusOneReflections) {
     // --bounces B: the camera-visible surface's reflection plus up to B more.
     Scene scene = furnaceScene();

@@ -93,10 +93,20 @@ TEST_F(PicrefCli, BadCameraIsBadUsageNamingTheValue) {
 
 TEST_F(PicrefCli, UnknownComponentIsBadUsageNamingTheValue) {
     test::CommandResult r =
-        run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 --component glossy --out " +
+        run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 --component specular --out " +
             (mDir / "x.exr").string());
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_NE(r.err.find("glossy"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("specular"), std::string::npos) << r.err;
+    // The glossy component is the lobe's term: without a lobe there is nothing to trace.
+    test::CommandResult noLobe =
+        run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 --component glossy --out " +
+            (mDir / "x.exr").string());
+    EXPECT_EQ(noLobe.exitCode, 2);
+    EXPECT_NE(noLobe.err.find("--glossy N --glossy-weight W"), std::string::npos) << noLobe.err;
+    test::CommandResult lobe =
+        run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 2 --component glossy "
+            "--glossy 10 --glossy-weight 0.5 --out " + (mDir / "g.exr").string());
+    EXPECT_EQ(lobe.exitCode, 0) << lobe.err;
 }
 
 TEST_F(PicrefCli, ProbesWriteEveryCacheWithTheBakesBands) {

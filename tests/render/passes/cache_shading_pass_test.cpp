@@ -111,6 +111,23 @@ TEST(RendererIndirect, GlossyLobeMatchesTheCpuShading) {
     test::report("indirect + glossy (cornell 96x96)", c);
     EXPECT_LE(c.error.relativeRmse, 0.01);
     test::expectFiniteNonNegative(c.gpu, "glossy");
+
+    // The lobe's part alone: the same in both twins, and what the lobe adds to the indirect.
+    params.component = ShadeComponent::Glossy;
+    const test::Comparison lobe = test::compare(*renderer, b.scene, *b.rays, b.bake, b.values,
+                                                defaultLightSet(b.scene), b.scene.cameras.at(0),
+                                                params);
+    test::report("glossy lobe alone (cornell 96x96)", lobe);
+    EXPECT_LE(lobe.error.relativeRmse, 0.01);
+    params.component = ShadeComponent::Indirect;
+    params.glossyExponent = 0.0f;
+    auto diffuse = renderer->render(defaultLightSet(b.scene), b.scene.cameras.at(0), params);
+    ASSERT_TRUE(diffuse) << diffuse.error().message;
+    for (size_t i = 0; i < c.gpu.pixels.size(); ++i)
+        for (int ch = 0; ch < 3; ++ch)
+            ASSERT_NEAR(c.gpu.pixels[i][ch], diffuse->pixels[i][ch] + lobe.gpu.pixels[i][ch],
+                        1e-5f * (1.0f + c.gpu.pixels[i][ch]))
+                << "pixel " << i;
 }
 
 // The light set's indirect scales (paper 001 §4) act where the cache term is reconstructed,
