@@ -528,14 +528,22 @@ CacheIndexMaps ClientScene::indexMaps() const {
         gridCaches, header.lightmap_width(), header.lightmap_height(), lightmapCaches};
 }
 
-Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame) {
+Result<CacheValues> cacheValuesOf(const ClientScene& scene, const HalfFrame& frame) {
     const v1::SceneHeader& header = scene.header;
-    PIC_TRY_ASSIGN(CacheValues values,
-                   cacheValuesOf(frame, header.caches(), header.bands_y(), header.bands_c()));
+    return cacheValuesOf(frame, header.caches(), header.bands_y(), header.bands_c());
+}
+
+CacheTextures cacheTexturesOf(const ClientScene& scene, const CacheValues& values) {
     const CacheIndexMaps maps = scene.indexMaps();
-    CacheTextures textures = makeCacheTextures(maps, header.bands_y(), header.bands_c());
+    CacheTextures textures =
+        makeCacheTextures(maps, scene.header.bands_y(), scene.header.bands_c());
     copyCachesToTextures(maps, values, textures);
     return textures;
+}
+
+Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame) {
+    PIC_TRY_ASSIGN(CacheValues values, cacheValuesOf(scene, frame));
+    return cacheTexturesOf(scene, values);
 }
 
 ClientLayout clientLayoutOf(const ClientScene& scene) {

@@ -181,6 +181,12 @@ private:
 /// scene's caches and band counts.
 Result<CacheTextures> cacheTexturesOf(const ClientScene& scene, const HalfFrame& frame);
 
+/// The caches a frame holds, widened to floats (InvalidInput as cacheTexturesOf).
+Result<CacheValues> cacheValuesOf(const ClientScene& scene, const HalfFrame& frame);
+
+/// The textures of `values` for `scene` (the same layout as cacheTexturesOf's).
+CacheTextures cacheTexturesOf(const ClientScene& scene, const CacheValues& values);
+
 /// The renderer's layout (render/renderer.h) of a downloaded scene.
 ClientLayout clientLayoutOf(const ClientScene& scene);
 

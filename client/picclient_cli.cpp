@@ -3,11 +3,14 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <google/protobuf/util/json_util.h>
@@ -15,6 +18,7 @@
 
 #include "client/connection.h"
 #include "client/load_test.h"
+#include "core/cache_blend.h"
 #include "core/cli.h"
 #include "proto/wire.h"
 #include "render/renderer.h"
@@ -350,6 +354,149 @@ int runRender(const Common& common, const RenderCommand& command) {
     return 0;
 }
 
+struct RecordCommand {
+    ViewFlags view;
+    ShadeFlags shade;
+    std::string device;
+    uint32_t shadowMapSize = 1024;
+    uint32_t samples = 1;
+    std::string cacheDir;
+    double fps = 10.0;
+    double durationSeconds = 10.0;
+    double blendSeconds = 0.5;
+    std::string outDir;
+    std::string format = "png";
+    float exposure = 1.0f;
+};
+
+/// A version the stream delivered: its caches and light set, and when it arrived.
+struct Arrival {
+    CacheValues values;
+    LightSet lights;
+    Clock::time_point at;
+};
+
+int runRecord(const Common& common, const RecordCommand& command) {
+    auto view = command.view.toView();
+    if (!view) return reportError(view.error());
+    if (auto ok = CacheBlend::check(command.blendSeconds); !ok) return reportError(ok.error());
+    std::error_code ec;
+    std::filesystem::create_directories(command.outDir, ec);
+    if (ec)
+        return reportError(Error{ErrorCode::Io, fmt::format("cannot create {}: {}",
+                                                            command.outDir, ec.message())});
+    PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
+    auto joined = connection->joinSession(common.session, common.token);
+    if (!joined) return reportError(joined.error());
+    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir);
+    if (!client) return reportError(client.error());
+    auto camera = view->cameraIn(client->scene);
+    if (!camera) return reportError(camera.error());
+    gpu::ContextOptions contextOptions;
+    contextOptions.deviceName = command.device;
+    auto context = gpu::Context::create(contextOptions);
+    if (!context) return reportError(context.error());
+    RendererOptions rendererOptions;
+    rendererOptions.shadowMapSize = command.shadowMapSize;
+    auto renderer =
+        Renderer::create(**context, client->scene, clientLayoutOf(*client), rendererOptions);
+    if (!renderer) return reportError(renderer.error());
+
+    // The stream is read on its own thread (next() blocks); the frames are drawn here at their
+    // times, each from the caches blended up to that moment.
+    auto stream = connection->subscribe(common.session, common.token, patienceOf(common));
+    std::mutex mutex;
+    std::vector<Arrival> arrived;
+    std::optional<Error> streamError;
+    std::thread reader([&] {
+        FrameDecoder decoder(client->header);
+        v1::Frame frame;
+        while (stream->next(frame)) {
+            const Result<void> applied = decoder.apply(frame);
+            Result<CacheValues> values = applied ? cacheValuesOf(*client, decoder.frame())
+                                                 : Result<CacheValues>(std::unexpected(applied.error()));
+            std::lock_guard lock(mutex);
+            if (!values) {
+                streamError = values.error();
+                return;
+            }
+            arrived.push_back({std::move(*values),
+                               decoder.lights() ? *decoder.lights() : LightSet{}, Clock::now()});
+        }
+    });
+    const auto stop = [&] {
+        stream->cancel();
+        reader.join();
+    };
+
+    CacheBlend blend(command.blendSeconds);
+    std::optional<LightSet> lights;
+    const ShadeParams params = command.shade.toParams(view->size, command.samples);
+    const auto start = Clock::now();
+    const auto seconds = [&](Clock::time_point t) {
+        return std::chrono::duration<double>(t - start).count();
+    };
+    const auto period = std::chrono::duration<double>(1.0 / command.fps);
+    uint32_t frames = 0, versions = 0;
+    double renderMs = 0.0;
+    for (auto due = start; seconds(due) < command.durationSeconds;
+         due += std::chrono::duration_cast<Clock::duration>(period)) {
+        std::this_thread::sleep_until(due);
+        {
+            std::lock_guard lock(mutex);
+            if (streamError) break;
+            for (Arrival& a : arrived) {
+                if (auto pushed = blend.push(std::move(a.values), seconds(a.at)); !pushed) {
+                    stop();
+                    return reportError(pushed.error());
+                }
+                // The direct light follows the newest light set at once; the caches blend.
+                if (!a.lights.lights.empty() || !lights) lights = std::move(a.lights);
+                ++versions;
+            }
+            arrived.clear();
+        }
+        const double now = std::max(seconds(Clock::now()), seconds(due));
+        const CacheValues* shown = blend.at(now);
+        if (!shown) continue;  // nothing received yet
+        if (auto set = (*renderer)->setCaches(cacheTexturesOf(*client, *shown)); !set) {
+            stop();
+            return reportError(set.error());
+        }
+        RenderTimings timings;
+        auto image = (*renderer)->render(*lights, *camera, params, &timings);
+        if (!image) {
+            stop();
+            return reportError(image.error());
+        }
+        renderMs += timings.totalMs;
+        const std::string path = (std::filesystem::path(command.outDir) /
+                                  fmt::format("frame_{:05}.{}", frames, command.format))
+                                     .string();
+        if (auto written = writeImage(path, *image, command.exposure); !written) {
+            stop();
+            return reportError(written.error());
+        }
+        ++frames;
+        // A frame that took longer than the period leaves the skipped slots out.
+        while (Clock::now() - due > period) due += std::chrono::duration_cast<Clock::duration>(period);
+    }
+    stop();
+    if (streamError) return reportError(*streamError);
+    const double elapsed = seconds(Clock::now());
+    std::fprintf(stderr,
+                 "picclient record: %u frames in %.1f s (%.1f per second, %.1f ms to render "
+                 "each), %u versions blended over %.2f s -> %s\n",
+                 frames, elapsed, double(frames) / elapsed, frames ? renderMs / frames : 0.0,
+                 versions, command.blendSeconds, command.outDir.c_str());
+    std::printf("%s\n", command.outDir.c_str());
+    if (frames == 0)
+        return reportError(Error{ErrorCode::Internal, fmt::format("no version arrived within {} s: "
+                                                                  "nothing was recorded",
+                                                                  command.durationSeconds)});
+    return 0;
+}
+
 }  // namespace
 
 int picclientMain(int argc, char** argv) {
@@ -431,7 +578,42 @@ int picclientMain(int argc, char** argv) {
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);
 
+    RecordCommand record;
+    record.cacheDir = defaultCacheDir();
+    CLI::App* recordCommand = app.add_subcommand(
+        "record", "render the session's stream as a sequence of frames at a fixed rate, each "
+                  "from the caches blended over time from one version to the next");
+    addServer(*recordCommand, common);
+    addSession(*recordCommand, common);
+    record.view.addTo(*recordCommand);
+    record.shade.addTo(*recordCommand);
+    addDeviceOption(*recordCommand, record.device);
+    recordCommand->add_option("--shadow-map-size", record.shadowMapSize,
+                              "texels per side of each shadow-map layer")
+        ->check(CLI::Range(16u, 16384u));
+    recordCommand->add_option("--samples", record.samples,
+                              "subsamples per pixel, averaged (default 1)")
+        ->check(CLI::Range(1u, kMaxSamplesPerPixel));
+    recordCommand->add_option("--fps", record.fps, "frames per second (default 10)")
+        ->check(CLI::Range(0.1, 240.0));
+    recordCommand->add_option("--duration", record.durationSeconds,
+                              "seconds to record (default 10)")
+        ->check(CLI::Range(0.001, 86400.0));
+    recordCommand->add_option("--blend", record.blendSeconds,
+                              "seconds over which the caches move from one version to the next "
+                              "(default 0.5; 0: each version at once)")
+        ->check(CLI::Range(0.0, 3600.0));
+    recordCommand->add_option("--format", record.format, "frame files: png (default) or exr")
+        ->check(CLI::IsMember({"png", "exr"}));
+    recordCommand->add_option("--exposure", record.exposure,
+                              "factor applied before PNG quantisation (default 1)")
+        ->check(CLI::PositiveNumber);
+    recordCommand->add_option("--cache-dir", record.cacheDir, "where downloaded scenes are kept");
+    recordCommand->add_option("--out-dir", record.outDir, "folder for frame_00000.png, …")
+        ->required();
+
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
+    if (recordCommand->parsed()) return runRecord(common, record);
     if (session->parsed()) return runSession(common, bakeId);
     if (lights->parsed()) return runLights(common, lightsPath);
     if (watch->parsed()) return runWatch(common, count, watchSeconds);

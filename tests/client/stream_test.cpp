@@ -24,6 +24,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "client/connection.h"
@@ -851,6 +852,87 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
     EXPECT_NE(updateLine.find("bytes="), std::string::npos);
     EXPECT_NE(updateLine.find("subscribers="), std::string::npos);
 
+    server.signal(SIGTERM);
+    EXPECT_EQ(server.wait(), 0);
+}
+
+// `picclient record` draws the stream at a fixed rate from caches blended over time: after a
+// light change every pixel moves monotonically from the old version's value to the new one's,
+// some frames show the light part of the way, and the last frames show the new version.
+TEST(StreamCli, RecordBlendsFromOneVersionToTheNext) {
+    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
+                  "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet"});
+    ASSERT_GT(server.pid(), 0);
+    const std::string first = readLine(server.out());
+    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
+    const std::string address = first.substr(std::string("listening on ").size());
+    int exit = 0;
+    const std::string client = PIC_PICCLIENT;
+    const std::string created = run(client + " session --server " + address, exit);
+    ASSERT_EQ(exit, 0) << created;
+    const auto json = nlohmann::json::parse(created);
+    const std::string session = json["session"], editor = json["editor_token"];
+
+    const test::ScratchDir dir("pic_record");
+    const fs::path frames = dir / "frames";
+    Child recorder({client, "record", "--server", address, "--session", session, "--token", editor,
+                    "--scene-camera", "0", "--size", "16x16", "--component", "indirect", "--fps",
+                    "20", "--duration", "6", "--blend", "1.5", "--format", "exr", "--cache-dir",
+                    (dir / "cache").string(), "--out-dir", frames.string()});
+    ASSERT_GT(recorder.pid(), 0);
+    // The first frame shows the session's first version; then the light brightens 4×.
+    for (int i = 0; i < 3000 && !fs::exists(frames / "frame_00000.exr"); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_TRUE(fs::exists(frames / "frame_00000.exr"));
+    LightSet brighter = pointLight(0.0f);
+    for (Light& light : brighter.lights) light.intensity *= 4.0f;
+    const fs::path lightsFile = dir / "brighter.json";
+    {
+        std::ofstream out(lightsFile);
+        out << toJson(brighter);
+    }
+    const std::string set = run(client + " lights --server " + address + " --session " + session +
+                                    " --token " + editor + " --set " + lightsFile.string(),
+                                exit);
+    ASSERT_EQ(exit, 0) << set;
+    ASSERT_EQ(recorder.wait(), 0);
+
+    std::vector<Image> images;
+    for (int k = 0;; ++k) {
+        const fs::path path = frames / fmt::format("frame_{:05}.exr", k);
+        if (!fs::exists(path)) break;
+        auto image = readImage(path.string());
+        ASSERT_TRUE(image) << image.error().message;
+        images.push_back(std::move(*image));
+    }
+    ASSERT_GE(images.size(), 20u);
+    const auto mean = [](const Image& image) {
+        double sum = 0.0;
+        for (const glm::vec3& p : image.pixels) sum += p.r + p.g + p.b;
+        return sum / double(image.pixels.size());
+    };
+    const Image& before = images.front();
+    const Image& after = images.back();
+    ASSERT_GT(mean(after), 2.0 * mean(before));
+    EXPECT_EQ(after.pixels, images[images.size() - 2].pixels);  // settled
+    int between = 0;
+    for (size_t k = 1; k < images.size(); ++k) {
+        for (size_t i = 0; i < after.pixels.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                const float lo = std::min(before.pixels[i][c], after.pixels[i][c]);
+                const float hi = std::max(before.pixels[i][c], after.pixels[i][c]);
+                const float slack = 1e-4f * (1.0f + hi);
+                ASSERT_GE(images[k].pixels[i][c], lo - slack) << "frame " << k << " pixel " << i;
+                ASSERT_LE(images[k].pixels[i][c], hi + slack) << "frame " << k << " pixel " << i;
+                // Never back towards the old value.
+                const float step = images[k].pixels[i][c] - images[k - 1].pixels[i][c];
+                ASSERT_GE(step * (after.pixels[i][c] - before.pixels[i][c]), -slack * slack)
+                    << "frame " << k << " pixel " << i;
+            }
+        const double m = mean(images[k]);
+        between += m > 1.1 * mean(before) && m < 0.9 * mean(after);
+    }
+    EXPECT_GE(between, 3) << "frames part of the way from the old light to the new";
     server.signal(SIGTERM);
     EXPECT_EQ(server.wait(), 0);
 }
