@@ -11,9 +11,10 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     mGridOption = command.add_option("--grid-cell", mGridCell, "grid cell size in metres (default: largest extent / 16)");
     command.add_option("--grid-caches", mGridCaches,
                        "where grid caches go: surfaces (only where surfaces too small for the "
-                       "light map read them) or volume (everywhere near geometry, for dynamic "
-                       "objects; default surfaces)")
-        ->check(CLI::IsMember({"surfaces", "volume"}));
+                       "light map read them), volume (everywhere near geometry: dynamic objects "
+                       "near surfaces) or space (every free grid vertex: dynamic objects "
+                       "anywhere); default surfaces")
+        ->check(CLI::IsMember({"surfaces", "volume", "space"}));
     mTexelOption = command.add_option("--lightmap-texel", mLightmapTexel,
                                       "light-map texel size in metres (default: about 8k texels over the scene's area)");
     command.add_option("--link-mode", mLinkMode, "sh or rtp (default rtp)")->check(CLI::IsMember({"sh", "rtp"}));
@@ -62,7 +63,9 @@ BakeOptions BakeOptionFlags::toOptions() const {
     if (*mChromaOption) options.bandsC = mChromaBands;
     if (*mGridOption) options.gridCell = mGridCell;
     if (*mTexelOption) options.lightmapTexel = mLightmapTexel;
-    options.gridCaches = mGridCaches == "volume" ? GridCaches::Volume : GridCaches::Surfaces;
+    options.gridCaches = mGridCaches == "space"    ? GridCaches::Space
+                         : mGridCaches == "volume" ? GridCaches::Volume
+                                                   : GridCaches::Surfaces;
     options.linkMode = mLinkMode == "sh" ? LinkMode::Sh : LinkMode::Rtp;
     options.hierarchy = mHierarchy == "kdtree"          ? HierarchyMethod::KdTree
                         : mHierarchy == "agglomerative" ? HierarchyMethod::Agglomerative

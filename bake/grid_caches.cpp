@@ -159,9 +159,10 @@ Result<GridCacheSet> placeGridCaches(const Scene& scene, const EmbreeScene& rays
         }, 512);
     }
 
-    // 2. One-cell dilation, then every corner of a dilated cell needs a cache.
-    std::vector<uint8_t> needed(vertexCount, 0);
-    for (uint32_t z = 0; z < cells.z; ++z)
+    // 2. One-cell dilation, then every corner of a dilated cell needs a cache; in Space mode
+    //    every vertex does, and the inside test below keeps those in open space.
+    std::vector<uint8_t> needed(vertexCount, params.mode == GridCaches::Space ? 1 : 0);
+    for (uint32_t z = 0; z < cells.z && params.mode != GridCaches::Space; ++z)
         for (uint32_t y = 0; y < cells.y; ++y)
             for (uint32_t x = 0; x < cells.x; ++x) {
                 bool near = false;

@@ -1,8 +1,9 @@
 #pragma once
 /// Grid cache placement (paper 000 §4.4, paper 001 §5): caches at the vertices of grid
 /// cells that contain or touch geometry, dilated by one cell, never inside solid geometry —
-/// the volume dynamic objects are shaded from — or only at the vertices that grid-shaded
-/// surfaces read, where nothing dynamic is shaded.
+/// the volume dynamic objects near surfaces are shaded from —, at every vertex in open space
+/// (dynamic objects anywhere), or only at the vertices that grid-shaded surfaces read, where
+/// nothing dynamic is shaded.
 
 #include <cstdint>
 #include <span>

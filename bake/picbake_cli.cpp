@@ -177,7 +177,7 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
                gridCachesName(p.gridCaches), info->gridCaches, bake->grid.dims.x, bake->grid.dims.y,
                bake->grid.dims.z, report.gridInsideSolid, report.gridDuplicates,
                p.gridCaches == GridCaches::Surfaces
-                   ? fmt::format(", {} that only dynamic objects would read left out (--grid-caches volume keeps them)",
+                   ? fmt::format(", {} that only dynamic objects would read left out (--grid-caches volume or space keeps them)",
                                  report.gridUnread)
                    : "");
     fmt::print("  lightmap texel  {}\n", withDefault("lightmap_texel", fmt::format("{:.4g} m", p.lightmapTexel)));

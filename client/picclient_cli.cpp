@@ -225,9 +225,40 @@ struct RenderCommand {
     std::string device;
     uint32_t shadowMapSize = 1024;
     uint32_t samples = 4;
+    ObjectFlags objects;
     std::string cacheDir;
     double waitSeconds = 60;
 };
+
+/// The scene and layout a view renders: the client's, or with `placements` a copy holding
+/// the dynamic objects too, their triangles shaded from the grid (not light-mapped). Warns
+/// when the bake's grid leaves much of them without a cache around.
+struct ViewScene {
+    Scene placed;  ///< with the objects (empty without)
+    ClientLayout layout;
+    const Scene* scene = nullptr;
+};
+
+Result<void> placeInto(ViewScene& view, const ClientScene& client,
+                       const std::vector<ObjectPlacement>& placements) {
+    view.layout = clientLayoutOf(client);
+    view.scene = &client.scene;
+    if (placements.empty()) return {};
+    PIC_TRY_ASSIGN(view.placed, placeObjects(client.scene, placements));
+    view.scene = &view.placed;
+    view.layout.sceneHash = view.placed.hash;
+    view.layout.triangleUvs.resize(3 * view.placed.triangles.size(), glm::vec2(kNotLightmapped));
+    const double covered =
+        gridCoverage(view.placed, client.scene.vertices.size(), view.layout.gridOrigin,
+                     view.layout.gridCellSize, view.layout.gridDims, client.gridCaches);
+    if (covered < 0.9)
+        std::fprintf(stderr,
+                     "picclient render: warning: %.0f %% of the objects' vertices have no grid "
+                     "cache around them and get no indirect light there; a bake made with "
+                     "--grid-caches space fills the grid for dynamic objects\n",
+                     100.0 * (1.0 - covered));
+    return {};
+}
 
 int runRender(const Common& common, const RenderCommand& command) {
     const auto start = Clock::now();
@@ -237,6 +268,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     auto view = command.view.toView();
     if (!view) return reportError(view.error());
     if (auto output = command.output.check(); !output) return reportError(output.error());
+    PIC_TRY_ASSIGN_OR_EXIT(const std::vector<ObjectPlacement> placements,
+                           command.objects.placements());
     std::optional<LightSet> pushed;
     if (!command.lightsPath.empty()) {
         auto lights = readLightSet(command.lightsPath);
@@ -254,6 +287,9 @@ int runRender(const Common& common, const RenderCommand& command) {
 
     auto camera = view->cameraIn(client->scene);
     if (!camera) return reportError(camera.error());
+    ViewScene shown;
+    if (auto placed = placeInto(shown, *client, placements); !placed)
+        return reportError(placed.error());
 
     // Subscribe first, then push: the wait below measures the light change to the frame.
     auto stream = connection->subscribe(common.session, common.token, patienceOf(common));
@@ -325,7 +361,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!context) return reportError(context.error());
     RendererOptions rendererOptions;
     rendererOptions.shadowMapSize = command.shadowMapSize;
-    auto renderer = Renderer::create(**context, client->scene, clientLayoutOf(*client), rendererOptions);
+    auto renderer = Renderer::create(**context, *shown.scene, shown.layout, rendererOptions);
     if (!renderer) return reportError(renderer.error());
     if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
     RenderTimings timings;
@@ -574,6 +610,7 @@ int picclientMain(int argc, char** argv) {
                               "G-buffer and a shading pass (default 4; 1: pixel centres; "
                               "picref shade --spp N is the CPU counterpart)")
         ->check(CLI::Range(1u, kMaxSamplesPerPixel));
+    render.objects.addTo(*renderCommand);
     renderCommand->add_option("--cache-dir", render.cacheDir, "where downloaded scenes are kept");
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);

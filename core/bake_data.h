@@ -70,13 +70,17 @@ inline const char* linkCutName(LinkCut cut) {
 enum class GridCaches : uint32_t {
     Surfaces = 0,  ///< only at the vertices that grid-shaded surfaces read (triangles too
                    ///< small for the light map): what a static scene's image needs
-    Volume = 1,    ///< at every free vertex near geometry: also for dynamic objects, which
-                   ///< are shaded from the grid wherever they are placed
+    Volume = 1,    ///< at every free vertex near geometry (paper 001 §5's occupied cells,
+                   ///< dilated by one): dynamic objects near surfaces
+    Space = 2,     ///< at every free vertex of the grid, inside rooms however far from
+                   ///< geometry: dynamic objects anywhere (paper 000 §5.1)
 };
 
 /// The mode's name in the CLI, the bake file and reports.
 inline const char* gridCachesName(GridCaches mode) {
-    return mode == GridCaches::Volume ? "volume" : "surfaces";
+    return mode == GridCaches::Space    ? "space"
+           : mode == GridCaches::Volume ? "volume"
+                                        : "surfaces";
 }
 
 /// The parameters a bake was made with, after defaults were resolved.

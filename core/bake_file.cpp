@@ -498,7 +498,7 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     PIC_TRY_ASSIGN(p.gridCell, reader.f32("grid_cell"));
     // Bakes written before grid caches could be limited to what surfaces read filled the volume.
     PIC_TRY_ASSIGN(const uint32_t gridCaches, reader.contains("grid_caches")
-                                                  ? reader.oneOf("grid_caches", {"surfaces", "volume"})
+                                                  ? reader.oneOf("grid_caches", {"surfaces", "volume", "space"})
                                                   : Result<uint32_t>(1u));
     p.gridCaches = static_cast<GridCaches>(gridCaches);
     PIC_TRY_ASSIGN(p.lightmapTexel, reader.f32("lightmap_texel"));

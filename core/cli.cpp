@@ -146,6 +146,19 @@ void ShadeFlags::addTo(CLI::App& command) {
     glossyWeight->needs(glossy);
 }
 
+void ObjectFlags::addTo(CLI::App& command) {
+    command.add_option("--object", mObjects,
+                       "a glTF model not in the bake, shaded from the grid caches (repeatable; "
+                       "each needs its --transform)");
+    command.add_option("--transform", mTransforms,
+                       "tx,ty,tz,rx,ry,rz,s: where the --object of the same position goes "
+                       "(metres; degrees about x, then y, then z; uniform scale)");
+}
+
+Result<std::vector<ObjectPlacement>> ObjectFlags::placements() const {
+    return parseObjectFlags(mObjects, mTransforms);
+}
+
 ShadeParams ShadeFlags::toParams(glm::uvec2 size, uint32_t samplesPerPixel) const {
     ShadeParams params;
     params.width = size.x;

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/scene.h"
+#include "core/scene_objects.h"
 #include "core/shade_params.h"
 
 namespace pic {
@@ -117,6 +118,20 @@ private:
     std::string mComponent = "full";
     float mGlossyExponent = 0.0f;
     float mGlossyWeight = 0.0f;
+};
+
+/// --object FILE --transform tx,ty,tz,rx,ry,rz,s, repeatable, paired in order: dynamic
+/// objects placed into a view (core/scene_objects.h).
+class ObjectFlags {
+public:
+    /// Adds the two options to `command`.
+    void addTo(CLI::App& command);
+    /// The placements; InvalidInput when the counts differ or a transform does not parse.
+    Result<std::vector<ObjectPlacement>> placements() const;
+
+private:
+    std::vector<std::string> mObjects;
+    std::vector<std::string> mTransforms;
 };
 
 }  // namespace pic

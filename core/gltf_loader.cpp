@@ -364,7 +364,7 @@ public:
                        "note: '{}': {} triangles wound clockwise about their vertex normals were "
                        "turned to face them\n",
                        mPath, mScene.rewound);
-        finish();
+        finishScene(mScene);
         return std::move(mScene);
     }
 
@@ -941,35 +941,6 @@ private:
                         nodeIndex);
         mScene.cameras.push_back(std::move(camera));
         return {};
-    }
-
-    /// Bounds, area and the content hash over geometry, materials and their texels.
-    void finish() {
-        for (const Vertex& v : mScene.vertices) mScene.bounds.extend(v.position);
-        double area = 0.0;
-        for (uint32_t t = 0; t < mScene.triangles.size(); ++t) area += mScene.triangleArea(t);
-        mScene.totalArea = area;
-
-        static_assert(sizeof(Vertex) == 14 * sizeof(float), "Vertex must have no padding");
-        static_assert(sizeof(Triangle) == 5 * sizeof(uint32_t), "Triangle must have no padding");
-        uint64_t h = hashVector(mScene.vertices);
-        h = hashVector(mScene.triangles, h);
-        for (const Material& m : mScene.materials) {
-            h = hashBytes(m.name.data(), m.name.size(), h);
-            h = hashBytes(&m.baseColorFactor, sizeof(m.baseColorFactor), h);
-            h = hashBytes(&m.baseColorTexture, sizeof(m.baseColorTexture), h);
-            h = hashBytes(&m.baseColorTexCoord, sizeof(m.baseColorTexCoord), h);
-            h = hashBytes(&m.emission, sizeof(m.emission), h);
-            h = hashBytes(&m.emissiveTexture, sizeof(m.emissiveTexture), h);
-            uint8_t doubleSided = m.doubleSided ? 1 : 0;
-            h = hashBytes(&doubleSided, 1, h);
-        }
-        for (const Texture& t : mScene.textures) {
-            int32_t header[4] = {t.width, t.height, t.repeatS ? 1 : 0, t.repeatT ? 1 : 0};
-            h = hashBytes(header, sizeof(header), h);
-            h = hashVector(t.texels, h);
-        }
-        mScene.hash = h;
     }
 
     const tinygltf::Model& mModel;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/hash.h"
 
 namespace pic {
 
@@ -96,6 +97,35 @@ glm::vec3 Scene::emissionAt(uint32_t t, float b1, float b2) const {
     glm::vec2 uv =
         b0 * vertices[tri.v[0]].uv0 + b1 * vertices[tri.v[1]].uv0 + b2 * vertices[tri.v[2]].uv0;
     return material.emission * glm::vec3(textures[size_t(material.emissiveTexture)].sample(uv));
+}
+
+void finishScene(Scene& scene) {
+    scene.bounds = Aabb{};
+    for (const Vertex& v : scene.vertices) scene.bounds.extend(v.position);
+    double area = 0.0;
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) area += scene.triangleArea(t);
+    scene.totalArea = area;
+
+    static_assert(sizeof(Vertex) == 14 * sizeof(float), "Vertex must have no padding");
+    static_assert(sizeof(Triangle) == 5 * sizeof(uint32_t), "Triangle must have no padding");
+    uint64_t h = hashVector(scene.vertices);
+    h = hashVector(scene.triangles, h);
+    for (const Material& m : scene.materials) {
+        h = hashBytes(m.name.data(), m.name.size(), h);
+        h = hashBytes(&m.baseColorFactor, sizeof(m.baseColorFactor), h);
+        h = hashBytes(&m.baseColorTexture, sizeof(m.baseColorTexture), h);
+        h = hashBytes(&m.baseColorTexCoord, sizeof(m.baseColorTexCoord), h);
+        h = hashBytes(&m.emission, sizeof(m.emission), h);
+        h = hashBytes(&m.emissiveTexture, sizeof(m.emissiveTexture), h);
+        uint8_t doubleSided = m.doubleSided ? 1 : 0;
+        h = hashBytes(&doubleSided, 1, h);
+    }
+    for (const Texture& t : scene.textures) {
+        int32_t header[4] = {t.width, t.height, t.repeatS ? 1 : 0, t.repeatT ? 1 : 0};
+        h = hashBytes(header, sizeof(header), h);
+        h = hashVector(t.texels, h);
+    }
+    scene.hash = h;
 }
 
 }  // namespace pic

@@ -135,4 +135,9 @@ struct Scene {
     glm::vec3 emissionAt(uint32_t t, float b1, float b2) const;
 };
 
+/// Sets `scene`'s bounds, total area and content hash (over geometry, materials and their
+/// texels) from its vertices, triangles, materials and textures: the last step of loading or
+/// building a scene.
+void finishScene(Scene& scene);
+
 }  // namespace pic

@@ -66,6 +66,7 @@ struct RenderArgs {
     std::string lightsPath;
     uint64_t seed = 1;
     ImageOutputFlags output;
+    ObjectFlags objects;
 };
 
 int runRender(const RenderArgs& args) {
@@ -79,8 +80,14 @@ int runRender(const RenderArgs& args) {
             {ErrorCode::InvalidInput,
              fmt::format("--bounces must be -1 (unlimited) or >= 0, got {}", args.bounces)});
     if (auto output = args.output.check(); !output) return reportError(output.error());
+    auto placements = args.objects.placements();
+    if (!placements) return reportError(placements.error());
 
     auto scene = loadScene(args.scenePath);
+    if (!scene) return reportError(scene.error());
+    // Dynamic objects are part of the scene the reference traces: their shadows, their
+    // reflections and the light they block all count.
+    if (!placements->empty()) scene = placeObjects(*scene, *placements);
     if (!scene) return reportError(scene.error());
     auto camera = args.view.cameraIn(*scene);
     if (!camera) return reportError(camera.error());
@@ -253,6 +260,9 @@ int picrefMain(int argc, char** argv) {
         app.get_option("--out"),
     };
 
+    render.objects.addTo(app);
+    renderOnly.push_back(app.get_option("--object"));
+    renderOnly.push_back(app.get_option("--transform"));
     app.get_option("--glossy")->needs(app.get_option("--glossy-weight"));
     app.get_option("--glossy-weight")->needs(app.get_option("--glossy"));
 

@@ -42,6 +42,7 @@ struct ShadeCommand {
     int bounces = -1;
     uint32_t spp = 4;  // picclient render --samples' default
     ImageOutputFlags output;
+    ObjectFlags objects;
 };
 
 /// Checks what can be checked without reading files, so that usage errors come first.
@@ -57,6 +58,8 @@ int runShade(const ShadeCommand& command) {
     if (auto usage = checkUsage(command); !usage) return reportError(usage.error());
     auto view = command.view.toView();
     if (!view) return reportError(view.error());
+    auto placements = command.objects.placements();
+    if (!placements) return reportError(placements.error());
 
     auto scene = loadScene(command.scenePath);
     if (!scene) return reportError(scene.error());
@@ -100,9 +103,42 @@ int runShade(const ShadeCommand& command) {
     std::fprintf(stderr, "picref shade: update on %s: %d bounces, %.1f ms (ms per pass: %s)\n",
                  (*runtime)->name(), stats.bounces, stats.totalMs, passes.c_str());
 
+    // Dynamic objects join the shaded scene only, as in the client: the caches were lit
+    // without them, and their triangles read the grid.
+    const Scene* shaded = &*scene;
+    const EmbreeScene* shadedRays = rays->get();
+    Scene placed;
+    std::unique_ptr<EmbreeScene> placedRays;
+    BakeData withObjects;
+    const BakeData* shadedBake = &*bake;
+    if (!placements->empty()) {
+        auto built = placeObjects(*scene, *placements);
+        if (!built) return reportError(built.error());
+        placed = std::move(*built);
+        auto builtRays = EmbreeScene::create(placed);
+        if (!builtRays) return reportError(builtRays.error());
+        placedRays = std::move(*builtRays);
+        withObjects = *bake;
+        withObjects.sceneHash = placed.hash;
+        withObjects.lightmap.triangleUvs.resize(3 * placed.triangles.size(),
+                                                glm::vec2(kNotLightmapped));
+        const double covered =
+            gridCoverage(placed, scene->vertices.size(), bake->grid.origin, bake->grid.cellSize,
+                         bake->grid.dims, bake->grid.cacheIndex);
+        if (covered < 0.9)
+            std::fprintf(stderr,
+                         "picref shade: warning: %.0f %% of the objects' vertices have no grid "
+                         "cache around them; a bake made with --grid-caches space fills the "
+                         "grid for dynamic objects\n",
+                         100.0 * (1.0 - covered));
+        shaded = &placed;
+        shadedRays = placedRays.get();
+        shadedBake = &withObjects;
+    }
     const ShadeParams params = command.shade.toParams(view->size, command.spp);
     const auto shadeStart = Clock::now();
-    auto image = shadeFromCaches(*scene, **rays, *bake, **values, lights, *camera, params);
+    auto image =
+        shadeFromCaches(*shaded, *shadedRays, *shadedBake, **values, lights, *camera, params);
     if (!image) return reportError(image.error());
     const double shadeMs = millisecondsSince(shadeStart);
 
@@ -138,6 +174,7 @@ int picrefShadeMain(int argc, char** argv) {
         ->check(CLI::Range(1u, kMaxSamplesPerPixel));
     addGlobalFlags(app);
     command.output.addTo(app);
+    command.objects.addTo(app);
 
     if (auto exit = parseCommandLine(app, argc, argv)) return *exit;
     return runShade(command);

@@ -339,6 +339,38 @@ TEST(Bake, GridCachesOnlyWhereSurfacesReadThemUnlessAVolumeIsAskedFor) {
     }
 }
 
+TEST(Bake, GridCachesInSpaceFillTheRoomWhereTheVolumeFollowsItsWalls) {
+    // Cells of 5 cm: a point in the open right half of the cornell box, at least 0.3 m from
+    // every wall and box, is beyond the volume's one-cell dilation; dynamic objects placed
+    // there read the space mode's caches.
+    BakeOptions options = test::smallBakeOptions(2048, 16, 0.05f, 0.1f);
+    const test::BakedScene& volume = test::bakedScene("cornell", options);
+    options.gridCaches = GridCaches::Space;
+    const test::BakedScene& space = test::bakedScene("cornell", options);
+    ASSERT_TRUE(volume.ok && space.ok);
+    EXPECT_EQ(space.bake.params.gridCaches, GridCaches::Space);
+    const auto cacheAt = [](const BakeData& bake, const glm::vec3& p) {
+        const GridLayout& g = bake.grid;
+        const glm::uvec3 v = glm::uvec3(glm::round((p - g.origin) / g.cellSize));
+        return g.cacheIndex[v.x + size_t{g.dims.x} * (v.y + size_t{g.dims.y} * v.z)];
+    };
+    const glm::vec3 middle(0.2f, 0.65f, 0.1f);
+    EXPECT_EQ(cacheAt(volume.bake, middle), kNoCache);
+    EXPECT_NE(cacheAt(space.bake, middle), kNoCache);
+    // Every vertex the volume holds, the space holds too; none outside the room.
+    size_t volumeCaches = 0, spaceCaches = 0;
+    for (size_t v = 0; v < space.bake.grid.cacheIndex.size(); ++v) {
+        volumeCaches += volume.bake.grid.cacheIndex[v] != kNoCache;
+        spaceCaches += space.bake.grid.cacheIndex[v] != kNoCache;
+        if (volume.bake.grid.cacheIndex[v] != kNoCache) {
+            EXPECT_NE(space.bake.grid.cacheIndex[v], kNoCache) << v;
+        }
+    }
+    EXPECT_GT(spaceCaches, volumeCaches);
+    const glm::vec3 outside(0.0f, 0.5f, -0.55f);  // a cell behind the back wall
+    EXPECT_EQ(cacheAt(space.bake, outside), kNoCache);
+}
+
 /// Visible solid angle summed over the links of each cache.
 std::vector<double> solidAnglePerCache(const LinkResult& links, size_t caches, uint32_t nL) {
     std::vector<double> sums(caches, 0.0);

@@ -818,6 +818,26 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
                 error->relativeRmse, error->meanRatio);
     EXPECT_LE(error->relativeRmse, 0.01);
     EXPECT_NEAR(error->meanRatio, 1.0, 0.01);
+    // A dynamic object joins the view; an --object without its --transform is bad usage.
+    const fs::path withBox = dir / "box.exr";
+    const std::string box = std::string(PIC_TEST_SCENE_DIR) + "/object_box.gltf";
+    std::string placed = run(client + " render --server " + address + " --session " + session +
+                                 " --token " + editor + " --scene-camera 0 --size 63x56 " +
+                                 "--component indirect --object " + box +
+                                 " --transform 0.05,0.55,0.05,20,35,0,0.22 --cache-dir " +
+                                 cacheDir.string() + " --out " + withBox.string() + " 2>&1",
+                             exit);
+    EXPECT_EQ(exit, 0) << placed;
+    auto boxImage = readImage(withBox.string());
+    ASSERT_TRUE(boxImage) << placed;
+    EXPECT_NE(boxImage->pixels, read->pixels);
+    std::string unpaired = run(client + " render --server " + address + " --session " + session +
+                                   " --token " + editor + " --scene-camera 0 --size 8x8 --object " +
+                                   box + " --cache-dir " + cacheDir.string() + " --out " +
+                                   withBox.string() + " 2>&1",
+                               exit);
+    EXPECT_EQ(exit, 2) << unpaired;
+    EXPECT_NE(unpaired.find("1 objects, 0 transforms"), std::string::npos) << unpaired;
     std::string viewerPush = run(client + " render --server " + address + " --session " + session +
                                      " --token " + viewer + " --lights " + lightsFile.string() +
                                      " --scene-camera 0 --size 8x8 --cache-dir " + cacheDir.string() +

@@ -371,7 +371,7 @@ TEST_F(BakeFile, ParamsWithoutGridCachesReadAsTheVolume) {
     // Where grid caches go round-trips by name; bakes written before grid caches could be
     // limited to what surfaces read placed them in the whole volume.
     BakeData bake = makeBake(LinkMode::Rtp);
-    for (const GridCaches mode : {GridCaches::Surfaces, GridCaches::Volume}) {
+    for (const GridCaches mode : {GridCaches::Surfaces, GridCaches::Volume, GridCaches::Space}) {
         bake.params.gridCaches = mode;
         const auto [file, bytes] = written(bake);
         const Result<BakeData> read = readBakeFile(file);

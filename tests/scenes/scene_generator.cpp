@@ -251,6 +251,15 @@ Result<void> buildSmallSpot(GltfBuilder& gltf, const SceneOptions&) {
     return {};
 }
 
+/// `object_box`: a lone 1 m cube centred on the origin, in a light grey: a dynamic object to
+/// place into other scenes (`--object FILE --transform …`); no lights, no camera.
+Result<void> buildObjectBox(GltfBuilder& gltf, const SceneOptions&) {
+    const uint32_t grey = gltf.addMaterial({.name = "box", .baseColor = {0.6, 0.6, 0.6}});
+    addMesh(gltf, "box", grey,
+            [](MeshBuilder& mesh) { mesh.addBox({0.0f, 0.0f, 0.0f}, {0.5f, 0.5f, 0.5f}); });
+    return {};
+}
+
 /// `closed_box`: a sealed 1 m room with a point light at its centre.
 Result<void> buildClosedBox(GltfBuilder& gltf, const SceneOptions&) {
     const uint32_t white = addWhite(gltf);
@@ -923,6 +932,7 @@ constexpr SceneEntry kScenes[] = {
     {"small_spot", buildSmallSpot},
     {"atrium", buildAtrium},
     {"closed_box", buildClosedBox},
+    {"object_box", buildObjectBox},
     {"bad_points", buildBadPoints},
     {"bad_empty", buildBadEmpty},
     {"textured_quad", buildTexturedQuad},

@@ -15,6 +15,7 @@
 #include "core/camera.h"
 #include "core/gltf_loader.h"
 #include "core/light_set.h"
+#include "core/scene_objects.h"
 #include "rays/embree_scene.h"
 #include "render/cpu/cache_shading.h"
 #include "tests/render/renderer_fixture.h"
@@ -165,6 +166,55 @@ TEST(RendererIndirect, IndirectScalesMatchTheCpuShading) {
                         << label << ", pixel " << i;
         }
     }
+    EXPECT_EQ(test::sharedContext()->validationMessages(), 0u);
+}
+
+// A dynamic object (core/scene_objects.h) joins the view in both twins alike: its triangles
+// are grid-shaded, it casts shadows and is lit through the shadow maps, as the CPU's rays do.
+TEST(RendererObjects, DynamicObjectsMatchTheCpuShading) {
+    const test::LitScene& b = test::litScene("cornell");
+    ASSERT_TRUE(b.ok);
+    ObjectPlacement box;
+    box.path = test::testScenePath("object_box");
+    box.translation = {0.05f, 0.55f, 0.05f};
+    box.rotationDegrees = {20.0f, 35.0f, 0.0f};
+    box.scale = 0.22f;
+    auto placed = placeObjects(b.scene, {box});
+    ASSERT_TRUE(placed) << placed.error().message;
+    auto rays = EmbreeScene::create(*placed);
+    ASSERT_TRUE(rays);
+    BakeData bake = b.bake;
+    bake.sceneHash = placed->hash;
+    bake.lightmap.triangleUvs.resize(3 * placed->triangles.size(), glm::vec2(kNotLightmapped));
+    auto renderer = test::rendererFor(*placed, bake, b.values);
+    ASSERT_TRUE(renderer);
+    ShadeParams params;
+    params.width = kAxisWidth;
+    params.height = kAxisHeight;
+    for (const ShadeComponent component : {ShadeComponent::Indirect, ShadeComponent::Full}) {
+        params.component = component;
+        const test::Comparison c = test::compare(*renderer, *placed, **rays, bake, b.values,
+                                                 defaultLightSet(*placed),
+                                                 b.scene.cameras.at(0), params);
+        const std::string label = std::string(component == ShadeComponent::Full ? "full" : "indirect") +
+                                  ", cornell with a box placed in it";
+        test::report(label.c_str(), c);
+        // As without objects: the cache term to float precision, direct light up to the
+        // shadow maps' edges (RendererDirect).
+        EXPECT_LE(c.error.relativeRmse, component == ShadeComponent::Full ? 0.06 : 0.01) << label;
+        EXPECT_LE(c.differing, 0.01) << label;
+    }
+    // The object is in the image: it differs from the scene without it.
+    auto without = test::rendererFor(b.scene, b.bake, b.values);
+    ASSERT_TRUE(without);
+    auto plain = without->render(defaultLightSet(b.scene), b.scene.cameras.at(0), params);
+    auto with = renderer->render(defaultLightSet(*placed), b.scene.cameras.at(0), params);
+    ASSERT_TRUE(plain && with);
+    size_t changed = 0;
+    for (size_t i = 0; i < plain->pixels.size(); ++i)
+        changed += glm::any(glm::greaterThan(glm::abs(plain->pixels[i] - with->pixels[i]),
+                                             glm::vec3(1e-3f)));
+    EXPECT_GT(changed, plain->pixels.size() / 50);
     EXPECT_EQ(test::sharedContext()->validationMessages(), 0u);
 }
 
