@@ -200,7 +200,7 @@ public:
     /// The offset of a localised estimate's link: the centroid of the part the cache sees,
     /// Σ w·Ω·V·k·x / Σ w·Ω·V·k (k: LinkReadWeight), from the read node's flux centroid,
     /// Σ w·a·x / Σ w·a (metres). The runtime scales the read node's flux by its linear spread
-    /// along this offset (render/cpu/pull.h). Zero for a surfel, and under LinkReads::Node,
+    /// along this offset (render/node_spread.h). Zero for a surfel, and under LinkReads::Node,
     /// whose links read the node's mean.
     glm::vec3 offsetOf(const NodeEstimate& e) const {
         const Node& read = mNodes[e.readNode];
@@ -215,7 +215,7 @@ public:
     /// The spread share ρ of a link: the trace of the covariance of the part the cache sees
     /// (its visible samples, weights w·Ω·V·k) over that of its read node (weights w·a), ≤ 1. The
     /// runtime's exponential spread reads a link of ρ = 1 at the node's mean and one of ρ = 0
-    /// at the spread's value at the part's centroid (render/cpu/pull.h). 1 under
+    /// at the spread's value at the part's centroid (render/node_spread.h). 1 under
     /// LinkReads::Node, whose links read the node's mean.
     float spreadShareOf(const NodeEstimate& e) const {
         if (mParams.reads == LinkReads::Node) return 1.0f;
@@ -391,7 +391,7 @@ private:
         }
         e.sampleCount = static_cast<uint32_t>(samples.size()) - e.sampleBegin;
         // The refinement order is a bound on the error of the node's model: a link reads its
-        // node's flux as spread by the weights and a linear spread (render/cpu/pull.h), which
+        // node's flux as spread by the weights and a linear spread (render/node_spread.h), which
         // light varying over the node at a rate g beyond the model (a sunlit patch, a shadow's
         // edge) misses by up to g·r at a distance r from where the model is right, so the link
         // is off by up to Ω·g·r over the Ω it sees. g depends on the lights, unknown here, so

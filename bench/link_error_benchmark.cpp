@@ -26,6 +26,7 @@
 #include "render/cpu/cache_lighting.h"
 #include "render/cpu/pull.h"
 #include "render/cpu/surfel_lighting.h"
+#include "render/node_spread.h"
 
 namespace pic {
 
@@ -202,7 +203,7 @@ int runLinkErrorBenchmark(const LinkErrorParams& params) {
                 read[c] *= colour[c] * weightedArea[node] / colouredArea[node][c];
         return read;
     };
-    // What a link reads with the node's flux spread (render/cpu/pull.h), relative to the
+    // What a link reads with the node's flux spread (render/node_spread.h), relative to the
     // node's flux: the spread at the box point of the visible part's centroid (Σ w·Ω·x /
     // Σ w·Ω, as the bake's offset), with the part's spread share.
     const NodeSpread spread = nodeSpread(*bake);

@@ -11,7 +11,7 @@
 ///             spread by the bake's flux weights, Φ·w/(π·Σ w·a) (Φ/(πA) with uniform
 ///             weights), per channel in the surfels' colours κ, Φ·w·κ/(π·Σ w·κ·a), with
 ///             visible-part reads (the links' tints), exact visibility,
-///   spread    the same with the node's flux spread (render/cpu/pull.h) read as the runtime
+///   spread    the same with the node's flux spread (render/node_spread.h) read as the runtime
 ///             reads it, at the centroid of the part the cache sees (Σ w·Ω·k·x / Σ w·Ω·k) with
 ///             that part's spread share: what the runtime's links read, exact visibility,
 ///   linked    the runtime's cache (estimated visibility, the spread read at each link's box

@@ -20,7 +20,6 @@
 #include "core/gltf_loader.h"
 #include "core/sh.h"
 #include "proto/wire.h"
-#include "render/cpu/lightmap_copy.h"
 
 namespace pic {
 

@@ -142,7 +142,7 @@ struct LinkSet {
                                            ///< the part the link sees from its node's flux centroid
     std::vector<uint8_t> spreadShare;      ///< both modes: nC·nL codes (encodeSpreadShare): the
                                            ///< spread of the part the link sees over its node's
-                                           ///< (render/cpu/pull.h)
+                                           ///< (render/node_spread.h)
 };
 
 /// The code of a spread share ρ ∈ [0, 1] (clamped; NaN → 0), ρ·63 rounded.

@@ -1,7 +1,9 @@
 #pragma once
 /// The cache textures renderers sample (paper 000 §4.7, buffers 6 and 9): the unique caches'
 /// SH written into every grid vertex and light-map texel that holds one, through the bake's
-/// index maps. The server's runtime, `picref shade` and the thin client share this layout.
+/// index maps. The server's runtime, `picref shade` and the thin client share this layout;
+/// copyCachesToTextures fills it on the CPU (the light-map copy, paper 000 Figure 2 step 5),
+/// render/passes/lightmap_copy_pass.h on a GPU.
 ///
 /// Layout. Each channel of YCoCg is a monochrome texture array so that luma and chroma keep
 /// different coefficient counts; layer k holds SH coefficient k (core/sh.h order) of that
@@ -26,6 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "core/bake_data.h"
+#include "core/cache_values.h"
 
 namespace pic {
 
@@ -64,5 +67,13 @@ CacheIndexMaps cacheIndexMapsOf(const BakeData& bake);
 CacheTextures makeCacheTextures(const CacheIndexMaps& maps, uint32_t bandsY, uint32_t bandsC);
 /// The same for `bake`'s maps and band counts.
 CacheTextures makeCacheTextures(const BakeData& bake);
+
+/// Copies every cache's coefficients into each grid vertex and light-map texel that holds it;
+/// texels without a cache stay 0. `textures` comes from makeCacheTextures for the same maps
+/// and `values` has the band counts of `textures` and every cache the maps name.
+void copyCachesToTextures(const CacheIndexMaps& maps, const CacheValues& values,
+                          CacheTextures& textures);
+/// The same through `bake`'s maps; `values` has exactly the bake's caches.
+void copyCachesToTextures(const BakeData& bake, const CacheValues& values, CacheTextures& textures);
 
 }  // namespace pic

@@ -45,7 +45,7 @@ struct CacheStencil {
     float weight[8] = {};
     int count = 0;
     /// Bit k: cache k is a light-map cache on the reader's own surface, read through its
-    /// irradiance along its normal (CacheValues::irradiance; render/cpu/surfel_lighting.h
+    /// irradiance along its normal (CacheValues::irradiance; render/surfel_visibility.h
     /// surfelStencils) rather than its SH.
     uint8_t alongNormal = 0;
 };

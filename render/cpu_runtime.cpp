@@ -6,12 +6,14 @@
 #include <span>
 #include <vector>
 
+#include "core/cache_textures.h"
 #include "core/color.h"
 #include "core/sh.h"
 #include "render/cpu/cache_lighting.h"
-#include "render/cpu/lightmap_copy.h"
 #include "render/cpu/pull.h"
 #include "render/cpu/surfel_lighting.h"
+#include "render/node_spread.h"
+#include "render/surfel_visibility.h"
 
 namespace pic {
 namespace {

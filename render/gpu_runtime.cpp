@@ -1,12 +1,10 @@
 #include "render/gpu_runtime.h"
 
-#include "render/cpu/pull.h"
-
 #include <chrono>
 
+#include "core/cache_textures.h"
 #include "core/color.h"
-#include "render/cpu/lightmap_copy.h"
-#include "render/cpu/surfel_lighting.h"
+#include "render/node_spread.h"
 #include "render/passes/cache_lighting_pass.h"
 #include "render/passes/lightmap_copy_pass.h"
 #include "render/passes/pull_pass.h"
@@ -14,6 +12,7 @@
 #include "render/passes/shadow_map_pass.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/sh_tables.h"
+#include "render/surfel_visibility.h"
 
 namespace pic {
 namespace {

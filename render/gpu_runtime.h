@@ -52,10 +52,10 @@ struct GpuRuntimeOptions {
     uint32_t maxLinkTexelWords = 4;
     /// Where textures() gets the light-map copy (paper 000 Figure 2 step 5), on demand after
     /// each setLights (picserver streams the caches and never asks): true, on the host from
-    /// the caches setLights reads back anyway (render/cpu/lightmap_copy.h); false, the
-    /// LightmapCopyPass on the device, then the layers read back. Unset: the host on a CPU
-    /// device, whose memory is the host's, so the pass would only add a dispatch and a
-    /// submission; the device on a GPU.
+    /// the caches setLights reads back anyway (core/cache_textures.h copyCachesToTextures);
+    /// false, the LightmapCopyPass on the device, then the layers read back. Unset: the host
+    /// on a CPU device, whose memory is the host's, so the pass would only add a dispatch and
+    /// a submission; the device on a GPU.
     std::optional<bool> lightmapCopyOnHost;
 };
 
@@ -68,7 +68,7 @@ class CacheLightingPass;
 class LightmapCopyPass;
 }  // namespace gpu
 
-/// Each node's light from its flux (pulled): its flux spread (render/cpu/pull.h), the slopes
+/// Each node's light from its flux (pulled): its flux spread (render/node_spread.h), the slopes
 /// and ln Z packed by gpu::packNodeSpread and the radiance at the box centre as RGBE8, what
 /// surfel lighting (leaves) and the pull (inner nodes) write for cache lighting
 /// (shaders/shared/pull.h).

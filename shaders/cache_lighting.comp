@@ -112,7 +112,7 @@ void addLink(uint slot) {
         const vec3 direction = decodeOctahedral9(link.directionAndGreen);
         if (cacheNormal.w > 0.0) {
             // The cone's projection convolved with the clamped cosine at the cache's normal,
-            // Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d) (render/cpu/cache_lighting.h
+            // Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d) (render/link_irradiance.h
             // linkIrradiance).
             const float x = dot(cacheNormal.xyz, direction);
             float legendre = 1.0, previous = 0.0, w = 0.0;

@@ -29,7 +29,7 @@ layout(binding = 3) uniform sampler2D gbufferEmission;
 layout(std430, binding = 4) readonly buffer Lights { GpuLight lights[]; };
 layout(std430, binding = 5) readonly buffer ShadowLayers { GpuShadowLayer shadowLayers[]; };
 layout(binding = 6) uniform sampler2DArray shadowMaps;
-// Cache textures (render/cpu/lightmap_copy.h layout), half floats, coefficient-major layers.
+// Cache textures (core/cache_textures.h layout), half floats, coefficient-major layers.
 layout(std430, binding = 7) readonly buffer GridY { float16_t gridY[]; };
 layout(std430, binding = 8) readonly buffer GridCo { float16_t gridCo[]; };
 layout(std430, binding = 9) readonly buffer GridCg { float16_t gridCg[]; };

@@ -1,7 +1,7 @@
 #version 460
 // Light-map copy (paper 000 Figure 2 step 5): each grid vertex or light-map texel takes its
 // cache's coefficients, one layer per coefficient; no cache → 0. CPU twin:
-// render/cpu/lightmap_copy.cpp (which documents the layout).
+// copyCachesToTextures in core/cache_textures.cpp (core/cache_textures.h documents the layout).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_shader_16bit_storage : require

@@ -12,7 +12,7 @@
 
 #include "core/bake_data.h"
 #include "core/cache_values.h"
-#include "render/cpu/pull.h"
+#include "render/node_spread.h"
 
 namespace pic {
 
@@ -24,7 +24,7 @@ namespace pic {
 struct LinkTable {
     uint32_t bands = 0;                 ///< lY
     std::vector<glm::vec3> points;      ///< nC·nL box coordinates of LinkSet::offset in the
-                                        ///< link's node (render/cpu/pull.h encodeBoxPoint)
+                                        ///< link's node (render/node_spread.h encodeBoxPoint)
     std::vector<float> concentrationWeight;  ///< nC·nL: 1 − the link's spread share
                                              ///< (LinkSet::spreadShare)
     /// RTP: the unit directions cache → node, x, y and z each nC·nL (and a few zeros past the
@@ -32,24 +32,16 @@ struct LinkTable {
     std::array<std::vector<float>, 3> directions;
     /// RTP: band weights factor·K_l(α) of link j in band l at l·nC·nL + j; 0 for padding.
     std::vector<float> weights;
-    /// nC·nL (and kLinkLanes zeros past the end): linkIrradiance of every link.
+    /// nC·nL (and kLinkLanes zeros past the end): linkIrradiance of every link
+    /// (render/link_irradiance.h).
     std::vector<float> irradiance;
 };
-
-/// What link `slot` of `bake` adds to its cache's irradiance along the cache's normal n per
-/// unit of its node's flux (LinkTable::irradiance): the link's lY-band projection convolved
-/// with the clamped cosine at n, Σ_l K_l·Σ_m c_lm·y_lm(n) — for an RTP link's cone
-/// factor·Σ_l K_l·K_l(α)·(2l + 1)/(4π)·P_l(n·d) by the addition theorem. The luma's irradiance
-/// from the same links, so that no colour loses the chroma's higher bands; 0 for a grid cache's
-/// links, which have no normal. (The cone's exact clamped cosine read 1–2 % more light than
-/// these bands in the white rooms, and the path tracer sided with the bands.)
-float linkIrradiance(const BakeData& bake, size_t slot);
 
 /// Unpacks the links of `bake` for its lY bands, their offsets in the boxes of `spread`
 /// (nodeSpread(bake)).
 LinkTable unpackLinks(const BakeData& bake, const NodeSpread& spread);
 
-/// A node's light as its links read it (render/cpu/pull.h). A linear node holds, in YCoCg, its
+/// A node's light as its links read it (render/node_spread.h). A linear node holds, in YCoCg, its
 /// limited flux spread's flux at the box centre and the change per box coordinate (column k:
 /// centre ∘ the slopes along axis k), so that a link at box point u reads centre + spread·u.
 /// An exponential node holds, per RGB channel, its spread's centre, slopes (column k: the RGB
@@ -63,7 +55,7 @@ struct alignas(64) NodeLight {
     uint32_t exponential = 0;
 };
 
-/// The node light of every node from its flux spread (render/cpu/pull.h pullFluxSpread:
+/// The node light of every node from its flux spread (render/node_spread.h pullFluxSpread:
 /// `centreFlux`, W per RGB channel, `slopes`, `concentration`, `exponential`) into `out`
 /// (same size).
 void nodeLight(std::span<const glm::vec3> centreFlux, std::span<const glm::mat3> slopes,

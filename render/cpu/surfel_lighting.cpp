@@ -1,12 +1,11 @@
 #include "render/cpu/surfel_lighting.h"
 
-#include <algorithm>
 #include <numbers>
 #include <vector>
 
 #include "core/error.h"
-#include "core/geometry.h"
 #include "core/parallel.h"
+#include "render/surfel_visibility.h"
 
 namespace pic {
 namespace {
@@ -15,23 +14,6 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 /// Surfels per task: a surfel costs one shadow ray per light or one cache lookup.
 constexpr size_t kSurfelGrain = 256;
-
-/// A light-map cache lies on a surfel's own surface where their normals are within 25°: its
-/// irradiance along its normal is then what the surfel receives (surfelStencils).
-constexpr float kSameSurfaceCos = 0.9f;
-
-/// E_light·V at `surfel`: the light's irradiance there, or zero where the surfel faces away,
-/// lies outside the cone or range (no ray is cast) or the ray to the light is occluded. Rays
-/// start just above the surface so that they do not hit the surfel's own triangle.
-glm::vec3 visibleIrradiance(const EmbreeScene& rays, const Surfel& surfel, const Light& light) {
-    glm::vec3 toLight;
-    float distance = 0.0f;
-    const glm::vec3 e = lightIrradiance(light, surfel.position, surfel.normal, toLight, distance);
-    if (!(e.r > 0.0f || e.g > 0.0f || e.b > 0.0f)) return glm::vec3(0.0f);
-    const float epsilon = rays.epsilon();
-    const glm::vec3 origin = surfel.position + epsilon * surfel.normal;
-    return rays.occluded(origin, toLight, 0.0f, distance - epsilon) ? glm::vec3(0.0f) : e;
-}
 
 }  // namespace
 
@@ -55,71 +37,6 @@ void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeDat
         flux += (kPi * surfel.area * emissiveScale[surfel.material]) * surfel.emission;
         directFlux[i] = flux;
     }, kSurfelGrain);
-}
-
-void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
-                      std::span<uint32_t> bits) {
-    const size_t nS = bake.surfels.size();
-    PIC_CHECK_EQ(bits.size(), visibilityWords(nS));
-    // White and of unit strength: where E > 0 for it, E > 0 for any colour and intensity.
-    Light unit = light;
-    unit.color = glm::vec3(1.0f);
-    unit.intensity = 1.0f;
-    // A task per word, so that no two tasks write one word.
-    parallelFor(
-        0, bits.size(),
-        [&](size_t word) {
-            uint32_t mask = 0;
-            const size_t end = std::min(nS, 32 * word + 32);
-            for (size_t i = 32 * word; i < end; ++i) {
-                const glm::vec3 e = visibleIrradiance(rays, bake.surfels[i], unit);
-                if (e.r > 0.0f) mask |= 1u << (i - 32 * word);
-            }
-            bits[word] = mask;
-        },
-        kSurfelGrain / 32);
-}
-
-std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& rays,
-                                         const BakeData& bake) {
-    std::vector<CacheStencil> stencils(bake.surfels.size());
-    const float offset = 4.0f * rays.epsilon();
-    parallelFor(0, bake.surfels.size(), [&](size_t i) {
-        const Surfel& surfel = bake.surfels[i];
-        PIC_DCHECK(surfel.triangle < scene.triangles.size());
-        const Triangle& triangle = scene.triangles[surfel.triangle];
-        const glm::vec3 b = barycentric(surfel.position, scene.vertices[triangle.v[0]].position,
-                                        scene.vertices[triangle.v[1]].position,
-                                        scene.vertices[triangle.v[2]].position);
-        const CacheStencil all = surfaceStencil(bake, surfel.triangle, b.y, b.z, surfel.position);
-        const glm::vec3 origin = surfel.position + offset * surfel.normal;
-        CacheStencil seen;
-        float total = 0.0f;
-        for (int k = 0; k < all.count; ++k) {
-            const Cache& cache = bake.caches[all.cache[k]];
-            const glm::vec3 v = cache.position + offset * cache.normal - origin;
-            const float d = glm::length(v);
-            if (d > 2.0f * offset && rays.occluded(origin, v / d, 0.0f, d - offset)) continue;
-            seen.cache[seen.count] = all.cache[k];
-            seen.weight[seen.count] = all.weight[k];
-            total += all.weight[k];
-            ++seen.count;
-        }
-        CacheStencil& out = stencils[i];
-        if (seen.count == all.count || seen.count == 0 || !(total > 0.0f)) {
-            out = all;
-        } else {
-            for (int k = 0; k < seen.count; ++k) seen.weight[k] /= total;
-            out = seen;
-        }
-        for (int k = 0; k < out.count; ++k) {
-            const Cache& cache = bake.caches[out.cache[k]];
-            if (cache.kind == gpu::kCacheKindLightmap &&
-                glm::dot(cache.normal, surfel.normal) >= kSameSurfaceCos)
-                out.alongNormal |= uint8_t(1u << k);
-        }
-    }, kSurfelGrain / 4);
-    return stencils;
 }
 
 void bounceSurfelFlux(const BakeData& bake, std::span<const CacheStencil> stencils,

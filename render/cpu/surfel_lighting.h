@@ -5,7 +5,8 @@
 ///
 /// The pass is split in two so that bounces do not recast shadow rays: the direct part depends
 /// on the light set only, the bounce part adds ρ·A·E_indirect read from the previous bounce's
-/// caches.
+/// caches. The rays it shares with the GPU backend (visibleIrradiance, surfelVisibility,
+/// surfelStencils) are render/surfel_visibility.h.
 
 #include <span>
 
@@ -24,29 +25,6 @@ namespace pic {
 /// the light. `directFlux` must hold nS entries.
 void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
                       const LightSet& lights, std::span<glm::vec3> directFlux);
-
-/// Words of a visibility mask over nS surfels (surfelVisibility): one bit per surfel.
-inline size_t visibilityWords(size_t surfels) {
-    return (surfels + 31) / 32;
-}
-
-/// The V of directSurfelFlux for one light, as bits: bit i % 32 of `bits[i / 32]` is set where
-/// the surfel faces the light within its cone and range and the ray to it is unoccluded. The
-/// light's colour and intensity do not matter. `bits` must hold visibilityWords(nS) words.
-void surfelVisibility(const EmbreeScene& rays, const BakeData& bake, const Light& light,
-                      std::span<uint32_t> bits);
-
-/// The caches each surfel's bounce reads: surfaceStencil at the surfel's barycentrics, less
-/// the caches it cannot see. A cache is dropped when the segment from the surfel (offset along
-/// its normal) to the cache (offset along a light-map cache's normal) is occluded, and the
-/// others are renormalised; a surfel that sees none of them keeps them all. Bilinear light-map
-/// texels and trilinear grid vertices otherwise reach through a thin wall: a floor that runs
-/// under a partition interpolates the texels on its far side, and surfels there re-emit the
-/// other room's light at every bounce. One ray per stencil entry, computed once per bake.
-/// Light-map caches whose normal is within 25° of the surfel's are marked
-/// (CacheStencil::alongNormal): the bounce reads their irradiance along their normal.
-std::vector<CacheStencil> surfelStencils(const Scene& scene, const EmbreeScene& rays,
-                                         const BakeData& bake);
 
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
 /// irradiance that the caches of `previousBounce` deliver at the surfel through its stencil

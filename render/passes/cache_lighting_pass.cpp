@@ -9,7 +9,8 @@
 
 #include "core/color.h"
 #include "core/parallel.h"
-#include "render/cpu/cache_lighting.h"
+#include "render/link_irradiance.h"
+#include "render/node_spread.h"
 #include "shaders/shared/cache_lighting.h"
 #include "spirv/cache_lighting_comp.h"
 

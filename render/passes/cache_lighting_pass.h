@@ -12,13 +12,13 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
-#include "render/cpu/pull.h"
+#include "render/node_spread.h"
 #include "shaders/shared/cache_lighting.h"
 
 namespace pic::gpu {
 
 /// The GPU's 16-byte form of a runtime-projected link with tint code `tint` (core/color.h
-/// encodeLinkTint), box point `point` (render/cpu/pull.h encodeBoxPoint) and spread share code
+/// encodeLinkTint), box point `point` (render/node_spread.h encodeBoxPoint) and spread share code
 /// `spreadShare` (core/bake_data.h encodeSpreadShare) whose node has area `nodeArea`
 /// (shaders/shared/cache_lighting.h): the node index (below 2^24), V = factor·π·A as binary16
 /// (clamped to 65504, at least the smallest subnormal for a link with factor > 0), 1 − cos α
@@ -34,7 +34,7 @@ class CacheLightingPass {
 public:
     /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box point,
     /// lY² half coefficients, radianceShCoefficient, and the link's irradiance along a
-    /// light-map cache's normal (render/cpu/cache_lighting.h linkIrradiance) rescaled alike, in
+    /// light-map cache's normal (render/link_irradiance.h linkIrradiance) rescaled alike, in
     /// shLinkWords(lY²) words) and the caches' normals, their box
     /// points in the boxes of `spread` (nodeSpread(bake)). Fails naming the count where the
     /// bake has more nodes than a GPU link addresses (2^24).

@@ -1,7 +1,8 @@
 #pragma once
 /// Light-map copy on the GPU (paper 000 Figure 2 step 5): the caches' half-float SH into the
 /// grid and light-map textures (coefficient-major layers per YCoCg channel, layout in
-/// core/cache_textures.h). CPU twin: render/cpu/lightmap_copy.h.
+/// core/cache_textures.h). CPU twin: core/cache_textures.h
+/// copyCachesToTextures.
 
 #include <array>
 #include <memory>

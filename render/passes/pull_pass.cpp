@@ -9,8 +9,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "core/color.h"
-
-#include "render/cpu/pull.h"
+#include "render/node_spread.h"
 #include "shaders/shared/pull.h"
 #include "spirv/pull_comp.h"
 
@@ -87,7 +86,7 @@ Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeD
     PIC_TRY_ASSIGN(pass->mLevel, Kernel::create(context, kSpirvPullComp, layout, "pull (level)"));
     layout.specialization = {kPullModeTail};
     PIC_TRY_ASSIGN(pass->mTail, Kernel::create(context, kSpirvPullComp, layout, "pull (tail)"));
-    // The children, the area and the flux spread (render/cpu/pull.h).
+    // The children, the area and the flux spread (render/node_spread.h).
     PIC_CHECK_EQ(spread.centroid.size(), bake.nodes.size());
     std::vector<PullNode> inner(bake.nodes.size() - nS);
     for (size_t n = nS; n < bake.nodes.size(); ++n) {

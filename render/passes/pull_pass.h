@@ -3,7 +3,8 @@
 /// the flux's first moment, one dispatch per hierarchy level, lowest first, and one for the
 /// small upper levels together (shaders/shared/pull.h); each inner node's light, the radiance
 /// of its flux spread at its box centre as RGBE8 (§4.7) and the spread's slopes, is written
-/// for cache lighting. CPU twin: render/cpu/pull.h.
+/// for cache lighting. CPU twin: render/cpu/pull.h, with the node spreads of
+/// render/node_spread.h.
 
 #include <memory>
 #include <vector>
@@ -12,7 +13,7 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
-#include "render/cpu/pull.h"
+#include "render/node_spread.h"
 
 namespace pic::gpu {
 
@@ -21,7 +22,7 @@ namespace pic::gpu {
 float radianceScale(float area);
 
 /// Words 0-2 of a node's light as the pull packs them (shaders/shared/pull.h): its nine spread
-/// slopes (columns: the R, G, B slopes of render/cpu/pull.h ChannelSpread or
+/// slopes (columns: the R, G, B slopes of render/node_spread.h ChannelSpread or
 /// ExponentialSpread) and, for an exponential spread, ln Z per channel.
 glm::uvec3 packNodeSpread(const glm::mat3& slopes, const glm::vec3& concentration,
                           bool exponential);

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <span>
 
-#include "render/cpu/surfel_lighting.h"
 #include "render/passes/shadow_map_pass.h"
+#include "render/surfel_visibility.h"
 
 namespace pic::gpu {
 

@@ -1,7 +1,7 @@
 #pragma once
 /// Direct-light visibility by rays, traced on the host with Embree: the alternative to shadow
 /// maps (DirectVisibility::Rays). One ray per surfel and light, as the CPU twin casts them
-/// (render/cpu/surfel_lighting.h surfelVisibility), so the direct light is exact; the
+/// (render/surfel_visibility.h surfelVisibility), so the direct light is exact; the
 /// surfel-lighting pass reads one bit per surfel and light. On a CPU device (lavapipe) this is
 /// several times faster than rasterising shadow maps: llvmpipe pays for every caster triangle
 /// of every layer, whereas the server needs visibility at the nS surfels only.

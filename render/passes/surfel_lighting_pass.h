@@ -56,7 +56,7 @@ struct SurfelLightingResources {
 
 class SurfelLightingPass {
 public:
-    /// Uploads the surfels and their cache stencils (render/cpu/surfel_lighting.h
+    /// Uploads the surfels and their cache stencils (render/surfel_visibility.h
     /// surfelStencils: the CPU twin's bounce reads the same), nS of them.
     static Result<std::unique_ptr<SurfelLightingPass>> create(
         Context& context, const Scene& scene, const BakeData& bake,

@@ -40,7 +40,7 @@ struct GpuRtpLink {
     uint directionAndGreen;  // unit direction cache → node, octahedral x | y << 9
                              // | spread share << 18 | tint G << 24
     uint visibleAndCone;     // binary16 V (0 marks padding) | binary16 (1 − cos α) << 16
-    uint pointAndBlue;       // box point (render/cpu/pull.h encodeBoxPoint) | tint B << 24
+    uint pointAndBlue;       // box point (render/node_spread.h encodeBoxPoint) | tint B << 24
 };
 PIC_STRUCT_CHECK(GpuRtpLink, 16);
 PIC_CONST(uint, kGpuLinkNodeBits, 24u);
@@ -48,7 +48,7 @@ PIC_CONST(uint, kGpuLinkNodeBits, 24u);
 // An SH-projected link as the GPU reads it: the node index, its tint (unorm10 as in the bake),
 // its box point | its spread share's code << 24, then its lY² binary16 coefficients (rescaled
 // by π·A to take the node's radiance) two per 32-bit word, then one binary16 more, its
-// irradiance along a light-map cache's normal (render/cpu/cache_lighting.h linkIrradiance,
+// irradiance along a light-map cache's normal (render/link_irradiance.h linkIrradiance,
 // rescaled alike; 0 for grid caches), and zero words up to a multiple of 4, so that 2- or
 // 4-word texels divide it: 8, 8, 12 words for lY = 2, 3, 4 (a record always has room for the
 // extra half).

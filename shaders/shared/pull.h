@@ -20,7 +20,7 @@ PIC_CONST(uint, kPullTailNodes, 256u);
 // An inner node as the pull reads it: eight RGBA32UI texels. The pull reads the inner nodes and
 // the children's flux as uniform texel buffers, gathers on lavapipe rather than a branch per
 // lane (shared/cache_lighting.h). Besides the children and 1 / (π·A) it holds the node's
-// flux spread (render/cpu/pull.h NodeSpread): its principal axes, the inverse variances along
+// flux spread (render/node_spread.h NodeSpread): its principal axes, the inverse variances along
 // them, the surfels' extent [low, high] along them and each child's flux centroid less the
 // node's.
 struct PullNode {
@@ -62,7 +62,7 @@ PullNode fetchPullNode(usamplerBuffer records, uint i) {
 }
 #endif
 
-// A node as cache lighting reads it: one RGBA32UI texel (render/cpu/pull.h ChannelSpread and
+// A node as cache lighting reads it: one RGBA32UI texel (render/node_spread.h ChannelSpread and
 // ExponentialSpread). Words 0-2 hold the slopes of its flux spread per channel along its
 // box's axes, nine snorm8: word 0 R.xyz G.x, word 1 G.yz B.xy, word 2 B.z in bits 0-7; word 3
 // the spread's radiance at the box centre, centre / (π·A), as RGBE8. A linear node's slopes
@@ -75,7 +75,7 @@ PullNode fetchPullNode(usamplerBuffer records, uint i) {
 PIC_CONST(uint, kNodeLightRadianceWord, 3u);
 PIC_CONST(uint, kNodeLightExponentialBit, 0x80000000u);
 // The largest Σ_k |slope_k| of an exponential spread: its reads span at most e^{±3} about the
-// box centre (render/cpu/pull.h).
+// box centre (render/node_spread.h).
 PIC_CONST(float, kExponentialSpreadCap, 3.0f);
 // ln Z of an exponential spread lies in [0, kConcentrationRange]: with Σ|slope| ≤ 3 and
 // a_k ≤ √3·halfExtent_k it is at most ln(sinh(3√3) / (3√3)) < 2.9.

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/cache_textures.h"
 #include "render/cpu/cache_shading.h"
-#include "render/cpu/lightmap_copy.h"
 #include "render/cpu_runtime.h"
 #include "tests/support/baked_scene.h"
 

@@ -17,6 +17,7 @@
 #include "core/geometry.h"
 #include "core/sh.h"
 #include "render/cpu/cache_lighting.h"
+#include "render/node_spread.h"
 
 namespace pic {
 namespace {
@@ -282,7 +283,7 @@ TEST(CacheLighting, ALinksTintMultipliesItsNodesFluxPerChannel) {
 }
 
 TEST(CacheLighting, AnExponentialNodeIsReadAtTheLinksPointAndSpreadShare) {
-    // Through an exponential node (render/cpu/pull.h) a link at box point u with spread share
+    // Through an exponential node (render/node_spread.h) a link at box point u with spread share
     // ρ carries centre ∘ exp(slopes·u − (1 − ρ)·ln Z) per channel: the same cache as a linear
     // node holding that flux evenly, in both link forms, tinted or not.
     const glm::vec3 u(0.5f, -0.25f, 1.0f);

@@ -1,6 +1,6 @@
-// The pull's CPU twin (render/cpu/pull.h): inner nodes of a three-level hierarchy hold the
-// exact sums of their leaves; the limited linear and the exponential flux spreads and the box
-// points links read them at.
+// The pull's CPU twin (render/cpu/pull.h) and the node spreads (render/node_spread.h): inner
+// nodes of a three-level hierarchy hold the exact sums of their leaves; the limited linear and
+// the exponential flux spreads and the box points links read them at.
 
 #include <gtest/gtest.h>
 
@@ -9,6 +9,7 @@
 
 #include "core/bake_data.h"
 #include "render/cpu/pull.h"
+#include "render/node_spread.h"
 
 namespace pic {
 namespace {

@@ -14,6 +14,7 @@
 #include "core/light_set.h"
 #include "rays/embree_scene.h"
 #include "render/cpu/surfel_lighting.h"
+#include "render/surfel_visibility.h"
 #include "tests/support/lights.h"
 
 namespace pic {

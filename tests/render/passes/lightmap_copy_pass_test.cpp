@@ -1,6 +1,6 @@
 // The light-map copy pass on lavapipe (or the machine's GPU) against its CPU twin
-// (render/cpu/lightmap_copy.h): the same grid and light-map layers, to half-float rounding,
-// and the same coverage.
+// (core/cache_textures.h copyCachesToTextures): the same grid and light-map layers, to
+// half-float rounding, and the same coverage.
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,6 @@
 #include "core/cache_textures.h"
 #include "core/light_set.h"
 #include "render/cpu/cache_lighting.h"
-#include "render/cpu/lightmap_copy.h"
 #include "tests/render/gpu_fixture.h"
 
 namespace pic {

@@ -14,6 +14,7 @@
 #include "core/color.h"
 #include "core/light_set.h"
 #include "render/cpu/pull.h"
+#include "render/node_spread.h"
 #include "render/passes/pull_pass.h"
 #include "shaders/shared/pull.h"
 #include "tests/render/gpu_fixture.h"

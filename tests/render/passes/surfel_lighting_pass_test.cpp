@@ -12,6 +12,7 @@
 #include "core/light_set.h"
 #include "render/cpu/cache_lighting.h"
 #include "render/cpu/surfel_lighting.h"
+#include "render/surfel_visibility.h"
 #include "tests/render/gpu_fixture.h"
 
 namespace pic {
