@@ -90,8 +90,9 @@ public:
     Result<void> setCaches(const CacheTextures& textures);
 
     /// Renders `camera`'s view lit by `lights` as `params` asks: params.component selects
-    /// full (visible emission + direct + cache term), direct or indirect (the cache term,
-    /// with the glossy lobe when glossyWeight and glossyExponent are > 0); misses are black.
+    /// full (visible emission + direct + cache term), direct, indirect (the cache term, with
+    /// the glossy lobe when glossyWeight and glossyExponent are > 0) or glossy (the lobe
+    /// alone); the cache term takes the light set's indirect scales; misses are black.
     /// samplesPerPixel subsamples per pixel, averaged (1: the pixel centre); the frame's cost
     /// grows with them, shadow maps aside. Never NaN, infinite or negative for accepted
     /// inputs. InvalidInput for sizes outside 1..16384, sample counts outside
