@@ -22,9 +22,8 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 SCENES=$HERE/../../shared/scenes
 mkdir -p "$OUT"
 
-SERVER_PID=
-stop_server() { if [ -n "$SERVER_PID" ]; then kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true; SERVER_PID=; fi; }
-trap stop_server EXIT
+# shellcheck source=server_session.sh
+source "$HERE/server_session.sh"
 
 # The relative RMSE of `picbench compare`'s row for block size $2 in its output $1.
 rmse_at() { awk -v b="$2x$2" '$1 == b { print $2 }' <<<"$1"; }
@@ -41,25 +40,12 @@ run_case() {
   local ref="$OUT/${name}_ref.exr"
   [ -f "$ref" ] || "$PICREF" --quiet "$scene" "${light_args[@]}" "${camera[@]}" --size "$size" \
     --spp "$SPP" --out "$ref"
-  "$PICSERVER" --quiet --bake "$bake" --scene "$scene" --listen 127.0.0.1:0 --backend cpu \
-    > "$OUT/${name}_server.log" 2>&1 &
-  SERVER_PID=$!
-  local address=
-  for _ in $(seq 600); do
-    address=$(sed -n 's/^listening on //p' "$OUT/${name}_server.log" | head -1)
-    [ -n "$address" ] && break
-    sleep 0.1
-  done
-  [ -n "$address" ] || { echo "picserver did not start:"; cat "$OUT/${name}_server.log"; exit 1; }
-  local session token
-  session=$("$PICCLIENT" session --server "$address")
-  token=$(echo "$session" | sed -n 's/.*"editor_token": *"\([^"]*\)".*/\1/p')
-  session=$(echo "$session" | sed -n 's/.*"session": *"\([^"]*\)".*/\1/p')
+  start_session "$bake" "$scene" "$OUT/${name}_server.log"
   for n in $SAMPLES; do
     local gpu="$OUT/${name}_gpu_s$n.exr" cpu="$OUT/${name}_cpu_s$n.exr" times=()
     for _ in 1 2 3; do
       local log
-      log=$("$PICCLIENT" render --server "$address" --session "$session" --token "$token" \
+      log=$("$PICCLIENT" render --server "$ADDRESS" --session "$SESSION" --token "$TOKEN" \
         "${light_args[@]}" "${camera[@]}" --size "$size" --samples "$n" \
         --cache-dir "$OUT/client_cache" --out "$gpu" 2>&1 >/dev/null)
       times+=("$(sed -E 's/.*samples per pixel, on "[^"]*" ([0-9.]+) ms.*/\1/' <<<"$log")")

@@ -21,29 +21,15 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 SCENES=$HERE/../../shared/scenes
 mkdir -p "$OUT"
 
-SERVER_PID=
-stop_server() { if [ -n "$SERVER_PID" ]; then kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true; SERVER_PID=; fi; }
-trap stop_server EXIT
+# shellcheck source=server_session.sh
+source "$HERE/server_session.sh"
 
 # run_case NAME SCENE LIGHTS CAMERA SIZE: one view, both components, both shading paths.
 run_case() {
   local name=$1 scene=$2 lights=$3 camera=$4 size=$5
   local bake="$OUT/${name%%-*}.pic"
   [ -f "$bake" ] || "$PICBAKE" --quiet bake "$scene" -o "$bake" > "$OUT/${name%%-*}_bake.log"
-  "$PICSERVER" --quiet --bake "$bake" --scene "$scene" --listen 127.0.0.1:0 --backend cpu \
-    > "$OUT/${name}_server.log" 2>&1 &
-  SERVER_PID=$!
-  local address=
-  for _ in $(seq 600); do
-    address=$(sed -n 's/^listening on //p' "$OUT/${name}_server.log" | head -1)
-    [ -n "$address" ] && break
-    sleep 0.1
-  done
-  [ -n "$address" ] || { echo "picserver did not start:"; cat "$OUT/${name}_server.log"; exit 1; }
-  local session token
-  session=$("$PICCLIENT" session --server "$address")
-  token=$(echo "$session" | sed -n 's/.*"editor_token": *"\([^"]*\)".*/\1/p')
-  session=$(echo "$session" | sed -n 's/.*"session": *"\([^"]*\)".*/\1/p')
+  start_session "$bake" "$scene" "$OUT/${name}_server.log"
   for component in direct full; do
     local bounces=()
     [ "$component" = direct ] && bounces=(--bounces 0)
@@ -52,7 +38,7 @@ run_case() {
       --spp "$SPP" "${bounces[@]}" --component "$component" --out "$ref"
     "$PICREF" shade --quiet "$scene" --bake "$bake" --lights "$lights" --camera "$camera" \
       --size "$size" --component "$component" --spp 1 --out "$OUT/${name}_${component}_cpu.exr" 2> /dev/null
-    "$PICCLIENT" render --server "$address" --session "$session" --token "$token" \
+    "$PICCLIENT" render --server "$ADDRESS" --session "$SESSION" --token "$TOKEN" \
       --lights "$lights" --camera "$camera" --size "$size" --component "$component" --samples 1 \
       --cache-dir "$OUT/client_cache" --out "$OUT/${name}_${component}_gpu.exr" 2> /dev/null
     for path in cpu gpu; do

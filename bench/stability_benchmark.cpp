@@ -279,11 +279,11 @@ Result<MovingLightResult> runMovingLight(const Scene& scene, const EmbreeScene& 
         for (uint32_t k = 0; k < steps; ++k) {
             lights.lights[0].position = result.path[k];
             PIC_TRY(blend.push(versions[k], double(k)));
+            const double newest = meanLuminance(linked[k]);
             for (uint32_t j = 0; j < framesPerUpdate; ++j) {
                 const CacheValues* shown = blend.at(double(k) + double(j) / framesPerUpdate);
                 PIC_TRY_ASSIGN(Image frame,
                                shadeFromCaches(scene, rays, bake, *shown, lights, camera, shade));
-                const double newest = meanLuminance(linked[k]);
                 double distance = 0.0;
                 for (size_t i = 0; i < frame.pixels.size(); ++i)
                     distance += std::abs(double(luminance(frame.pixels[i])) -

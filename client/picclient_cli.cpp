@@ -217,16 +217,54 @@ int runLoad(const Common& common, const LoadOptions& options, const std::string&
     return (*report)["errors"].get<uint64_t>() == 0 ? 0 : 1;
 }
 
-struct RenderCommand {
-    std::string lightsPath;
+/// What `render` and `record` draw with: the view, the shading, the device, the shadow maps,
+/// subsamples per pixel and where downloaded scenes are kept.
+struct DrawFlags {
     ViewFlags view;
     ShadeFlags shade;
-    ImageOutputFlags output;
     std::string device;
     uint32_t shadowMapSize = 1024;
-    uint32_t samples = 4;
+    uint32_t samples = 1;
+    std::string cacheDir = defaultCacheDir();
+
+    /// Adds the flags to `command`; `samplesHelp` says what --samples defaults to there.
+    void addTo(CLI::App& command, const char* samplesHelp) {
+        view.addTo(command);
+        shade.addTo(command);
+        addDeviceOption(command, device);
+        command.add_option("--shadow-map-size", shadowMapSize,
+                           "texels per side of each shadow-map layer")
+            ->check(CLI::Range(16u, 16384u));
+        command.add_option("--samples", samples, samplesHelp)
+            ->check(CLI::Range(1u, kMaxSamplesPerPixel));
+        command.add_option("--cache-dir", cacheDir, "where downloaded scenes are kept");
+    }
+};
+
+/// A Vulkan context on the asked device and a renderer of `scene` in it (declared in that
+/// order: the renderer goes first).
+struct ClientRenderer {
+    std::unique_ptr<gpu::Context> context;
+    std::unique_ptr<Renderer> renderer;
+};
+
+Result<ClientRenderer> createRenderer(const DrawFlags& flags, const Scene& scene,
+                                      const ClientLayout& layout) {
+    gpu::ContextOptions contextOptions;
+    contextOptions.deviceName = flags.device;
+    ClientRenderer out;
+    PIC_TRY_ASSIGN(out.context, gpu::Context::create(contextOptions));
+    RendererOptions options;
+    options.shadowMapSize = flags.shadowMapSize;
+    PIC_TRY_ASSIGN(out.renderer, Renderer::create(*out.context, scene, layout, options));
+    return out;
+}
+
+struct RenderCommand {
+    std::string lightsPath;
+    DrawFlags draw;
+    ImageOutputFlags output;
     ObjectFlags objects;
-    std::string cacheDir;
     double waitSeconds = 60;
 };
 
@@ -251,12 +289,8 @@ Result<void> placeInto(ViewScene& view, const ClientScene& client,
     const double covered =
         gridCoverage(view.placed, client.scene.vertices.size(), view.layout.gridOrigin,
                      view.layout.gridCellSize, view.layout.gridDims, client.gridCaches);
-    if (covered < 0.9)
-        std::fprintf(stderr,
-                     "picclient render: warning: %.0f %% of the objects' vertices have no grid "
-                     "cache around them and get no indirect light there; a bake made with "
-                     "--grid-caches space fills the grid for dynamic objects\n",
-                     100.0 * (1.0 - covered));
+    if (const std::string warning = gridCoverageWarning(covered); !warning.empty())
+        std::fprintf(stderr, "picclient render: warning: %s\n", warning.c_str());
     return {};
 }
 
@@ -265,7 +299,8 @@ int runRender(const Common& common, const RenderCommand& command) {
     const auto since = [](Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
     };
-    auto view = command.view.toView();
+    const DrawFlags& draw = command.draw;
+    auto view = draw.view.toView();
     if (!view) return reportError(view.error());
     if (auto output = command.output.check(); !output) return reportError(output.error());
     PIC_TRY_ASSIGN_OR_EXIT(const std::vector<ObjectPlacement> placements,
@@ -281,7 +316,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     if (!joined) return reportError(joined.error());
     const auto sceneStart = Clock::now();
     bool downloaded = false;
-    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir, &downloaded);
+    auto client = connection->fetchScene(joined->bake_id(), draw.cacheDir, &downloaded);
     if (!client) return reportError(client.error());
     const double sceneMs = since(sceneStart);
 
@@ -355,18 +390,11 @@ int runRender(const Common& common, const RenderCommand& command) {
     // newer than the one pushed or joined.
     if (decoder.lights()) lights = *decoder.lights();
 
-    gpu::ContextOptions contextOptions;
-    contextOptions.deviceName = command.device;
-    auto context = gpu::Context::create(contextOptions);
-    if (!context) return reportError(context.error());
-    RendererOptions rendererOptions;
-    rendererOptions.shadowMapSize = command.shadowMapSize;
-    auto renderer = Renderer::create(**context, *shown.scene, shown.layout, rendererOptions);
-    if (!renderer) return reportError(renderer.error());
-    if (auto set = (*renderer)->setCaches(*textures); !set) return reportError(set.error());
+    PIC_TRY_ASSIGN_OR_EXIT(ClientRenderer renderer, createRenderer(draw, *shown.scene, shown.layout));
+    if (auto set = renderer.renderer->setCaches(*textures); !set) return reportError(set.error());
     RenderTimings timings;
-    auto image = (*renderer)->render(lights, *camera,
-                                     command.shade.toParams(view->size, command.samples), &timings);
+    auto image = renderer.renderer->render(lights, *camera,
+                                           draw.shade.toParams(view->size, draw.samples), &timings);
     if (!image) return reportError(image.error());
     if (auto written = command.output.write(*image); !written) return reportError(written.error());
 
@@ -383,7 +411,7 @@ int runRender(const Common& common, const RenderCommand& command) {
         (unsigned long long)decoder.version(),
         pushed ? "light change to decoded frame" : "current frame received and decoded in",
         latencyMs, serverMs, bytes, decodeMs, texturesMs, view->size.x, view->size.y,
-        command.shade.component().c_str(), command.samples, (*context)->deviceName().c_str(),
+        draw.shade.component().c_str(), draw.samples, renderer.context->deviceName().c_str(),
         timings.totalMs,
         passes.c_str(), since(start), command.output.path().c_str());
     std::printf("%s\n", command.output.path().c_str());
@@ -391,12 +419,7 @@ int runRender(const Common& common, const RenderCommand& command) {
 }
 
 struct RecordCommand {
-    ViewFlags view;
-    ShadeFlags shade;
-    std::string device;
-    uint32_t shadowMapSize = 1024;
-    uint32_t samples = 1;
-    std::string cacheDir;
+    DrawFlags draw;
     double fps = 10.0;
     double durationSeconds = 10.0;
     double blendSeconds = 0.5;
@@ -408,12 +431,13 @@ struct RecordCommand {
 /// A version the stream delivered: its caches and light set, and when it arrived.
 struct Arrival {
     CacheValues values;
-    LightSet lights;
+    std::optional<LightSet> lights;  ///< what the frame named (servers before frames did: none)
     Clock::time_point at;
 };
 
 int runRecord(const Common& common, const RecordCommand& command) {
-    auto view = command.view.toView();
+    const DrawFlags& draw = command.draw;
+    auto view = draw.view.toView();
     if (!view) return reportError(view.error());
     if (auto ok = CacheBlend::check(command.blendSeconds); !ok) return reportError(ok.error());
     std::error_code ec;
@@ -424,19 +448,12 @@ int runRecord(const Common& common, const RecordCommand& command) {
     PIC_TRY_ASSIGN_OR_EXIT(auto connection, connectTo(common));
     auto joined = connection->joinSession(common.session, common.token);
     if (!joined) return reportError(joined.error());
-    auto client = connection->fetchScene(joined->bake_id(), command.cacheDir);
+    auto client = connection->fetchScene(joined->bake_id(), draw.cacheDir);
     if (!client) return reportError(client.error());
     auto camera = view->cameraIn(client->scene);
     if (!camera) return reportError(camera.error());
-    gpu::ContextOptions contextOptions;
-    contextOptions.deviceName = command.device;
-    auto context = gpu::Context::create(contextOptions);
-    if (!context) return reportError(context.error());
-    RendererOptions rendererOptions;
-    rendererOptions.shadowMapSize = command.shadowMapSize;
-    auto renderer =
-        Renderer::create(**context, client->scene, clientLayoutOf(*client), rendererOptions);
-    if (!renderer) return reportError(renderer.error());
+    PIC_TRY_ASSIGN_OR_EXIT(ClientRenderer renderer,
+                           createRenderer(draw, client->scene, clientLayoutOf(*client)));
 
     // The stream is read on its own thread (next() blocks); the frames are drawn here at their
     // times, each from the caches blended up to that moment.
@@ -457,7 +474,9 @@ int runRecord(const Common& common, const RecordCommand& command) {
                 return;
             }
             arrived.push_back({std::move(*values),
-                               decoder.lights() ? *decoder.lights() : LightSet{}, Clock::now()});
+                               decoder.lights() ? std::optional<LightSet>(*decoder.lights())
+                                                : std::nullopt,
+                               Clock::now()});
         }
     });
     const auto stop = [&] {
@@ -467,13 +486,14 @@ int runRecord(const Common& common, const RecordCommand& command) {
 
     CacheBlend blend(command.blendSeconds);
     std::optional<LightSet> lights;
-    const ShadeParams params = command.shade.toParams(view->size, command.samples);
+    const ShadeParams params = draw.shade.toParams(view->size, draw.samples);
     const auto start = Clock::now();
     const auto seconds = [&](Clock::time_point t) {
         return std::chrono::duration<double>(t - start).count();
     };
     const auto period = std::chrono::duration<double>(1.0 / command.fps);
     uint32_t frames = 0, versions = 0;
+    bool uploadedSettled = false;  // the textures hold the settled newest version
     double renderMs = 0.0;
     for (auto due = start; seconds(due) < command.durationSeconds;
          due += std::chrono::duration_cast<Clock::duration>(period)) {
@@ -487,7 +507,9 @@ int runRecord(const Common& common, const RecordCommand& command) {
                     return reportError(pushed.error());
                 }
                 // The direct light follows the newest light set at once; the caches blend.
-                if (!a.lights.lights.empty() || !lights) lights = std::move(a.lights);
+                if (a.lights) lights = std::move(a.lights);
+                if (!lights) lights = LightSet{};
+                uploadedSettled = false;
                 ++versions;
             }
             arrived.clear();
@@ -495,12 +517,16 @@ int runRecord(const Common& common, const RecordCommand& command) {
         const double now = std::max(seconds(Clock::now()), seconds(due));
         const CacheValues* shown = blend.at(now);
         if (!shown) continue;  // nothing received yet
-        if (auto set = (*renderer)->setCaches(cacheTexturesOf(*client, *shown)); !set) {
-            stop();
-            return reportError(set.error());
+        // Once a blend has settled the textures hold its version until the next arrives.
+        if (!uploadedSettled) {
+            if (auto set = renderer.renderer->setCaches(cacheTexturesOf(*client, *shown)); !set) {
+                stop();
+                return reportError(set.error());
+            }
+            uploadedSettled = blend.settled(now);
         }
         RenderTimings timings;
-        auto image = (*renderer)->render(*lights, *camera, params, &timings);
+        auto image = renderer.renderer->render(*lights, *camera, params, &timings);
         if (!image) {
             stop();
             return reportError(image.error());
@@ -590,7 +616,7 @@ int picclientMain(int argc, char** argv) {
     loadCommand->add_option("--report", reportPath, "JSON report to write")->required();
 
     RenderCommand render;
-    render.cacheDir = defaultCacheDir();
+    render.draw.samples = 4;
     CLI::App* renderCommand = app.add_subcommand(
         "render", "render one frame headless (Vulkan: a GPU, else lavapipe) shaded with the "
                   "session's current caches; --lights (editor token) is applied first");
@@ -598,39 +624,22 @@ int picclientMain(int argc, char** argv) {
     addSession(*renderCommand, common);
     renderCommand->add_option("--lights", render.lightsPath,
                               "light set JSON to push first (needs the editor token)");
-    render.view.addTo(*renderCommand);
-    render.shade.addTo(*renderCommand);
+    render.draw.addTo(*renderCommand,
+                      "subsamples per pixel, averaged: anti-aliasing, each costs a G-buffer and "
+                      "a shading pass (default 4; 1: pixel centres; picref shade --spp N is the "
+                      "CPU counterpart)");
     render.output.addTo(*renderCommand);
-    addDeviceOption(*renderCommand, render.device);
-    renderCommand->add_option("--shadow-map-size", render.shadowMapSize,
-                              "texels per side of each shadow-map layer")
-        ->check(CLI::Range(16u, 16384u));
-    renderCommand->add_option("--samples", render.samples,
-                              "subsamples per pixel, averaged: anti-aliasing, each costs a "
-                              "G-buffer and a shading pass (default 4; 1: pixel centres; "
-                              "picref shade --spp N is the CPU counterpart)")
-        ->check(CLI::Range(1u, kMaxSamplesPerPixel));
     render.objects.addTo(*renderCommand);
-    renderCommand->add_option("--cache-dir", render.cacheDir, "where downloaded scenes are kept");
     renderCommand->add_option("--wait", render.waitSeconds, "seconds to wait for the version")
         ->check(CLI::PositiveNumber);
 
     RecordCommand record;
-    record.cacheDir = defaultCacheDir();
     CLI::App* recordCommand = app.add_subcommand(
         "record", "render the session's stream as a sequence of frames at a fixed rate, each "
                   "from the caches blended over time from one version to the next");
     addServer(*recordCommand, common);
     addSession(*recordCommand, common);
-    record.view.addTo(*recordCommand);
-    record.shade.addTo(*recordCommand);
-    addDeviceOption(*recordCommand, record.device);
-    recordCommand->add_option("--shadow-map-size", record.shadowMapSize,
-                              "texels per side of each shadow-map layer")
-        ->check(CLI::Range(16u, 16384u));
-    recordCommand->add_option("--samples", record.samples,
-                              "subsamples per pixel, averaged (default 1)")
-        ->check(CLI::Range(1u, kMaxSamplesPerPixel));
+    record.draw.addTo(*recordCommand, "subsamples per pixel, averaged (default 1)");
     recordCommand->add_option("--fps", record.fps, "frames per second (default 10)")
         ->check(CLI::Range(0.1, 240.0));
     recordCommand->add_option("--duration", record.durationSeconds,
@@ -645,7 +654,6 @@ int picclientMain(int argc, char** argv) {
     recordCommand->add_option("--exposure", record.exposure,
                               "factor applied before PNG quantisation (default 1)")
         ->check(CLI::PositiveNumber);
-    recordCommand->add_option("--cache-dir", record.cacheDir, "where downloaded scenes are kept");
     recordCommand->add_option("--out-dir", record.outDir, "folder for frame_00000.png, …")
         ->required();
 

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <system_error>
 
+#include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/bake_data.h"
@@ -145,6 +146,14 @@ double gridCoverage(const Scene& scene, size_t firstVertex, const glm::vec3& ori
         covered += any ? 1 : 0;
     }
     return double(covered) / double(scene.vertices.size() - firstVertex);
+}
+
+std::string gridCoverageWarning(double coverage) {
+    if (coverage >= 0.9) return {};
+    return fmt::format("{:.0f} % of the objects' vertices have no grid cache around them and get "
+                       "no indirect light there; a bake made with --grid-caches space fills the "
+                       "grid for dynamic objects",
+                       100.0 * (1.0 - coverage));
 }
 
 }  // namespace pic

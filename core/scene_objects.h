@@ -47,4 +47,9 @@ Result<Scene> placeObjects(const Scene& base, const std::vector<ObjectPlacement>
 double gridCoverage(const Scene& scene, size_t firstVertex, const glm::vec3& origin,
                     float cellSize, const glm::uvec3& dims, const std::vector<uint32_t>& cacheIndex);
 
+/// What a program warns when the objects find a grid cache around fewer than 90 % of their
+/// vertices (`coverage` from gridCoverage), naming the bake mode that fills the grid; empty
+/// when they find enough.
+std::string gridCoverageWarning(double coverage);
+
 }  // namespace pic

@@ -125,12 +125,8 @@ int runShade(const ShadeCommand& command) {
         const double covered =
             gridCoverage(placed, scene->vertices.size(), bake->grid.origin, bake->grid.cellSize,
                          bake->grid.dims, bake->grid.cacheIndex);
-        if (covered < 0.9)
-            std::fprintf(stderr,
-                         "picref shade: warning: %.0f %% of the objects' vertices have no grid "
-                         "cache around them; a bake made with --grid-caches space fills the "
-                         "grid for dynamic objects\n",
-                         100.0 * (1.0 - covered));
+        if (const std::string warning = gridCoverageWarning(covered); !warning.empty())
+            std::fprintf(stderr, "picref shade: warning: %s\n", warning.c_str());
         shaded = &placed;
         shadedRays = placedRays.get();
         shadedBake = &withObjects;

@@ -731,13 +731,26 @@ TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
 }
 
 
-TEST(StreamCli, PicserverAndPicclientEndToEnd) {
-    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
-                          "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet"});
-    ASSERT_GT(server.pid(), 0);
+/// picserver as a child on a free loopback port serving the fixture's bake on the CPU backend
+/// (one bounce), with `extra` flags after those: its address, or "" with a test failure.
+std::string startCliServer(Child& server, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args{PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene,
+                                  "--listen", "127.0.0.1:0", "--backend", "cpu", "--bounces",
+                                  "1", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    server = Child(args);
+    EXPECT_GT(server.pid(), 0);
+    if (server.pid() <= 0) return "";
     const std::string first = readLine(server.out());
-    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
-    const std::string address = first.substr(std::string("listening on ").size());
+    EXPECT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
+    if (!first.starts_with("listening on ")) return "";
+    return first.substr(std::string("listening on ").size());
+}
+
+TEST(StreamCli, PicserverAndPicclientEndToEnd) {
+    Child server;
+    const std::string address = startCliServer(server);
+    ASSERT_FALSE(address.empty());
     EXPECT_NE(address, "127.0.0.1:0");
 
     int exit = 0;
@@ -880,12 +893,9 @@ TEST(StreamCli, PicserverAndPicclientEndToEnd) {
 // light change every pixel moves monotonically from the old version's value to the new one's,
 // some frames show the light part of the way, and the last frames show the new version.
 TEST(StreamCli, RecordBlendsFromOneVersionToTheNext) {
-    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
-                  "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet"});
-    ASSERT_GT(server.pid(), 0);
-    const std::string first = readLine(server.out());
-    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
-    const std::string address = first.substr(std::string("listening on ").size());
+    Child server;
+    const std::string address = startCliServer(server);
+    ASSERT_FALSE(address.empty());
     int exit = 0;
     const std::string client = PIC_PICCLIENT;
     const std::string created = run(client + " session --server " + address, exit);
@@ -959,13 +969,10 @@ TEST(StreamCli, RecordBlendsFromOneVersionToTheNext) {
 
 TEST(StreamCli, TlsServerAndClient) {
     const std::string tls = PIC_TEST_TLS_DIR;
-    Child server({PIC_PICSERVER, "--bake", bakePath(), "--scene", kScene, "--listen",
-                          "127.0.0.1:0", "--backend", "cpu", "--bounces", "1", "--quiet",
-                          "--tls-cert", tls + "/server.crt", "--tls-key", tls + "/server.key"});
-    ASSERT_GT(server.pid(), 0);
-    const std::string first = readLine(server.out());
-    ASSERT_TRUE(first.starts_with("listening on 127.0.0.1:")) << first;
-    const std::string address = first.substr(std::string("listening on ").size());
+    Child server;
+    const std::string address =
+        startCliServer(server, {"--tls-cert", tls + "/server.crt", "--tls-key", tls + "/server.key"});
+    ASSERT_FALSE(address.empty());
     int exit = 0;
     const std::string client = PIC_PICCLIENT;
     std::string created = run(client + " session --server " + address + " --tls-ca " + tls +
