@@ -7,12 +7,12 @@
 #include "render/node_spread.h"
 #include "render/passes/cache_lighting_pass.h"
 #include "render/passes/lightmap_copy_pass.h"
+#include "render/passes/pass.h"
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/sh_tables.h"
-#include "render/surfel_visibility.h"
 
 namespace pic {
 namespace {
@@ -85,22 +85,28 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
 
     mVisibility = options.directVisibility.value_or(
         ctx.isCpuDevice() ? DirectVisibility::Rays : DirectVisibility::ShadowMaps);
-    if (mVisibility == DirectVisibility::Rays) {
-        PIC_TRY_ASSIGN(mRayVisibility, RayVisibilityPass::create(ctx, rays, mBake));
-    } else {
-        PIC_TRY_ASSIGN(mShadows,
-                       ShadowMapPass::create(ctx, mScene, options.shadowMapSize,
-                                             {.levelsOfDetail = options.casterLevelsOfDetail,
-                                              .equalFootprint = options.shadowEqualFootprint}));
-    }
-    PIC_TRY_ASSIGN(mSurfels, SurfelLightingPass::create(ctx, mScene, mBake,
-                                                        surfelStencils(mScene, rays, mBake),
-                                                        rays.epsilon(), mVisibility));
+    // Every pass is made through the pass table (render/passes/pass.h) from one config.
     const NodeSpread spread = nodeSpread(mBake);
-    PIC_TRY_ASSIGN(mPull, PullPass::create(ctx, mBake, spread));
-    const bool cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice());
-    PIC_TRY_ASSIGN(mCacheLighting, CacheLightingPass::create(ctx, mBake, spread, cachePerSubgroup,
-                                                             options.maxLinkTexelWords));
+    const PassConfig config{
+        .scene = &mScene,
+        .bake = &mBake,
+        .rays = &rays,
+        .spread = &spread,
+        .visibility = mVisibility,
+        .shadowMapSize = options.shadowMapSize,
+        .shadowMap = {.levelsOfDetail = options.casterLevelsOfDetail,
+                      .equalFootprint = options.shadowEqualFootprint},
+        .cachePerSubgroup = options.cachePerSubgroup.value_or(!ctx.isCpuDevice()),
+        .maxLinkTexelWords = options.maxLinkTexelWords,
+    };
+    if (mVisibility == DirectVisibility::Rays) {
+        PIC_TRY_ASSIGN(mRayVisibility, createPass<RayVisibilityPass>(ctx, config));
+    } else {
+        PIC_TRY_ASSIGN(mShadows, createPass<ShadowMapPass>(ctx, config));
+    }
+    PIC_TRY_ASSIGN(mSurfels, createPass<SurfelLightingPass>(ctx, config));
+    PIC_TRY_ASSIGN(mPull, createPass<PullPass>(ctx, config));
+    PIC_TRY_ASSIGN(mCacheLighting, createPass<CacheLightingPass>(ctx, config));
     PIC_TRY(bindVisibility());
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeLight));
     PIC_TRY(mCacheLighting->bind(ctx, mNodeLight, mCacheY, mCacheCo, mCacheCg, mCacheIrradiance,
@@ -114,7 +120,8 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
 
 Result<gpu::LightmapCopyPass*> GpuRuntime::lightmapCopyPass() {
     if (!mLightmapCopy) {
-        PIC_TRY_ASSIGN(mLightmapCopy, gpu::LightmapCopyPass::create(*mContext, mBake));
+        PIC_TRY_ASSIGN(mLightmapCopy,
+                       gpu::createPass<gpu::LightmapCopyPass>(*mContext, {.bake = &mBake}));
         PIC_TRY(mLightmapCopy->bind(mCacheY, mCacheCo, mCacheCg));
     }
     return mLightmapCopy.get();
@@ -140,7 +147,7 @@ Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
 void GpuRuntime::recordShadowMaps(VkCommandBuffer cmd) {
     if (!mShadows) return;
     mTimer.begin(cmd, "shadow_maps");
-    mShadows->record(cmd);
+    mShadows->record(cmd, {});
 }
 
 void GpuRuntime::addVisibilityStats(UpdateStats& stats) const {
@@ -187,14 +194,16 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     // look at the sums tells which bounce is the last.
     const auto cacheBounce = [&](VkCommandBuffer cmd, const BounceStep& next, uint32_t sumSlot) {
         mTimer.begin(cmd, "pull");
-        mPull->record(cmd);
+        mPull->record(cmd, {});
         mTimer.begin(cmd, "cache_lighting");
-        mCacheLighting->record(cmd);
+        mCacheLighting->record(cmd, {});
         if (next.another) {
             // The caches are written before the surfels read them.
             gpu::computeBarrier(cmd);
             mTimer.begin(cmd, "surfel_lighting");
-            mSurfels->record(cmd, true, lightCount, sumSlot, next.tail);
+            mSurfels->record(
+                cmd,
+                {.bounce = true, .lightCount = lightCount, .sumSlot = sumSlot, .tail = next.tail});
         }
         // Everything written before the next submission's first pass reads it.
         gpu::computeBarrier(cmd);
@@ -208,7 +217,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         [&](VkCommandBuffer cmd) {
             recordShadowMaps(cmd);
             mTimer.begin(cmd, "surfel_lighting");
-            mSurfels->record(cmd, false, lightCount, 0);
+            mSurfels->record(cmd, {.lightCount = lightCount, .sumSlot = 0});
             // The leaves are written before the pull reads them.
             gpu::computeBarrier(cmd);
             cacheBounce(cmd, step, 1);
@@ -246,7 +255,7 @@ Result<const CacheTextures*> GpuRuntime::textures() {
             // the cache buffers.
             PIC_TRY_ASSIGN(gpu::LightmapCopyPass * pass, lightmapCopyPass());
             PIC_TRY(uploadCaches(mValues));
-            PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd); }));
+            PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd, {}); }));
             PIC_TRY(pass->read(*mContext, mTextures));
         }
         mTexturesCurrent = true;
@@ -321,7 +330,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runDirect(const LightSet& lights,
         [&](VkCommandBuffer cmd) {
             recordShadowMaps(cmd);
             mTimer.begin(cmd, "surfel_lighting");
-            mSurfels->record(cmd, false, uint32_t(lights.lights.size()), 0);
+            mSurfels->record(cmd, {.lightCount = uint32_t(lights.lights.size()), .sumSlot = 0});
         },
         stats));
     addVisibilityStats(stats);
@@ -334,7 +343,8 @@ Result<std::vector<glm::vec3>> GpuRuntime::runBounce(std::span<const glm::vec3> 
     PIC_CHECK_EQ(previous.irradiance.size(), mBake.caches.size());
     PIC_TRY(uploadFlux(direct, const_cast<gpu::Buffer&>(mSurfels->directFlux())));
     PIC_TRY(uploadCaches(previous));
-    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mSurfels->record(cmd, true, 0, 0); }));
+    PIC_TRY(
+        mContext->submit([&](VkCommandBuffer cmd) { mSurfels->record(cmd, {.bounce = true}); }));
     return downloadFlux(mNodeFlux, mBake.surfels.size());
 }
 
@@ -343,7 +353,7 @@ Result<std::vector<glm::vec3>> GpuRuntime::runPull(std::span<const glm::vec3> le
     std::vector<glm::vec3> nodes(mBake.nodes.size(), glm::vec3(0.0f));
     std::copy(leaves.begin(), leaves.end(), nodes.begin());
     PIC_TRY(uploadFlux(nodes, mNodeFlux));
-    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mPull->record(cmd); }));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { mPull->record(cmd, {}); }));
     return downloadFlux(mNodeFlux, mBake.nodes.size());
 }
 
@@ -375,7 +385,7 @@ Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::uvec4> nod
     PIC_CHECK_EQ(nodeLight.size(), mBake.nodes.size());
     PIC_TRY(mContext->upload(mNodeLight, nodeLight.data(), nodeLight.size_bytes()));
     PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
-        mCacheLighting->record(cmd);
+        mCacheLighting->record(cmd, {});
         recordCacheReadback(cmd);
     }));
     CacheValues values = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
@@ -387,7 +397,7 @@ Result<CacheValues> GpuRuntime::runCacheLighting(std::span<const glm::uvec4> nod
 Result<CacheTextures> GpuRuntime::runLightmapCopy(const CacheValues& values) {
     PIC_TRY_ASSIGN(gpu::LightmapCopyPass * pass, lightmapCopyPass());
     PIC_TRY(uploadCaches(values));
-    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd); }));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) { pass->record(cmd, {}); }));
     CacheTextures textures = makeCacheTextures(mBake);
     PIC_TRY(pass->read(*mContext, textures));
     mTexturesCurrent = false;

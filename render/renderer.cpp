@@ -8,6 +8,7 @@
 #include "core/sh.h"
 #include "render/passes/cache_shading_pass.h"
 #include "render/passes/gbuffer_pass.h"
+#include "render/passes/pass.h"
 #include "render/passes/shadow_map_pass.h"
 #include "render/runtime.h"
 #include "render/sh_tables.h"
@@ -137,11 +138,19 @@ Result<void> Renderer::init(const RendererOptions& options) {
     // The CPU twin's ray offset (rays/embree_scene.h EmbreeScene::epsilon), so that shadow
     // tests start from the same height above the surface.
     mEpsilon = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
-    PIC_TRY_ASSIGN(mShadows, ShadowMapPass::create(mContext, mScene, options.shadowMapSize));
-    PIC_TRY_ASSIGN(mGbuffer, GbufferPass::create(mContext, mScene, mLayout.triangleUvs));
-    PIC_TRY_ASSIGN(mShading, CacheShadingPass::create(
-                                 mContext, mLayout.bandsY, mLayout.bandsC, mLayout.gridDims,
-                                 {mLayout.lightmapWidth, mLayout.lightmapHeight}));
+    // Every pass is made through the pass table (render/passes/pass.h) from one config.
+    const PassConfig config{
+        .scene = &mScene,
+        .shadowMapSize = options.shadowMapSize,
+        .triangleUvs = mLayout.triangleUvs,
+        .bandsY = mLayout.bandsY,
+        .bandsC = mLayout.bandsC,
+        .gridDims = mLayout.gridDims,
+        .lightmapSize = {mLayout.lightmapWidth, mLayout.lightmapHeight},
+    };
+    PIC_TRY_ASSIGN(mShadows, createPass<ShadowMapPass>(mContext, config));
+    PIC_TRY_ASSIGN(mGbuffer, createPass<GbufferPass>(mContext, config));
+    PIC_TRY_ASSIGN(mShading, createPass<CacheShadingPass>(mContext, config));
     const ShTables tables = makeShTables();
     PIC_TRY_ASSIGN(mShTables, Buffer::createWith(mContext, &tables, sizeof(tables),
                                                  VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "SH tables"));
@@ -188,7 +197,10 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
 
     const float near = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
 
-    gpu::CacheShadingPush push{};
+    // What the G-buffer and shading passes record with: the shading's push here, the
+    // G-buffer's per subsample.
+    gpu::FrameResources frame{};
+    gpu::CacheShadingPush& push = frame.shading;
     push.eye = camera.eye;
     push.component = params.component == ShadeComponent::Full       ? gpu::kShadeFull
                      : params.component == ShadeComponent::Direct   ? gpu::kShadeDirect
@@ -215,7 +227,7 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
         [&](VkCommandBuffer cmd) {
             if (direct) {
                 mTimer.begin(cmd, "shadow_maps");
-                mShadows->record(cmd);
+                mShadows->record(cmd, {});
             }
             // One G-buffer and one shading pass per subsample (the CPU twin's offsets and
             // footprints, render/cpu/cache_shading.h), each adding to the pixel's sum.
@@ -223,9 +235,10 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
             for (uint32_t s = 0; s < n; ++s) {
                 if (s == 1) mTimer.begin(cmd, "subsamples");
                 if (s == 0) mTimer.begin(cmd, "gbuffer");
-                mGbuffer->record(cmd, gpu::gbufferPushOf(camera, params.width, params.height,
-                                                         near, subsampleOffset(s, n),
-                                                         1.0f / std::sqrt(float(n))));
+                frame.gbuffer =
+                    gpu::gbufferPushOf(camera, params.width, params.height, near,
+                                       subsampleOffset(s, n), 1.0f / std::sqrt(float(n)));
+                mGbuffer->record(cmd, frame);
                 if (s == 0) mTimer.begin(cmd, "cache_shading");
                 if (s > 0) {
                     // The previous subsample's sums are written before this one adds to them.
@@ -237,7 +250,7 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
                                          nullptr, 0, nullptr);
                 }
                 push.accumulate = s > 0 ? 1u : 0u;
-                mShading->record(cmd, push);
+                mShading->record(cmd, frame);
             }
             // The shader's writes are visible to the host's read of the radiance.
             VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};

@@ -77,11 +77,13 @@ uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea) {
         float(double(halfToFloat(coefficient)) * std::numbers::pi * double(nodeArea)));
 }
 
-Result<std::unique_ptr<CacheLightingPass>> CacheLightingPass::create(Context& context,
-                                                                     const BakeData& bake,
-                                                                     const NodeSpread& spread,
-                                                                     bool cachePerSubgroup,
-                                                                     uint32_t maxTexelWords) {
+Result<std::unique_ptr<Pass>> CacheLightingPass::create(Context& context,
+                                                        const PassConfig& config) {
+    PIC_CHECK(config.bake != nullptr && config.spread != nullptr);
+    const BakeData& bake = *config.bake;
+    const NodeSpread& spread = *config.spread;
+    const bool cachePerSubgroup = config.cachePerSubgroup;
+    const uint32_t maxTexelWords = config.maxLinkTexelWords;
     std::unique_ptr<CacheLightingPass> pass(new CacheLightingPass());
     // Per subgroup: as many caches per workgroup as it has subgroups of the default size (the
     // shader strides over any the device leaves, should it launch fewer).
@@ -234,7 +236,7 @@ Result<void> CacheLightingPass::bind(Context& context, const Buffer& nodeLight,
     return {};
 }
 
-void CacheLightingPass::record(VkCommandBuffer cmd) {
+void CacheLightingPass::record(VkCommandBuffer cmd, const FrameResources&) {
     // Chunks write disjoint caches: no barrier between them.
     for (size_t k = 0; k < mSets.size(); ++k) {
         const CacheLightingPush push{mChunkFirst[k], mChunkCount[k], 0, 0};

@@ -13,6 +13,7 @@
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
 #include "render/node_spread.h"
+#include "render/passes/pass.h"
 #include "shaders/shared/cache_lighting.h"
 
 namespace pic::gpu {
@@ -30,29 +31,28 @@ GpuRtpLink packRtpLink(const RtpLink& link, uint32_t tint, uint32_t point, uint8
 /// c·π·A, clamped to ±65504.
 uint16_t radianceShCoefficient(uint16_t coefficient, float nodeArea);
 
-class CacheLightingPass {
+class CacheLightingPass final : public Pass {
 public:
-    /// Uploads the links (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box point,
-    /// lY² half coefficients, radianceShCoefficient, and the link's irradiance along a
+    static constexpr PassKind kKind = PassKind::CacheLighting;
+    /// Uploads the links of config.bake (RTP: 16 bytes each, packRtpLink; SH: node index, tint, box
+    /// point, lY² half coefficients, radianceShCoefficient, and the link's irradiance along a
     /// light-map cache's normal (render/link_irradiance.h linkIrradiance) rescaled alike, in
     /// shLinkWords(lY²) words) and the caches' normals, their box
-    /// points in the boxes of `spread` (nodeSpread(bake)). Fails naming the count where the
-    /// bake has more nodes than a GPU link addresses (2^24).
-    /// `cachePerSubgroup`: a subgroup shares each cache's links (GPUs), else an invocation
+    /// points in the boxes of config.spread (nodeSpread(bake)). Fails naming the count where
+    /// the bake has more nodes than a GPU link addresses (2^24).
+    /// config.cachePerSubgroup: a subgroup shares each cache's links (GPUs), else an invocation
     /// walks them (CPU devices); shaders/shared/cache_lighting.h says why. The links are read
-    /// in uint texels of up to `maxTexelWords` words that the device supports and that divide
-    /// a link: 4 or 2 words before 3, else one.
-    static Result<std::unique_ptr<CacheLightingPass>> create(Context& context, const BakeData& bake,
-                                                             const NodeSpread& spread,
-                                                             bool cachePerSubgroup,
-                                                             uint32_t maxTexelWords = 4);
+    /// in uint texels of up to config.maxLinkTexelWords words that the device supports and
+    /// that divide a link: 4 or 2 words before 3, else one.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
     /// Binds the node light (4 words per node, shaders/shared/pull.h; its usage must allow
     /// uniform texel buffers), the output caches (half), the output irradiance along the
     /// light-map caches' normals (vec4 per cache, CacheValues::irradiance) and the SH tables.
     Result<void> bind(Context& context, const Buffer& nodeLight, const Buffer& cacheY,
                       const Buffer& cacheCo, const Buffer& cacheCg, const Buffer& cacheIrradiance,
                       const Buffer& shTables);
-    void record(VkCommandBuffer cmd);
+    /// Lights every cache, chunk by chunk (reads nothing of `frame`).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
     /// Link bytes read per update.
     VkDeviceSize linkBytes() const { return mLinkBytes; }
     VkDeviceSize bytes() const { return mLinks.size(); }

@@ -17,10 +17,10 @@ constexpr uint32_t kShTablesBinding = 15;
 
 }  // namespace
 
-Result<std::unique_ptr<CacheShadingPass>> CacheShadingPass::create(Context& context,
-                                                                   uint32_t bandsY, uint32_t bandsC,
-                                                                   const glm::uvec3& gridDims,
-                                                                   const glm::uvec2& lightmapSize) {
+Result<std::unique_ptr<Pass>> CacheShadingPass::create(Context& context, const PassConfig& config) {
+    const uint32_t bandsY = config.bandsY, bandsC = config.bandsC;
+    const glm::uvec3& gridDims = config.gridDims;
+    const glm::uvec2& lightmapSize = config.lightmapSize;
     std::unique_ptr<CacheShadingPass> pass(new CacheShadingPass(context));
     pass->mCountY = bandsY * bandsY;
     pass->mCountC = bandsC * bandsC;
@@ -112,7 +112,8 @@ Result<void> CacheShadingPass::bind(const CacheShadingResources& r) {
     return {};
 }
 
-void CacheShadingPass::record(VkCommandBuffer cmd, const CacheShadingPush& push) const {
+void CacheShadingPass::record(VkCommandBuffer cmd, const FrameResources& frame) {
+    const CacheShadingPush& push = frame.shading;
     PIC_CHECK(mSet != VK_NULL_HANDLE);
     // Devices may cap a dispatch at 65535 workgroups along x (lavapipe does): large images
     // take several dispatches, each starting where the previous one ended.

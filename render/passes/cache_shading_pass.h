@@ -15,6 +15,7 @@
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
 #include "render/passes/gbuffer_pass.h"
+#include "render/passes/pass.h"
 #include "render/passes/shadow_map_pass.h"
 #include "shaders/shared/cache_shading.h"
 
@@ -29,24 +30,22 @@ struct CacheShadingResources {
 };
 
 /// Shades the G-buffer into one RGB radiance per pixel; owns the cache textures it reads.
-class CacheShadingPass {
+class CacheShadingPass final : public Pass {
 public:
-    /// Builds the kernel for lY = `bandsY`, lC = `bandsC` and allocates the cache textures of
-    /// a grid of `gridDims` vertices and a light map of `lightmapSize` texels, all zero (no
-    /// cache: the cache term is black until setCaches). Unsupported when one channel's layers
-    /// exceed the device's storage-buffer range.
-    static Result<std::unique_ptr<CacheShadingPass>> create(Context& context, uint32_t bandsY,
-                                                            uint32_t bandsC,
-                                                            const glm::uvec3& gridDims,
-                                                            const glm::uvec2& lightmapSize);
+    static constexpr PassKind kKind = PassKind::CacheShading;
+    /// Builds the kernel for lY = config.bandsY, lC = config.bandsC and allocates the cache
+    /// textures of a grid of config.gridDims vertices and a light map of config.lightmapSize
+    /// texels, all zero (no cache: the cache term is black until setCaches). Unsupported when
+    /// one channel's layers exceed the device's storage-buffer range.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
 
     /// Uploads `textures` as half floats; they must have this pass's band counts and sizes
     /// (the caller checks).
     Result<void> setCaches(const CacheTextures& textures);
     /// Binds the pass to its inputs and output (again whenever one of them was reallocated).
     Result<void> bind(const CacheShadingResources& resources);
-    /// Records the shading of every pixel with `push` (width, height, component, …).
-    void record(VkCommandBuffer cmd, const CacheShadingPush& push) const;
+    /// Records the shading of every pixel with frame.shading (width, height, component, …).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
 
     /// Bytes of GPU memory held (cache textures).
     VkDeviceSize bytes() const;

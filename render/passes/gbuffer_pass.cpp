@@ -72,8 +72,10 @@ GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height,
     return push;
 }
 
-Result<std::unique_ptr<GbufferPass>> GbufferPass::create(Context& context, const Scene& scene,
-                                                         std::span<const glm::vec2> triangleUvs) {
+Result<std::unique_ptr<Pass>> GbufferPass::create(Context& context, const PassConfig& config) {
+    PIC_CHECK(config.scene != nullptr);
+    const Scene& scene = *config.scene;
+    const std::span<const glm::vec2> triangleUvs = config.triangleUvs;
     PIC_CHECK_EQ(triangleUvs.size(), 3 * scene.triangles.size());
     if (scene.triangles.empty())
         return fail(ErrorCode::InvalidInput, "scene {} has no triangles to render",
@@ -289,7 +291,8 @@ Result<void> GbufferPass::prepare(uint32_t width, uint32_t height, const LightSe
     return mContext.upload(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
 }
 
-void GbufferPass::record(VkCommandBuffer cmd, const GbufferPush& push) {
+void GbufferPass::record(VkCommandBuffer cmd, const FrameResources& frame) {
+    const GbufferPush& push = frame.gbuffer;
     PIC_CHECK(mWidth > 0 && mHeight > 0);
     // Earlier compute reads of the targets finish before they are cleared and drawn over
     // (their old contents are discarded: UNDEFINED).

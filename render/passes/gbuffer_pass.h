@@ -17,6 +17,7 @@
 #include "gpu/device.h"
 #include "gpu/handle.h"
 #include "gpu/resources.h"
+#include "render/passes/pass.h"
 #include "shaders/shared/gbuffer.h"
 
 namespace pic::gpu {
@@ -40,24 +41,25 @@ GbufferPush gbufferPushOf(const Camera& camera, uint32_t width, uint32_t height,
                           glm::vec2 offset = glm::vec2(0.5f), float footprintScale = 1.0f);
 
 /// Rasterises the G-buffer of one camera view per frame; the targets are resized on demand.
-class GbufferPass {
+class GbufferPass final : public Pass {
 public:
-    /// Uploads the scene's triangles (3 corners each, with `triangleUvs` as their light-map
-    /// UVs, kNotLightmapped for grid-shaded triangles), materials and textures with their mip
-    /// chains (as the scene holds them: core/texture.h buildMipChain), and builds
-    /// the raster pipeline. InvalidInput for a scene whose triangles, materials or textures
-    /// do not index each other or whose texels do not fill a texture's or a mip level's size; Unsupported when its textures or triangle records exceed one
-    /// storage buffer.
-    static Result<std::unique_ptr<GbufferPass>> create(Context& context, const Scene& scene,
-                                                       std::span<const glm::vec2> triangleUvs);
+    static constexpr PassKind kKind = PassKind::Gbuffer;
+    /// Uploads config.scene's triangles (3 corners each, with config.triangleUvs as their
+    /// light-map UVs, kNotLightmapped for grid-shaded triangles), materials and textures with their
+    /// mip chains (as the scene holds them: core/texture.h buildMipChain), and builds the raster
+    /// pipeline. InvalidInput for a scene whose triangles, materials or textures do not index each
+    /// other or whose texels do not fill a texture's or a mip level's size; Unsupported when its
+    /// textures or triangle records exceed one storage buffer.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
 
     /// Sizes the targets for width × height (new images when the size changed: `reallocated`
     /// says so, and descriptor sets that sample them must be rebuilt) and writes the emissive
     /// scales of `lights` per material.
     Result<void> prepare(uint32_t width, uint32_t height, const LightSet& lights,
                          bool& reallocated);
-    /// Records the raster pass with `push` and leaves every target readable by compute shaders.
-    void record(VkCommandBuffer cmd, const GbufferPush& push);
+    /// Records the raster pass with frame.gbuffer and leaves every target readable by compute
+    /// shaders.
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
 
     /// Colour target i < kGbufferTargets (shaders/shared/gbuffer.h).
     const RenderTarget& target(uint32_t i) const { return mTargets[i]; }

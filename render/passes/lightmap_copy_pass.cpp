@@ -8,8 +8,9 @@
 
 namespace pic::gpu {
 
-Result<std::unique_ptr<LightmapCopyPass>> LightmapCopyPass::create(Context& context,
-                                                                   const BakeData& bake) {
+Result<std::unique_ptr<Pass>> LightmapCopyPass::create(Context& context, const PassConfig& config) {
+    PIC_CHECK(config.bake != nullptr);
+    const BakeData& bake = *config.bake;
     std::unique_ptr<LightmapCopyPass> pass(new LightmapCopyPass());
     pass->mCountY = bake.params.bandsY * bake.params.bandsY;
     pass->mCountC = bake.params.bandsC * bake.params.bandsC;
@@ -54,7 +55,7 @@ Result<void> LightmapCopyPass::bind(const Buffer& cacheY, const Buffer& cacheCo,
     return {};
 }
 
-void LightmapCopyPass::record(VkCommandBuffer cmd) {
+void LightmapCopyPass::record(VkCommandBuffer cmd, const FrameResources&) {
     const LightmapCopyPush grid{mGridVertices, 0, 0, 0};
     mKernel.dispatch(cmd, mGridSet, &grid, groupsFor(mGridVertices, kLightmapCopyGroup));
     const LightmapCopyPush lightmap{mLightmapTexels, 0, 0, 0};

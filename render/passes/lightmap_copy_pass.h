@@ -12,16 +12,20 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
+#include "render/passes/pass.h"
 
 namespace pic::gpu {
 
-class LightmapCopyPass {
+class LightmapCopyPass final : public Pass {
 public:
-    /// Uploads the grid and light-map index maps and allocates the six texture buffers.
-    static Result<std::unique_ptr<LightmapCopyPass>> create(Context& context, const BakeData& bake);
+    static constexpr PassKind kKind = PassKind::LightmapCopy;
+    /// Uploads config.bake's grid and light-map index maps and allocates the six texture
+    /// buffers.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
     /// Binds the caches (half, cache-major) the textures are copied from.
     Result<void> bind(const Buffer& cacheY, const Buffer& cacheCo, const Buffer& cacheCg);
-    void record(VkCommandBuffer cmd);
+    /// Copies the caches into the grid and the light map (reads nothing of `frame`).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
     /// Reads the textures back into `out` (from makeCacheTextures for the same bake).
     Result<void> read(Context& context, CacheTextures& out) const;
     VkDeviceSize bytes() const;

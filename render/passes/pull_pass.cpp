@@ -62,8 +62,10 @@ bool unpackNodeSpread(const glm::uvec3& packed, glm::mat3& slopes, glm::vec3& co
     return true;
 }
 
-Result<std::unique_ptr<PullPass>> PullPass::create(Context& context, const BakeData& bake,
-                                                   const NodeSpread& spread) {
+Result<std::unique_ptr<Pass>> PullPass::create(Context& context, const PassConfig& config) {
+    PIC_CHECK(config.bake != nullptr && config.spread != nullptr);
+    const BakeData& bake = *config.bake;
+    const NodeSpread& spread = *config.spread;
     std::unique_ptr<PullPass> pass(new PullPass());
     const size_t nS = bake.surfels.size();
     pass->mSurfelCount = uint32_t(nS);
@@ -148,7 +150,7 @@ Result<void> PullPass::bind(Context& context, const Buffer& nodeFlux, const Buff
     return {};
 }
 
-void PullPass::record(VkCommandBuffer cmd) {
+void PullPass::record(VkCommandBuffer cmd, const FrameResources&) {
     // Level k ≥ 1 is nodes [levelOffsets[k − 1], levelOffsets[k]).
     for (uint32_t level = 1; level < mTailLevel; ++level) {
         const PullPush push{mLevelOffsets[level - 1], mLevelOffsets[level], mSurfelCount, 0};

@@ -14,6 +14,7 @@
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
 #include "render/node_spread.h"
+#include "render/passes/pass.h"
 
 namespace pic::gpu {
 
@@ -30,19 +31,20 @@ glm::uvec3 packNodeSpread(const glm::mat3& slopes, const glm::vec3& concentratio
 /// A node's spread from words 0-2 of its light; returns whether it is exponential.
 bool unpackNodeSpread(const glm::uvec3& packed, glm::mat3& slopes, glm::vec3& concentration);
 
-class PullPass {
+class PullPass final : public Pass {
 public:
-    /// Uploads each inner node's two children, 1 / (π·area) and flux spread (`spread` =
-    /// nodeSpread(bake)).
-    static Result<std::unique_ptr<PullPass>> create(Context& context, const BakeData& bake,
-                                                    const NodeSpread& spread);
+    static constexpr PassKind kKind = PassKind::Pull;
+    /// Uploads each inner node of config.bake: its two children, 1 / (π·area) and flux spread
+    /// (config.spread = nodeSpread(bake)).
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
     /// Binds the node flux (vec4 per node; its usage must allow uniform texel buffers) and
     /// node light (4 words per node, shaders/shared/pull.h) buffers, whose leaves surfel
     /// lighting writes.
     Result<void> bind(Context& context, const Buffer& nodeFlux, const Buffer& nodeLight);
     /// Records every level with a barrier after each (the tail's levels with one between
-    /// them inside its workgroup), so a level reads finished children.
-    void record(VkCommandBuffer cmd);
+    /// them inside its workgroup), so a level reads finished children (reads nothing of
+    /// `frame`).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
     VkDeviceSize bytes() const { return mInnerNodes.size() + mMoments.size(); }
 
 private:

@@ -14,9 +14,11 @@ namespace {
 constexpr VkBufferUsageFlags kVisibilityUsage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
 }  // namespace
 
-Result<std::unique_ptr<RayVisibilityPass>> RayVisibilityPass::create(Context& context,
-                                                                     const EmbreeScene& rays,
-                                                                     const BakeData& bake) {
+Result<std::unique_ptr<Pass>> RayVisibilityPass::create(Context& context,
+                                                        const PassConfig& config) {
+    PIC_CHECK(config.rays != nullptr && config.bake != nullptr);
+    const EmbreeScene& rays = *config.rays;
+    const BakeData& bake = *config.bake;
     std::unique_ptr<RayVisibilityPass> pass(new RayVisibilityPass(context, rays, bake));
     pass->mWords = uint32_t(visibilityWords(bake.surfels.size()));
     PIC_TRY_ASSIGN(pass->mLights,

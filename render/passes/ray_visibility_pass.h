@@ -17,15 +17,15 @@
 #include "gpu/device.h"
 #include "gpu/resources.h"
 #include "rays/embree_scene.h"
+#include "render/passes/pass.h"
 
 namespace pic::gpu {
 
-class RayVisibilityPass {
+class RayVisibilityPass final : public Pass {
 public:
-    /// `rays` and `bake` must outlive the pass.
-    static Result<std::unique_ptr<RayVisibilityPass>> create(Context& context,
-                                                             const EmbreeScene& rays,
-                                                             const BakeData& bake);
+    static constexpr PassKind kKind = PassKind::RayVisibility;
+    /// For the surfels of config.bake, traced in config.rays; both must outlive the pass.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
 
     /// Writes the GpuLight records of `lights` and traces the rays of every light that is new
     /// on its slot or whose type, position, direction, cone or range changed; colour and
@@ -33,6 +33,9 @@ public:
     /// `reallocated` tells whether the visibility buffer was replaced (descriptor sets that
     /// read it must be rebuilt): it grows with the number of lights, never shrinks.
     Result<void> prepare(const LightSet& lights, bool& reallocated);
+    /// Records nothing: prepare() traced the rays on the host and its uploads land with the
+    /// next submit.
+    void record(VkCommandBuffer, const FrameResources&) override {}
 
     /// Lights whose rays the last prepare() traced, and its wall-clock ms doing so.
     uint32_t tracedLights() const { return mTracedLights; }

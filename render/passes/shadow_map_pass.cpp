@@ -74,9 +74,11 @@ uint32_t footprintSide(float slopeAtOneTexel, float distance, float footprint, u
     return std::min(side, top);
 }
 
-Result<std::unique_ptr<ShadowMapPass>> ShadowMapPass::create(Context& context, const Scene& scene,
-                                                             uint32_t size,
-                                                             const ShadowMapOptions& options) {
+Result<std::unique_ptr<Pass>> ShadowMapPass::create(Context& context, const PassConfig& config) {
+    PIC_CHECK(config.scene != nullptr);
+    const Scene& scene = *config.scene;
+    const uint32_t size = config.shadowMapSize;
+    const ShadowMapOptions& options = config.shadowMap;
     if (size < kMinShadowMapSize || size > kMaxShadowMapSize)
         return fail(ErrorCode::InvalidInput, "shadow-map size must be in [{}, {}], got {}",
                     kMinShadowMapSize, kMaxShadowMapSize, size);
@@ -404,7 +406,7 @@ void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint3
     vkCmdBindIndexBuffer(cmd, mIndices.handle(), 0, VK_INDEX_TYPE_UINT32);
 }
 
-void ShadowMapPass::record(VkCommandBuffer cmd) {
+void ShadowMapPass::record(VkCommandBuffer cmd, const FrameResources&) {
     mRenderedLights = 0;
     mDrawnTriangles = 0;
     mRenderedTexels = 0;

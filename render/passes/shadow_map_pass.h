@@ -28,8 +28,9 @@
 #include "gpu/device.h"
 #include "gpu/handle.h"
 #include "gpu/resources.h"
-#include "shaders/shared/shadow_map.h"
+#include "render/passes/pass.h"
 #include "render/shadow_casters.h"
+#include "shaders/shared/shadow_map.h"
 
 namespace pic::gpu {
 
@@ -57,22 +58,6 @@ inline constexpr uint32_t kMinShadowSide = 16;
 /// type, position, direction, range, radiant intensity and cone; the shadow fields zero.
 GpuLight gpuLightRecord(const Light& light);
 
-/// How the pass draws the scene. The caster options are on by default; off only to measure
-/// what they save and to test what they change. The first two store the same depths; levels
-/// of detail move surfaces by at most kCasterErrorPerTexel texels of the layer that draws them.
-struct ShadowMapOptions {
-    bool mergeCoplanar = true;   ///< draw mergeShadowCasters(scene) instead of the scene
-    bool oneSidedSolids = true;  ///< skip the faces of solids that look away from the light
-    bool levelsOfDetail = true;  ///< layers whose texels are coarse draw simplified casters
-    /// Every layer `size` texels wide (false), or each perspective layer only as wide as
-    /// needed for texels, at the median distance from the light of the scene's surfaces that
-    /// layer holds (within the light's range and cone), as wide as an orthographic layer's
-    /// over the scene (at most `size`).
-    /// Off for pixels (a camera may look at the nearest surfaces); on for surfels, which are
-    /// spread over the surfaces by area.
-    bool equalFootprint = false;
-};
-
 /// The side (texels) of a perspective layer whose texels are `footprint` metres wide at
 /// `distance` metres, for a layer `slopeAtOneTexel` wide per metre of depth (2·tan(fov/2)):
 /// rounded up to a multiple of kMinShadowSide, within [kMinShadowSide, maxSide].
@@ -88,21 +73,20 @@ struct CasterLevel {
     uint32_t triangles = 0;
 };
 
-class ShadowMapPass {
+class ShadowMapPass final : public Pass {
 public:
-    /// Uploads the scene's casters and builds the depth-only pipelines. `size` is the side of
-    /// one layer in texels.
-    static Result<std::unique_ptr<ShadowMapPass>> create(Context& context, const Scene& scene,
-                                                         uint32_t size,
-                                                         const ShadowMapOptions& options = {});
+    static constexpr PassKind kKind = PassKind::ShadowMap;
+    /// Uploads config.scene's casters and builds the depth-only pipelines, drawn as
+    /// config.shadowMap says. config.shadowMapSize is the side of one layer in texels.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
 
     /// Lays out `lights` on layers, writes their GpuLight records and matrices and marks the
     /// lights whose maps must be rendered. `reallocated` tells whether the depth image was
     /// replaced (descriptor sets that sample it must be rebuilt).
     Result<void> prepare(const LightSet& lights, bool& reallocated);
     /// Renders the layers of the lights prepare() marked, leaving every layer readable by
-    /// compute shaders.
-    void record(VkCommandBuffer cmd);
+    /// compute shaders (reads nothing of `frame`).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
 
     /// Lights rendered by the last record().
     uint32_t renderedLights() const { return mRenderedLights; }

@@ -5,6 +5,7 @@
 #include "core/cache_values.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
+#include "render/surfel_visibility.h"
 #include "shaders/shared/surfel_lighting.h"
 #include "spirv/surfel_lighting_comp.h"
 
@@ -32,12 +33,15 @@ Result<std::optional<DirectVisibility>> parseDirectVisibility(std::string_view t
                 "direct visibility \"{}\" is none of auto, shadow-maps, rays", text);
 }
 
-Result<std::unique_ptr<SurfelLightingPass>> SurfelLightingPass::create(
-    Context& context, const Scene& scene, const BakeData& bake,
-    std::span<const CacheStencil> stencils, float epsilon, DirectVisibility visibility) {
-    if (stencils.size() != bake.surfels.size())
-        return fail(ErrorCode::InvalidInput, "{} surfel stencils for {} surfels", stencils.size(),
-                    bake.surfels.size());
+Result<std::unique_ptr<Pass>> SurfelLightingPass::create(Context& context,
+                                                         const PassConfig& config) {
+    PIC_CHECK(config.scene != nullptr && config.bake != nullptr && config.rays != nullptr);
+    const Scene& scene = *config.scene;
+    const BakeData& bake = *config.bake;
+    const std::vector<CacheStencil> stencils = surfelStencils(scene, *config.rays, bake);
+    PIC_CHECK_EQ(stencils.size(), bake.surfels.size());
+    const float epsilon = config.rays->epsilon();
+    const DirectVisibility visibility = config.visibility;
     std::unique_ptr<SurfelLightingPass> pass(new SurfelLightingPass(context, scene));
     pass->mSurfelCount = uint32_t(bake.surfels.size());
     pass->mEpsilon = epsilon;
@@ -171,18 +175,17 @@ Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
     return mContext.uploadWithNextSubmit(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
 }
 
-void SurfelLightingPass::record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount,
-                                uint32_t sumSlot, glm::vec3 tail) {
-    PIC_CHECK(sumSlot < 2);
+void SurfelLightingPass::record(VkCommandBuffer cmd, const FrameResources& frame) {
+    PIC_CHECK(frame.sumSlot < 2);
     PIC_CHECK(mDirectSet != VK_NULL_HANDLE && mBounceSet != VK_NULL_HANDLE);
     SurfelLightingPush push{};
     push.surfelCount = mSurfelCount;
-    push.lightCount = lightCount;
+    push.lightCount = frame.lightCount;
     push.epsilon = mEpsilon;
-    push.sumSlot = sumSlot;
-    push.tail = glm::vec4(tail, 0.0f);
-    const Kernel& kernel = bounce ? mBounce : mDirect;
-    kernel.dispatch(cmd, bounce ? mBounceSet : mDirectSet, &push,
+    push.sumSlot = frame.sumSlot;
+    push.tail = glm::vec4(frame.tail, 0.0f);
+    const Kernel& kernel = frame.bounce ? mBounce : mDirect;
+    kernel.dispatch(cmd, frame.bounce ? mBounceSet : mDirectSet, &push,
                     groupsFor(mSurfelCount, kSurfelLightingGroup));
 }
 

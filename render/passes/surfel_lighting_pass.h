@@ -20,6 +20,7 @@
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
+#include "render/passes/pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
 
@@ -54,24 +55,25 @@ struct SurfelLightingResources {
     const Buffer* shTables = nullptr;    ///< ShTables
 };
 
-class SurfelLightingPass {
+class SurfelLightingPass final : public Pass {
 public:
-    /// Uploads the surfels and their cache stencils (render/surfel_visibility.h
-    /// surfelStencils: the CPU twin's bounce reads the same), nS of them.
-    static Result<std::unique_ptr<SurfelLightingPass>> create(
-        Context& context, const Scene& scene, const BakeData& bake,
-        std::span<const CacheStencil> stencils, float epsilon, DirectVisibility visibility);
+    static constexpr PassKind kKind = PassKind::SurfelLighting;
+    /// Uploads the surfels of config.bake and their cache stencils (render/surfel_visibility.h
+    /// surfelStencils in config.rays: the CPU twin's bounce reads the same), nS of them, for
+    /// direct light seen through config.visibility; shadow tests start config.rays's ray
+    /// offset above the surfel.
+    static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
 
     /// (Re)binds the pass to the runtime's buffers and the current shadow-map image or
     /// visibility buffer.
     Result<void> bind(const SurfelLightingResources& resources);
     /// Writes the per-material emission scales of `lights`.
     Result<void> setEmissiveScales(const LightSet& lights);
-    /// Records the direct part (directFlux and the leaves) or a bounce (the leaves; with a
-    /// `tail`, each leaf's new flux S' becomes S' + tail·max(S' − S, 0), as the CPU twin's
-    /// bounceSurfelFlux); the pass's flux sum goes to `sumSlot` (0 or 1).
-    void record(VkCommandBuffer cmd, bool bounce, uint32_t lightCount, uint32_t sumSlot,
-                glm::vec3 tail = glm::vec3(0.0f));
+    /// Records the direct part (directFlux and the leaves) of frame.lightCount lights or, with
+    /// frame.bounce, a bounce (the leaves; with a frame.tail, each leaf's new flux S' becomes
+    /// S' + tail·max(S' − S, 0), as the CPU twin's bounceSurfelFlux); the pass's flux sum goes
+    /// to frame.sumSlot (0 or 1).
+    void record(VkCommandBuffer cmd, const FrameResources& frame) override;
     /// Σ of the leaves' flux of the last pass recorded with `sumSlot`, after it completed, in
     /// double (W, RGB).
     Result<glm::dvec3> totalFlux(uint32_t sumSlot);

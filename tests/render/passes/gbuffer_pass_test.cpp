@@ -150,7 +150,8 @@ TEST(GbufferPass, PixelsHoldWhatTheirCameraRaysHit) {
 
     gpu::Context* context = test::sharedContext();
     ASSERT_TRUE(context);
-    auto pass = gpu::GbufferPass::create(*context, scene, triangleUvs);
+    auto pass =
+        gpu::createPass<gpu::GbufferPass>(*context, {.scene = &scene, .triangleUvs = triangleUvs});
     ASSERT_TRUE(pass) << pass.error().message;
     Camera camera;
     camera.eye = {0.15f, 0.2f, 2.5f};
@@ -163,7 +164,8 @@ TEST(GbufferPass, PixelsHoldWhatTheirCameraRaysHit) {
     ASSERT_TRUE((*pass)->prepare(kWidth, kHeight, lights, reallocated));
     EXPECT_TRUE(reallocated);
     const gpu::GbufferPush push = gpu::gbufferPushOf(camera, kWidth, kHeight, 1e-3f);
-    ASSERT_TRUE(context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, push); }));
+    ASSERT_TRUE(
+        context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, {.gbuffer = push}); }));
     const std::vector<glm::vec4> targets = readTargets(*context, **pass);
     ASSERT_EQ(targets.size(), size_t{gpu::kGbufferTargets} * kWidth * kHeight);
 
@@ -272,7 +274,8 @@ TEST(GbufferPass, TexturedAlbedoIsTheCpuFootprintAverage) {
 
     gpu::Context* context = test::sharedContext();
     ASSERT_TRUE(context);
-    auto pass = gpu::GbufferPass::create(*context, scene, triangleUvs);
+    auto pass =
+        gpu::createPass<gpu::GbufferPass>(*context, {.scene = &scene, .triangleUvs = triangleUvs});
     ASSERT_TRUE(pass) << pass.error().message;
     Camera camera;
     camera.eye = {0.1f, 0.5f, 2.5f};
@@ -282,7 +285,8 @@ TEST(GbufferPass, TexturedAlbedoIsTheCpuFootprintAverage) {
     bool reallocated = false;
     ASSERT_TRUE((*pass)->prepare(kWidth, kHeight, LightSet{}, reallocated));
     const gpu::GbufferPush push = gpu::gbufferPushOf(camera, kWidth, kHeight, 1e-3f);
-    ASSERT_TRUE(context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, push); }));
+    ASSERT_TRUE(
+        context->submit([&](VkCommandBuffer cmd) { (*pass)->record(cmd, {.gbuffer = push}); }));
     const std::vector<glm::vec4> targets = readTargets(*context, **pass);
     ASSERT_EQ(targets.size(), size_t{gpu::kGbufferTargets} * kWidth * kHeight);
 

@@ -42,7 +42,7 @@ std::vector<std::vector<float>> renderLayers(gpu::Context& context, gpu::ShadowM
     bool reallocated = false;
     auto prepared = pass.prepare(lights, reallocated);
     EXPECT_TRUE(prepared) << prepared.error().message;
-    auto submitted = context.submit([&](VkCommandBuffer cmd) { pass.record(cmd); });
+    auto submitted = context.submit([&](VkCommandBuffer cmd) { pass.record(cmd, {}); });
     EXPECT_TRUE(submitted) << submitted.error().message;
     std::vector<std::vector<float>> layers;
     for (uint32_t l = 0; l < pass.depth().layers(); ++l) {
@@ -80,7 +80,8 @@ TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
     constexpr uint32_t kSize = 256;
     const LightSet lights = testLights(*scene);
     auto render = [&](gpu::ShadowMapOptions options, uint64_t& oneSided) {
-        auto pass = gpu::ShadowMapPass::create(**context, *scene, kSize, options);
+        auto pass = gpu::createPass<gpu::ShadowMapPass>(
+            **context, {.scene = &*scene, .shadowMapSize = kSize, .shadowMap = options});
         EXPECT_TRUE(pass) << pass.error().message;
         if (!pass) return std::vector<std::vector<float>>{};
         auto layers = renderLayers(**context, **pass, lights);
@@ -129,9 +130,12 @@ TEST_P(ShadowCasters, LevelsOfDetailMoveSurfacesByAtMostHalfATexel) {
     if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
     constexpr uint32_t kSize = 256;
     const LightSet lights = testLights(*scene);
-    auto exact = gpu::ShadowMapPass::create(**context, *scene, kSize, {.levelsOfDetail = false});
+    auto exact = gpu::createPass<gpu::ShadowMapPass>(
+        **context,
+        {.scene = &*scene, .shadowMapSize = kSize, .shadowMap = {.levelsOfDetail = false}});
     ASSERT_TRUE(exact) << exact.error().message;
-    auto coarse = gpu::ShadowMapPass::create(**context, *scene, kSize);
+    auto coarse =
+        gpu::createPass<gpu::ShadowMapPass>(**context, {.scene = &*scene, .shadowMapSize = kSize});
     ASSERT_TRUE(coarse) << coarse.error().message;
     const auto expected = renderLayers(**context, **exact, lights);
     const auto actual = renderLayers(**context, **coarse, lights);
@@ -273,9 +277,12 @@ TEST(ShadowSides, EqualFootprintGivesTheOrthographicTexelAtTheMedianDistance) {
     spot.outerConeAngle = 0.3f;
     lights.lights = {sun, bulb, nearBulb, spot};
 
-    auto uniform = gpu::ShadowMapPass::create(**context, scene, kSize);
+    auto uniform =
+        gpu::createPass<gpu::ShadowMapPass>(**context, {.scene = &scene, .shadowMapSize = kSize});
     ASSERT_TRUE(uniform) << uniform.error().message;
-    auto footprint = gpu::ShadowMapPass::create(**context, scene, kSize, {.equalFootprint = true});
+    auto footprint = gpu::createPass<gpu::ShadowMapPass>(
+        **context,
+        {.scene = &scene, .shadowMapSize = kSize, .shadowMap = {.equalFootprint = true}});
     ASSERT_TRUE(footprint) << footprint.error().message;
     const auto uniformLayers = renderLayers(**context, **uniform, lights);
     const auto footprintLayers = renderLayers(**context, **footprint, lights);
