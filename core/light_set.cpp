@@ -1,6 +1,7 @@
 #include "core/light_set.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -130,7 +131,78 @@ Result<void> rejectInapplicable(FieldReader& fields, LightType type,
     return {};
 }
 
-Result<Light> parseLight(const Json& value, size_t index) {
+/// Whether `name` is an environment file a light set may name: relative, below the scene's
+/// folder, an HDR or EXR image.
+Result<void> checkEnvironmentName(const std::string& name, const std::string& field) {
+    if (name.empty() || name.size() > kMaxEnvironmentBytes)
+        return fail(ErrorCode::InvalidInput, "{} must be 1 to {} bytes long, got {}", field,
+                    kMaxEnvironmentBytes, name.size());
+    if (std::ranges::any_of(name, [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F || c == '\\'; }))
+        return fail(ErrorCode::InvalidInput, "{} \"{}\" holds a control character or a backslash",
+                    field, clipped(name));
+    const std::filesystem::path path(name);
+    if (path.is_absolute() || name.front() == '/')
+        return fail(ErrorCode::InvalidInput,
+                    "{} \"{}\" must be relative to the scene's folder, not absolute", field,
+                    clipped(name));
+    for (const auto& part : path)
+        if (part == "..")
+            return fail(ErrorCode::InvalidInput,
+                        "{} \"{}\" must stay inside the scene's folder (no \"..\")", field,
+                        clipped(name));
+    std::string extension = path.extension().string();
+    std::ranges::transform(extension, extension.begin(),
+                           [](char c) { return char(std::tolower(static_cast<unsigned char>(c))); });
+    if (extension != ".hdr" && extension != ".exr")
+        return fail(ErrorCode::InvalidInput, "{} \"{}\" must be a .hdr or .exr image", field,
+                    clipped(name));
+    return {};
+}
+
+/// A light of type "sky" (the caller has read its id and type).
+Result<SkyLight> parseSky(FieldReader& fields, std::string id) {
+    SkyLight sky;
+    sky.id = std::move(id);
+    PIC_TRY_ASSIGN(sky.color, fields.vec3("color", sky.color));
+    if (glm::any(glm::lessThan(sky.color, glm::vec3(0.0f))))
+        return fail(ErrorCode::InvalidInput, "{} must be non-negative, got [{}, {}, {}]",
+                    fields.fieldPath("color"), sky.color.x, sky.color.y, sky.color.z);
+    PIC_TRY_ASSIGN(sky.intensity, fields.number("intensity", sky.intensity));
+    if (sky.intensity < 0.0f)
+        return fail(ErrorCode::InvalidInput, "{} must be finite and ≥ 0, got {}",
+                    fields.fieldPath("intensity"), sky.intensity);
+    const float peak = sky.intensity * std::max({sky.color.x, sky.color.y, sky.color.z});
+    if (sky.intensity > kMaxSkyRadiance || peak > kMaxSkyRadiance)
+        return fail(ErrorCode::InvalidInput,
+                    "{} × color is {:g} in its largest channel (intensity {:g}); a sky's radiance "
+                    "is at most {:g} W/(m²·sr)",
+                    fields.fieldPath("intensity"), peak, sky.intensity, kMaxSkyRadiance);
+    if (const Json* environment = fields.find("environment")) {
+        if (!environment->is_string())
+            return fail(ErrorCode::InvalidInput, "{} must be a string, got {}",
+                        fields.fieldPath("environment"), shown(*environment));
+        sky.environment = environment->get<std::string>();
+        PIC_TRY(checkEnvironmentName(sky.environment, fields.fieldPath("environment")));
+    }
+    PIC_TRY_ASSIGN(sky.rotationDegrees, fields.number("rotation", sky.rotationDegrees));
+    if (!(std::abs(sky.rotationDegrees) <= 1e6f))
+        return fail(ErrorCode::InvalidInput, "{} must be in [-1e6, 1e6] degrees, got {}",
+                    fields.fieldPath("rotation"), sky.rotationDegrees);
+    for (std::string_view key : {"position", "direction", "innerConeAngle", "outerConeAngle", "range"})
+        if (fields.find(key))
+            return fail(ErrorCode::InvalidInput, "{} does not apply to a sky light",
+                        fields.fieldPath(key));
+    PIC_TRY(fields.rejectUnknown());
+    return sky;
+}
+
+/// One entry of "lights": a punctual light, or the sky.
+struct ParsedLight {
+    std::optional<Light> light;
+    std::optional<SkyLight> sky;
+};
+
+Result<ParsedLight> parseLight(const Json& value, size_t index) {
     std::string path = fmt::format("lights[{}]", index);
     if (!value.is_object())
         return fail(ErrorCode::InvalidInput, "{} must be an object, got {}", path, shown(value));
@@ -155,8 +227,12 @@ Result<Light> parseLight(const Json& value, size_t index) {
     const Json* type = fields.find("type");
     if (!type)
         return fail(ErrorCode::InvalidInput,
-                    "{} is missing; it must be \"point\", \"spot\" or \"directional\"",
+                    "{} is missing; it must be \"point\", \"spot\", \"directional\" or \"sky\"",
                     fields.fieldPath("type"));
+    if (*type == "sky") {
+        PIC_TRY_ASSIGN(SkyLight sky, parseSky(fields, std::move(light.id)));
+        return ParsedLight{std::nullopt, std::move(sky)};
+    }
     if (*type == "point")
         light.type = LightType::Point;
     else if (*type == "spot")
@@ -165,7 +241,7 @@ Result<Light> parseLight(const Json& value, size_t index) {
         light.type = LightType::Directional;
     else
         return fail(ErrorCode::InvalidInput,
-                    "{} must be \"point\", \"spot\" or \"directional\", got {}",
+                    "{} must be \"point\", \"spot\", \"directional\" or \"sky\", got {}",
                     fields.fieldPath("type"), shown(*type));
 
     // Defaults are those of KHR_lights_punctual, which Light's initialisers already hold.
@@ -231,7 +307,7 @@ Result<Light> parseLight(const Json& value, size_t index) {
     }
 
     if (auto known = fields.rejectUnknown(); !known) return std::unexpected(known.error());
-    return light;
+    return ParsedLight{std::move(light), std::nullopt};
 }
 
 Result<std::map<std::string, float>> parseEmissiveScale(const Json& value) {
@@ -311,12 +387,21 @@ Result<LightSet> parseLightSet(const std::string& json) {
                         lights->size(), kMaxLights);
         std::set<std::string> ids;
         for (size_t i = 0; i < lights->size(); ++i) {
-            PIC_TRY_ASSIGN(Light light, parseLight((*lights)[i], i));
+            PIC_TRY_ASSIGN(ParsedLight parsed, parseLight((*lights)[i], i));
+            const std::string& id = parsed.light ? parsed.light->id : parsed.sky->id;
             // Sessions address lights by id, so two lights must never share one.
-            if (!ids.insert(light.id).second)
+            if (!ids.insert(id).second)
                 return fail(ErrorCode::InvalidInput, "lights[{}].id \"{}\" is used twice", i,
-                            clipped(light.id));
-            set.lights.push_back(std::move(light));
+                            clipped(id));
+            if (parsed.sky && set.sky)
+                return fail(ErrorCode::InvalidInput,
+                            "lights[{}] is a second sky (\"{}\" is one already); a light set "
+                            "holds at most one",
+                            i, clipped(set.sky->id));
+            if (parsed.sky)
+                set.sky = std::move(parsed.sky);
+            else
+                set.lights.push_back(std::move(*parsed.light));
         }
     }
     if (const Json* scales = fields.find("emissiveScale")) {
@@ -360,6 +445,16 @@ std::string toJson(const LightSet& set) {
         // JSON cannot hold infinity: an absent range means no cut-off.
         if (light.type != LightType::Directional && std::isfinite(light.range))
             object["range"] = light.range;
+        lights.push_back(std::move(object));
+    }
+    if (set.sky) {
+        FloatJson object;
+        object["id"] = set.sky->id;
+        object["type"] = "sky";
+        object["color"] = vec3Json(set.sky->color);
+        object["intensity"] = set.sky->intensity;
+        if (!set.sky->environment.empty()) object["environment"] = set.sky->environment;
+        if (set.sky->rotationDegrees != 0.0f) object["rotation"] = set.sky->rotationDegrees;
         lights.push_back(std::move(object));
     }
     FloatJson root;

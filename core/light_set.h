@@ -2,10 +2,11 @@
 /// Light sets (ARCHITECTURE.md §4): the lights and emissive scales a client sets, read from
 /// and written to the JSON form
 /// {"lights":[{"id","type","position","direction","color","intensity","innerConeAngle",
-///  "outerConeAngle","range"}], "emissiveScale":{"<material name>": s},
-///  "indirectScale":{"y": s, "cocg": s}}.
+///  "outerConeAngle","range"}, {"id","type":"sky","color","intensity","environment",
+///  "rotation"}], "emissiveScale":{"<material name>": s}, "indirectScale":{"y": s, "cocg": s}}.
 
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,6 +29,12 @@ inline constexpr float kMaxLightIntensity = 1e9f;
 /// Largest emissive scale of a material.
 inline constexpr float kMaxEmissiveScale = 1e6f;
 
+/// Largest sky radiance, intensity × colour in any channel, W/(m²·sr) (about 40 suns' worth of
+/// irradiance on a plane open to the whole sky).
+inline constexpr float kMaxSkyRadiance = 1e6f;
+/// Longest environment file name, in bytes.
+inline constexpr size_t kMaxEnvironmentBytes = 256;
+
 /// Largest artistic scale of the cache term's luma or chroma (IndirectScale).
 inline constexpr float kMaxIndirectScale = 16.0f;
 
@@ -41,12 +48,27 @@ struct IndirectScale {
     friend bool operator==(const IndirectScale&, const IndirectScale&) = default;
 };
 
+/// The sky (ARCHITECTURE.md §4): radiance L(ω) = intensity·colour·environment(R⁻¹ω) from
+/// every direction no geometry blocks, R the rotation about +Y. core/sky.h evaluates it.
+struct SkyLight {
+    std::string id = "sky";
+    glm::vec3 color{1.0f};
+    float intensity = 1.0f;        ///< W/(m²·sr) with a colour of 1 and no environment
+    /// Equirectangular .hdr or .exr (+Y up, core/sky.h skyDirection), a path relative to the
+    /// scene file's folder without ".." (picserver reads only what ships with its scenes);
+    /// empty: a constant sky.
+    std::string environment;
+    float rotationDegrees = 0.0f;  ///< about +Y, counter-clockwise seen from above
+    friend bool operator==(const SkyLight&, const SkyLight&) = default;
+};
+
 /// Whether `id` may name a light: 1 to kMaxLightIdBytes bytes without control characters.
 bool isLightId(std::string_view id);
 
 /// The dynamic lighting of a scene: punctual lights plus a scale per emissive material.
 struct LightSet {
     std::vector<Light> lights;
+    std::optional<SkyLight> sky;                 ///< at most one; JSON lists it among the lights
     std::map<std::string, float> emissiveScale;  ///< material name → factor on its emission (default 1)
     IndirectScale indirectScale;                 ///< on the cache term where clients shade
 
@@ -62,7 +84,9 @@ LightSet defaultLightSet(const Scene& scene);
 /// intensity × colour above kMaxLightIntensity, zero-length direction for spot/directional
 /// lights, cone angles outside 0 ≤ inner ≤ outer ≤ π/2 with outer > 0, negative range, more
 /// than kMaxLights lights, duplicate ids, ids that isLightId refuses, unknown keys, negative,
-/// non-finite or larger than kMaxEmissiveScale emissive scales, indirect scales outside
+/// non-finite or larger than kMaxEmissiveScale emissive scales, a second sky, a sky radiance
+/// above kMaxSkyRadiance, an environment that is absolute, climbs with "..", is not .hdr or
+/// .exr or is longer than kMaxEnvironmentBytes, indirect scales outside
 /// [0, kMaxIndirectScale] or with other keys than y and cocg. Text from the input is clipped
 /// in messages. Directions are normalised.
 Result<LightSet> parseLightSet(const std::string& json);

@@ -43,9 +43,10 @@ Result<Json> lightJson(const v1::Light& light, size_t index) {
     case v1::Light::POINT: object["type"] = "point"; break;
     case v1::Light::SPOT: object["type"] = "spot"; break;
     case v1::Light::DIRECTIONAL: object["type"] = "directional"; break;
+    case v1::Light::SKY: object["type"] = "sky"; break;
     default:
         return fail(ErrorCode::InvalidInput,
-                    "{}.type must be POINT, SPOT or DIRECTIONAL, got {}", path,
+                    "{}.type must be POINT, SPOT, DIRECTIONAL or SKY, got {}", path,
                     int(light.type()));
     }
     if (light.has_position()) {
@@ -62,12 +63,15 @@ Result<Json> lightJson(const v1::Light& light, size_t index) {
         {light.has_inner_cone_angle(), {light.inner_cone_angle(), "innerConeAngle"}},
         {light.has_outer_cone_angle(), {light.outer_cone_angle(), "outerConeAngle"}},
         {light.has_range(), {light.range(), "range"}},
+        {light.has_rotation(), {light.rotation(), "rotation"}},
     };
     for (const auto& [present, field] : numbers) {
         if (!present) continue;
         PIC_TRY(checkFinite(field.first, path + "." + field.second));
         object[field.second] = field.first;
     }
+    // An empty string is proto3's absent value: a constant sky.
+    if (!light.environment().empty()) object["environment"] = light.environment();
     return object;
 }
 
@@ -94,6 +98,15 @@ v1::LightSet toProto(const LightSet& lights) {
             wire.set_inner_cone_angle(light.innerConeAngle);
             wire.set_outer_cone_angle(light.outerConeAngle);
         }
+    }
+    if (lights.sky) {
+        v1::Light& wire = *out.add_lights();
+        wire.set_id(lights.sky->id);
+        wire.set_type(v1::Light::SKY);
+        wire.set_intensity(lights.sky->intensity);
+        *wire.mutable_color() = vec3(lights.sky->color);
+        wire.set_environment(lights.sky->environment);
+        if (lights.sky->rotationDegrees != 0.0f) wire.set_rotation(lights.sky->rotationDegrees);
     }
     for (const auto& [material, scale] : lights.emissiveScale)
         (*out.mutable_emissive_scale())[material] = scale;
