@@ -11,6 +11,7 @@
 #include "bake/grid_caches.h"
 #include "bake/lightmap_caches.h"
 #include "bake/lightmap_charts.h"
+#include "bake/sky_transfer.h"
 #include "bake/surfel_exposure.h"
 #include "bake/surfel_hierarchy.h"
 #include "bake/surfel_placement.h"
@@ -61,6 +62,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel)
         if (seesSurfel[c]) remap[c] = kept++;
     const uint32_t dropped = static_cast<uint32_t>(nC - kept);
     if (dropped == 0) return 0;
+    const size_t skyPerCache = nC ? bake.cacheSky.size() / nC : 0;
 
     LinkSet& links = bake.links;
     const size_t coefficients = links.mode == LinkMode::Sh ? size_t{links.bands} * links.bands : 0;
@@ -68,6 +70,8 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel)
         if (remap[c] == kNoCache) continue;
         const size_t to = remap[c];
         bake.caches[to] = bake.caches[c];
+        std::copy_n(bake.cacheSky.begin() + c * skyPerCache, skyPerCache,
+                    bake.cacheSky.begin() + to * skyPerCache);
         std::copy_n(links.tint.begin() + c * nL, nL, links.tint.begin() + to * nL);
         std::copy_n(links.offset.begin() + c * nL * 3, nL * 3, links.offset.begin() + to * nL * 3);
         std::copy_n(links.spreadShare.begin() + c * nL, nL, links.spreadShare.begin() + to * nL);
@@ -80,6 +84,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel)
         }
     }
     bake.caches.resize(kept);
+    bake.cacheSky.resize(size_t{kept} * skyPerCache);
     links.tint.resize(size_t{kept} * nL);
     links.offset.resize(size_t{kept} * nL * 3);
     links.spreadShare.resize(size_t{kept} * nL);
@@ -175,6 +180,9 @@ Result<BakeParams> resolveBakeParams(const Scene& scene, const BakeOptions& opti
     p.exposureRays = options.exposureRays;
     if (p.exposureRays > 1024)
         return fail(ErrorCode::InvalidInput, "--exposure-rays must be in [0, 1024], got {}", p.exposureRays);
+    p.skyRays = options.skyRays;
+    if (p.skyRays > 4096)
+        return fail(ErrorCode::InvalidInput, "--sky-rays must be in [0, 4096], got {}", p.skyRays);
     p.linkReads = options.linkReads;
     p.linkCut = options.linkCut;
     p.relaxIterations = options.relaxIterations;
@@ -309,6 +317,21 @@ Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, Bak
         exposureTimer.stop();
     }
 
+    BakePart part;
+    part.index = shard.index;
+    part.count = shard.count;
+    std::tie(part.cacheBegin, part.cacheEnd) = shardCaches(bake.caches.size(), shard);
+
+    if (p.skyRays > 0) {
+        // Every shard computes the surfels' transfer (shared, compared when joining) and its own
+        // caches' visibility.
+        StageTimer skyTimer(report, "sky");
+        bake.surfelSky = surfelSkyTransfer(*rays, bake.surfels, p.skyRays, p.seed);
+        bake.cacheSky = cacheSkyVisibility(*rays, bake.caches, part.cacheBegin, part.cacheEnd,
+                                           p.bandsY, p.skyRays, p.seed);
+        skyTimer.stop();
+    }
+
     StageTimer linkTimer(report, "links");
     LinkParams linkParams;
     linkParams.linksPerCache = p.linksPerCache;
@@ -319,10 +342,6 @@ Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, Bak
     linkParams.seed = p.seed;
     linkParams.reads = p.linkReads;
     linkParams.cut = p.linkCut;
-    BakePart part;
-    part.index = shard.index;
-    part.count = shard.count;
-    std::tie(part.cacheBegin, part.cacheEnd) = shardCaches(bake.caches.size(), shard);
     linkParams.cacheBegin = part.cacheBegin;
     linkParams.cacheEnd = part.cacheEnd;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
@@ -362,6 +381,7 @@ std::optional<std::string_view> firstDifference(const BakeData& a, const BakeDat
     if (!(a.params == b.params) || a.defaults != b.defaults) return "parameters";
     if (!sameBytes(a.surfels, b.surfels)) return "surfels";
     if (!sameBytes(a.surfelWeights, b.surfelWeights)) return "surfel flux weights";
+    if (!sameBytes(a.surfelSky, b.surfelSky)) return "surfel sky transfer";
     if (!sameBytes(a.nodes, b.nodes) || a.levelOffsets != b.levelOffsets) return "hierarchy";
     if (!sameBytes(a.caches, b.caches)) return "caches";
     const GridLayout &ga = a.grid, &gb = b.grid;
@@ -425,9 +445,21 @@ Result<void> BakeJoiner::add(BakePart part, const std::string& name) {
             LinkSet own = std::move(mBake->links);
             mBake->links = paddingLinks(own.mode, own.linksPerCache, own.bands, nC);
             placeLinks(mBake->links, own, begin);
+            std::vector<float> ownSky = std::move(mBake->cacheSky);
+            const size_t perCache = end > begin ? ownSky.size() / (end - begin) : 0;
+            mSkyPerCache = perCache;
+            mBake->cacheSky.assign(nC * perCache, 0.0f);
+            std::ranges::copy(ownSky, mBake->cacheSky.begin() + begin * perCache);
+        } else {
+            mSkyPerCache = end > begin ? mBake->cacheSky.size() / (end - begin) : 0;
         }
     } else {
         placeLinks(mBake->links, part.bake.links, begin);
+        if (part.bake.cacheSky.size() != (end - begin) * mSkyPerCache)
+            return fail(ErrorCode::InvalidInput, "{} holds {} cache sky values for {} caches, the "
+                        "other parts {} per cache", name, part.bake.cacheSky.size(), end - begin,
+                        mSkyPerCache);
+        std::ranges::copy(part.bake.cacheSky, mBake->cacheSky.begin() + begin * mSkyPerCache);
     }
     std::ranges::copy(part.seesSurfel, mSees.begin() + begin);
     return {};

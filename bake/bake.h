@@ -29,6 +29,7 @@ struct BakeOptions {
     uint32_t linkSamples = 16;
     uint32_t linkFinalSamples = 64;
     uint32_t exposureRays = 64;
+    uint32_t skyRays = 256;
     LinkReads linkReads = LinkReads::Visible;
     LinkCut linkCut = LinkCut::ErrorBound;
     uint32_t relaxIterations = 4;
@@ -108,6 +109,7 @@ public:
 private:
     std::optional<BakeData> mBake;   ///< the first part's, its links grown to every cache
     std::vector<uint8_t> mSees;      ///< per cache: its links see a surfel
+    size_t mSkyPerCache = 0;         ///< cache sky visibility values per cache
     std::vector<std::string> mNames; ///< per shard: the part given for it, empty while missing
 };
 

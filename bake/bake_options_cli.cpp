@@ -30,6 +30,10 @@ void BakeOptionFlags::addTo(CLI::App& command) {
     command.add_option("--exposure-rays", mOptions.exposureRays,
                        "rays per surfel that weight a node's flux towards its exposed surfels; 0: the "
                        "paper's uniform node radiance (default 64)");
+    command.add_option("--sky-rays", mOptions.skyRays,
+                       "rays per surfel and per cache for the sky transfer (how much of the sky "
+                       "each sees, for sky lights); 0: none, and light sets with a sky are "
+                       "refused (default 256)");
     command.add_option("--link-reads", mLinkReads,
                        "whose flux a link reads: visible (the smallest part of the linked node "
                        "holding what the cache sees) or node (the paper's; default visible)")

@@ -198,6 +198,9 @@ int runBakeCommand(const std::string& scenePath, const std::string& outPath, con
     fmt::print("  flux weights    {}\n", p.exposureRays > 0
                                             ? fmt::format("exposure, {} rays per surfel", p.exposureRays)
                                             : std::string("uniform (--exposure-rays 0)"));
+    fmt::print("  sky transfer    {}\n", p.skyRays > 0
+                                            ? fmt::format("{} rays per surfel and cache", p.skyRays)
+                                            : std::string("none (--sky-rays 0): skies are refused"));
     fmt::print("  links read      {}\n", p.linkReads == LinkReads::Node
                                             ? "the linked node's flux (--link-reads node)"
                                             : "the part of the node the cache sees");
@@ -321,6 +324,7 @@ int runInfoCommand(const std::string& bakePath, bool json) {
                      {"link_samples", p.linkSamples},
                      {"link_final_samples", p.linkFinalSamples},
                      {"exposure_rays", p.exposureRays},
+                     {"sky_rays", p.skyRays},
                      {"link_reads", p.linkReads == LinkReads::Node ? "node" : "visible"},
                      {"link_cut", linkCutName(p.linkCut)},
                      {"relax_iterations", p.relaxIterations},

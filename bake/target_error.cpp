@@ -167,7 +167,8 @@ public:
             base.links.value_or(0), base.bandsY.value_or(0), base.bandsC.value_or(0), base.gridCell.value_or(0.0f),
             base.lightmapTexel.value_or(0.0f), uint32_t(base.linkMode), uint32_t(base.hierarchy), base.linkSamples,
             base.linkFinalSamples, base.exposureRays, uint32_t(base.linkReads), uint32_t(base.linkCut));
-        what += fmt::format("|{} {} {} {}", base.relaxIterations, base.seed, uint32_t(base.gridCaches), views.size());
+        what += fmt::format("|{} {} {} {} {}", base.relaxIterations, base.seed, uint32_t(base.gridCaches),
+                            base.skyRays, views.size());
         for (const Camera& c : views)
             what += fmt::format("|{} {} {} {} {} {} {} {} {} {}", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y,
                                 c.target.z, c.up.x, c.up.y, c.up.z, c.fovyDegrees);

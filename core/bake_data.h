@@ -98,6 +98,8 @@ struct BakeParams {
     uint32_t linkFinalSamples = 64;  ///< visibility rays of a linked node's final estimate
     uint32_t exposureRays = 64;      ///< rays per surfel for the links' flux weights
                                      ///< (bake/surfel_exposure.h); 0: uniform node radiance
+    uint32_t skyRays = 256;          ///< rays per surfel and per cache for the sky transfer
+                                     ///< (bake/sky_transfer.h); 0: none, skies are refused
     LinkReads linkReads = LinkReads::Visible;
     LinkCut linkCut = LinkCut::ErrorBound;
     uint32_t relaxIterations = 4;    ///< surfel relaxation iterations
@@ -167,6 +169,9 @@ struct BakeData {
     GridLayout grid;
     LightmapLayout lightmap;
     LinkSet links;
+    /// Sky transfer (core/sky.h, bake/sky_transfer.h), empty when params.skyRays is 0:
+    std::vector<float> surfelSky;  ///< nS·kSkyCoefficients: T_k = ∫ V·max(0, n·ω)·y_k per surfel
+    std::vector<float> cacheSky;   ///< nC·skyVisibilityBands(lY)²: v_k = ∫ V·y_k per cache
     std::map<std::string, std::string> defaults;  ///< parameter → how its default was chosen
 };
 

@@ -1,5 +1,8 @@
 #include "core/bake_file.h"
 
+#include "core/sh.h"
+#include "core/sky.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -95,11 +98,11 @@ static_assert(sizeof(ShardRecord) == 24);
 static_assert(sizeof(glm::vec2) == 8 && std::is_trivially_copyable_v<glm::vec2>);
 
 /// Section names in the order the writer emits them; a file must hold each exactly once.
-constexpr std::array<std::string_view, 18> kSectionNames = {
+constexpr std::array<std::string_view, 20> kSectionNames = {
     "params",         "surfels",         "surfel_weights", "nodes",        "levels",
     "caches",         "grid",            "grid_index",     "lightmap",     "lightmap_index",
     "lightmap_uvs",   "links",           "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
-    "links_tint",     "links_offset",    "links_spread_share",
+    "links_tint",     "links_offset",    "links_spread_share", "surfel_sky", "cache_sky",
 };
 constexpr size_t kSectionCount = kSectionNames.size();
 static_assert(std::ranges::all_of(kSectionNames,
@@ -142,6 +145,8 @@ struct BakeView {
     std::span<const uint32_t> tint;
     std::span<const uint16_t> offset;
     std::span<const uint8_t> spreadShare;
+    std::span<const float> surfelSky;
+    std::span<const float> cacheSky;
 };
 
 std::string errnoText(int err) {
@@ -338,13 +343,37 @@ Result<void> checkLinks(const BakeView& v, uint64_t nC, ErrorCode code, const st
     return {};
 }
 
+/// The sky transfer: none without sky rays, else kSkyCoefficients finite values per surfel and
+/// skyVisibilityBands(lY)² per linked cache.
+Result<void> checkSky(const BakeView& v, const BakeParams& p, uint64_t linkedCaches,
+                      ErrorCode code, const std::string& what) {
+    const uint64_t perCache = p.skyRays ? uint64_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
+    const uint64_t perSurfel = p.skyRays ? uint64_t(kSkyCoefficients) : 0;
+    if (v.surfelSky.size() != v.surfels.size() * perSurfel)
+        return fail(code, "{}: {} surfel sky transfer values for {} surfels and {} sky rays, "
+                    "expected {}", what, v.surfelSky.size(), v.surfels.size(), p.skyRays,
+                    v.surfels.size() * perSurfel);
+    if (v.cacheSky.size() != linkedCaches * perCache)
+        return fail(code, "{}: {} cache sky visibility values for {} caches and {} sky rays, "
+                    "expected {}", what, v.cacheSky.size(), linkedCaches, p.skyRays,
+                    linkedCaches * perCache);
+    for (const auto& [values, name] : {std::pair{v.surfelSky, "surfel sky transfer"},
+                                       std::pair{v.cacheSky, "cache sky visibility"}})
+        if (const auto bad = std::ranges::find_if(values, [](float x) { return !std::isfinite(x); });
+            bad != values.end())
+            return fail(code, "{}: {} value {} is {}, expected finite", what, name,
+                        bad - values.begin(), *bad);
+    return {};
+}
+
 /// Checks that counts agree across arrays and that every index lies in range, so that the
-/// runtime can use the arrays without bounds checks; the links are those of `linkedCaches`
-/// caches (all of them in a bake).
-Result<void> checkContents(const BakeView& v, uint64_t linkedCaches, ErrorCode code,
-                           const std::string& what) {
+/// runtime can use the arrays without bounds checks; the links and cache sky visibilities are
+/// those of `linkedCaches` caches (all of them in a bake).
+Result<void> checkContents(const BakeView& v, const BakeParams& p, uint64_t linkedCaches,
+                           ErrorCode code, const std::string& what) {
     if (auto ok = checkNodes(v, code, what); !ok) return ok;
     if (auto ok = checkCachesAndLayouts(v, code, what); !ok) return ok;
+    if (auto ok = checkSky(v, p, linkedCaches, code, what); !ok) return ok;
     return checkLinks(v, linkedCaches, code, what);
 }
 
@@ -376,6 +405,7 @@ Result<std::string> paramsJson(const BakeParams& p,
     json["link_samples"] = p.linkSamples;
     json["link_final_samples"] = p.linkFinalSamples;
     json["exposure_rays"] = p.exposureRays;
+    json["sky_rays"] = p.skyRays;
     json["link_reads"] = linkReadsName(p.linkReads);
     json["link_cut"] = linkCutName(p.linkCut);
     json["relax_iterations"] = p.relaxIterations;
@@ -512,6 +542,7 @@ Result<ParsedParams> parseParams(std::span<const std::byte> bytes, const std::st
     // Bakes written before the final estimate had its own count re-estimated with link_samples.
     PIC_TRY_ASSIGN(p.linkFinalSamples, reader.u32Or("link_final_samples", p.linkSamples));
     PIC_TRY_ASSIGN(p.exposureRays, reader.u32("exposure_rays"));
+    PIC_TRY_ASSIGN(p.skyRays, reader.u32("sky_rays"));
     PIC_TRY_ASSIGN(const uint32_t linkReads, reader.oneOf("link_reads", {"node", "visible"}));
     p.linkReads = static_cast<LinkReads>(linkReads);
     // Bakes written before the error-bound cut refined by solid angle.
@@ -747,6 +778,8 @@ Result<BakeView> viewSections(const SectionMap& s, const std::string& file) {
     PIC_TRY_ASSIGN(v.tint, arrayIn<uint32_t>(s, "links_tint", file));
     PIC_TRY_ASSIGN(v.offset, arrayIn<uint16_t>(s, "links_offset", file));
     PIC_TRY_ASSIGN(v.spreadShare, arrayIn<uint8_t>(s, "links_spread_share", file));
+    PIC_TRY_ASSIGN(v.surfelSky, arrayIn<float>(s, "surfel_sky", file));
+    PIC_TRY_ASSIGN(v.cacheSky, arrayIn<float>(s, "cache_sky", file));
     return v;
 }
 
@@ -779,7 +812,8 @@ Result<DecodedBake> decodeBakeFile(const std::string& path, const FileKind& kind
             return fail(ErrorCode::Corrupt, "{}: shard_sees entry {} is {}, expected 0 or 1", file,
                         bad - sees.begin(), *bad);
     }
-    if (auto ok = checkContents(view, shard.cacheEnd - shard.cacheBegin, ErrorCode::Corrupt, file);
+    if (auto ok = checkContents(view, params.params, shard.cacheEnd - shard.cacheBegin,
+                                ErrorCode::Corrupt, file);
         !ok)
         return std::unexpected(ok.error());
 
@@ -823,6 +857,8 @@ BakeView viewOf(const BakeData& bake) {
     v.tint = links.tint;
     v.offset = links.offset;
     v.spreadShare = links.spreadShare;
+    v.surfelSky = bake.surfelSky;
+    v.cacheSky = bake.cacheSky;
     return v;
 }
 
@@ -853,6 +889,8 @@ std::array<std::span<const std::byte>, kSectionCount> sectionBytesOf(const BakeV
         std::as_bytes(v.tint),
         std::as_bytes(v.offset),
         std::as_bytes(v.spreadShare),
+        std::as_bytes(v.surfelSky),
+        std::as_bytes(v.cacheSky),
     };
 }
 
@@ -985,6 +1023,8 @@ BakeData bakeOf(const DecodedBake& decoded) {
     bake.links.tint = toVector(v.tint);
     bake.links.offset = toVector(v.offset);
     bake.links.spreadShare = toVector(v.spreadShare);
+    bake.surfelSky = toVector(v.surfelSky);
+    bake.cacheSky = toVector(v.cacheSky);
     return bake;
 }
 
@@ -994,7 +1034,8 @@ Result<void> writeBakeFile(const std::string& path, const BakeData& bake) {
     const std::string what = fmt::format("cannot write bake file {}", path);
     if (auto ok = checkParams(bake.params, ErrorCode::InvalidInput, what); !ok) return ok;
     const BakeView view = viewOf(bake);
-    if (auto ok = checkContents(view, view.caches.size(), ErrorCode::InvalidInput, what); !ok)
+    if (auto ok = checkContents(view, bake.params, view.caches.size(), ErrorCode::InvalidInput, what);
+        !ok)
         return ok;
     PIC_TRY_ASSIGN(const std::string params, paramsJson(bake.params, bake.defaults, what));
     return writeSections(path, kBakeKind, bake.sceneHash, sectionBytesOf(view, params), what);
@@ -1020,7 +1061,8 @@ Result<void> writeBakePart(const std::string& path, const BakePart& part) {
                     part.seesSurfel.size(), part.cacheEnd - part.cacheBegin);
     if (auto ok = checkParams(bake.params, ErrorCode::InvalidInput, what); !ok) return ok;
     const BakeView view = viewOf(bake);
-    if (auto ok = checkContents(view, part.cacheEnd - part.cacheBegin, ErrorCode::InvalidInput, what);
+    if (auto ok = checkContents(view, bake.params, part.cacheEnd - part.cacheBegin,
+                                ErrorCode::InvalidInput, what);
         !ok)
         return ok;
     PIC_TRY_ASSIGN(const std::string params, paramsJson(bake.params, bake.defaults, what));

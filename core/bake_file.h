@@ -42,10 +42,13 @@
 ///   links_tint       nC·nL × u32 link tint (core/color.h encodeLinkTint), both modes
 ///   links_offset     nC·nL·3 × u16 finite half float, metres (LinkSet::offset), both modes
 ///   links_spread_share nC·nL × u8 code ≤ 63 (LinkSet::spreadShare, encodeSpreadShare), both modes
+///   surfel_sky       nS·9 × f32 sky transfer (BakeData::surfelSky); empty when sky_rays is 0
+///   cache_sky        nC·skyVisibilityBands(lY)² × f32 sky visibility (BakeData::cacheSky);
+///                    empty when sky_rays is 0
 ///
 /// A part of a sharded bake (BakePart) has the same layout with magic "PICPART\0", the links of
-/// its cache range only (cacheEnd − cacheBegin caches in every links_* section) and two more
-/// sections after links_spread_share:
+/// its cache range only (cacheEnd − cacheBegin caches in every links_* section and in cache_sky) and two more
+/// sections after cache_sky:
 ///   shard            u32 index I, u32 count N, u64 cacheBegin, u64 cacheEnd
 ///   shard_sees       (cacheEnd − cacheBegin) × u8: 1 where the cache's links see a surfel, else 0
 ///
@@ -65,7 +68,7 @@
 namespace pic {
 
 /// Format version written into, and required of, every bake file.
-inline constexpr uint32_t kBakeFormatVersion = 6;
+inline constexpr uint32_t kBakeFormatVersion = 7;
 /// Bytes of the header including its trailing checksum; the section table follows.
 inline constexpr uint64_t kBakeHeaderBytes = 48;
 /// Bytes of one section table entry.

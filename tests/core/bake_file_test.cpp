@@ -15,6 +15,8 @@
 
 #include "core/color.h"
 #include "core/hash.h"
+#include "core/sh.h"
+#include "core/sky.h"
 
 namespace pic {
 namespace {
@@ -25,7 +27,7 @@ constexpr std::string_view kAllSections[] = {
     "params",       "surfels",      "surfel_weights", "nodes",          "levels",
     "caches",       "grid",         "grid_index",     "lightmap",       "lightmap_index",
     "lightmap_uvs", "links",        "links_rtp",      "links_sh_nodes", "links_sh_coeffs",
-    "links_tint",   "links_offset", "links_spread_share",
+    "links_tint",   "links_offset", "links_spread_share", "surfel_sky",   "cache_sky",
 };
 
 /// A hand-made bake: 4 surfels under a balanced hierarchy of 7 nodes, 2 grid caches and 1
@@ -42,6 +44,7 @@ BakeData makeBake(LinkMode mode) {
                    .hierarchy = HierarchyMethod::KdTree,
                    .linkSamples = 8,
                    .linkFinalSamples = 24,
+                   .skyRays = 16,
                    .relaxIterations = 3,
                    .seed = 0x123456789ABCDEF0ull};
     bake.sceneHash = 0xFEEDFACE12345678ull;
@@ -122,6 +125,9 @@ BakeData makeBake(LinkMode mode) {
         bake.links.offset.push_back(floatToHalf(0.125f * float(i) - 1.0f));
     for (uint32_t i = 0; i < nLinks; ++i) bake.links.spreadShare.push_back(encodeSpreadShare(0.2f * float(i)));
     bake.surfelWeights = {0.5f, 1.0f, 2.0f, 1.25f};
+    for (uint32_t i = 0; i < 4 * kSkyCoefficients; ++i) bake.surfelSky.push_back(0.03f * i - 0.5f);
+    const uint32_t visibility = shCount(skyVisibilityBands(3));
+    for (uint32_t i = 0; i < 3 * visibility; ++i) bake.cacheSky.push_back(1.0f - 0.01f * i);
     return bake;
 }
 
@@ -147,6 +153,7 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     EXPECT_EQ(a.params.linkSamples, b.params.linkSamples);
     EXPECT_EQ(a.params.linkFinalSamples, b.params.linkFinalSamples);
     EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
+    EXPECT_EQ(a.params.skyRays, b.params.skyRays);
     EXPECT_EQ(a.params.seed, b.params.seed);
     EXPECT_EQ(a.sceneHash, b.sceneHash);
     EXPECT_EQ(a.defaults, b.defaults);
@@ -174,6 +181,8 @@ void expectSameBake(const BakeData& a, const BakeData& b) {
     EXPECT_EQ(a.links.offset, b.links.offset);
     EXPECT_EQ(a.links.spreadShare, b.links.spreadShare);
     EXPECT_EQ(a.surfelWeights, b.surfelWeights);
+    EXPECT_EQ(a.surfelSky, b.surfelSky);
+    EXPECT_EQ(a.cacheSky, b.cacheSky);
 }
 
 std::vector<char> readBytes(const std::string& path) {
@@ -666,7 +675,8 @@ TEST_F(BakeFile, InconsistentBakeIsNotWritten) {
     EXPECT_TRUE(filesInDir().empty());
 }
 
-/// Shard `index` of `count` of `bake`: every array, the links of caches [begin, end) only.
+/// Shard `index` of `count` of `bake`: every array, the links and sky visibilities of caches
+/// [begin, end) only.
 BakePart partOf(const BakeData& bake, uint32_t index, uint32_t count, uint64_t begin, uint64_t end) {
     BakePart part;
     part.index = index;
@@ -687,6 +697,9 @@ BakePart partOf(const BakeData& bake, uint32_t index, uint32_t count, uint64_t b
     keep(links.tint, 1);
     keep(links.offset, 3);
     keep(links.spreadShare, 1);
+    const size_t perCache = part.bake.cacheSky.size() / bake.caches.size();
+    part.bake.cacheSky = {bake.cacheSky.begin() + begin * perCache,
+                          bake.cacheSky.begin() + end * perCache};
     return part;
 }
 

@@ -223,9 +223,50 @@ TEST(LightSetValidation, RejectsMalformedJsonAndStructure) {
                 "lights[0] has unknown key \"intensty\"");
 }
 
+TEST(LightSetParse, ReadsOneSkyAndWritesItBack) {
+    auto set = parseLightSet(R"({"lights":[{"type":"point","id":"lamp"},
+        {"type":"sky","id":"daylight","color":[0.5,0.75,1],"intensity":3,
+         "environment":"sky/noon.HDR","rotation":-45}]})");
+    ASSERT_TRUE(set) << set.error().message;
+    ASSERT_EQ(set->lights.size(), 1u);
+    ASSERT_TRUE(set->sky);
+    EXPECT_EQ(set->sky->id, "daylight");
+    expectVecNear(set->sky->color, {0.5f, 0.75f, 1.0f}, 0.0f);
+    EXPECT_EQ(set->sky->intensity, 3.0f);
+    EXPECT_EQ(set->sky->environment, "sky/noon.HDR");
+    EXPECT_EQ(set->sky->rotationDegrees, -45.0f);
+    auto again = parseLightSet(toJson(*set));
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_EQ(again->sky, set->sky);
+    // A bare sky is white, 1 W/(m²·sr), constant and unturned, its id generated as any light's.
+    auto bare = parseLightSet(oneLight(R"("type":"sky")"));
+    ASSERT_TRUE(bare) << bare.error().message;
+    ASSERT_TRUE(bare->sky);
+    SkyLight expected;
+    expected.id = "light_0";
+    EXPECT_EQ(*bare->sky, expected);
+    EXPECT_TRUE(bare->lights.empty());
+}
+
+TEST(LightSetValidation, RejectsBadSkies) {
+    expectError(R"({"lights":[{"type":"sky"},{"type":"sky","id":"second"}]})",
+                "lights[1] is a second sky");
+    expectError(oneLight(R"("type":"sky","position":[0,1,0])"),
+                "lights[0].position does not apply to a sky light");
+    expectError(oneLight(R"("type":"sky","environment":"/etc/sky.exr")"),
+                "must be relative to the scene's folder");
+    expectError(oneLight(R"("type":"sky","environment":"maps/../../sky.exr")"), "no \"..\"");
+    expectError(oneLight(R"("type":"sky","environment":"sky.png")"), "must be a .hdr or .exr");
+    expectError(oneLight(R"("type":"sky","environment":7)"), "lights[0].environment");
+    expectError(oneLight(R"("type":"sky","intensity":2e6)"), "lights[0].intensity");
+    expectError(oneLight(R"("type":"sky","color":[1,-1,1])"), "lights[0].color");
+    expectError(oneLight(R"("type":"sky","rotation":"north")"), "lights[0].rotation");
+}
+
 TEST(LightSetValidation, RejectsBadTypesAndIds) {
     expectError(oneLight(R"("id":"a")"), "lights[0].type is missing");
-    expectError(oneLight(R"("type":"area")"), "lights[0].type must be \"point\", \"spot\" or");
+    expectError(oneLight(R"("type":"area")"),
+                "lights[0].type must be \"point\", \"spot\", \"directional\" or \"sky\", got \"area\"");
     expectError(oneLight(R"("type":"point","id":"")"), "lights[0].id must be a non-empty string");
     expectError(oneLight(R"("type":"point","id":7)"), "lights[0].id must be a non-empty string");
     expectError(R"({"lights":[{"type":"point","id":"a"},{"type":"spot","id":"a"}]})",

@@ -21,7 +21,7 @@ namespace {
 using BakeKey =
     std::tuple<std::string, std::optional<uint32_t>, std::optional<uint32_t>,
                std::optional<uint32_t>, std::optional<uint32_t>, std::optional<float>,
-               std::optional<float>, GridCaches, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t,
+               std::optional<float>, GridCaches, LinkMode, HierarchyMethod, uint32_t, uint32_t, uint32_t, uint32_t,
                LinkReads, LinkCut, uint32_t, uint64_t, std::optional<std::pair<float, float>>>;
 
 BakeKey keyOf(const std::string& name, const BakeOptions& o,
@@ -39,6 +39,7 @@ BakeKey keyOf(const std::string& name, const BakeOptions& o,
             o.linkSamples,
             o.linkFinalSamples,
             o.exposureRays,
+            o.skyRays,
             o.linkReads,
             o.linkCut,
             o.relaxIterations,
