@@ -92,7 +92,7 @@ struct BakePart {
     uint32_t count = 1;                ///< N
     uint64_t cacheBegin = 0;
     uint64_t cacheEnd = 0;
-    std::vector<uint8_t> seesSurfel;   ///< per cache of the range: 1 when its links see a surfel
+    std::vector<uint8_t> seesSurfel;   ///< per cache of the range: 1 when its links see a surfel or it sees the sky
     BakeData bake;                     ///< links: (cacheEnd − cacheBegin)·nL entries
 };
 

@@ -11,8 +11,10 @@
 #include "core/sh.h"
 #include "render/cpu/cache_lighting.h"
 #include "render/cpu/pull.h"
+#include "render/cpu/sky_caches.h"
 #include "render/cpu/surfel_lighting.h"
 #include "render/node_spread.h"
+#include "render/sky_lighting.h"
 #include "render/surfel_visibility.h"
 
 namespace pic {
@@ -53,7 +55,8 @@ public:
           mExponential(bake.nodes.size()),
           mNodeLight(bake.nodes.size()),
           mValues(CacheValues::zeros(bake.caches.size(), bake.params.bandsY, bake.params.bandsC)),
-          mStencils(surfelStencils(scene, rays, bake)) {
+          mStencils(surfelStencils(scene, rays, bake)),
+          mSky(scene, bake) {
         // Links' box points, directions and cone factors do not depend on the lights: unpacked
         // once.
         mLinks = unpackLinks(bake, mSpread);
@@ -81,12 +84,14 @@ private:
     std::vector<NodeLight> mNodeLight;   ///< 2nS − 1: both as links read them
     CacheValues mValues;
     std::vector<CacheStencil> mStencils;  ///< nS: the caches each surfel's bounce reads
+    SkyState mSky;
     CacheTextures mTextures;              ///< filled on demand from mValues
     bool mTexturesCurrent = false;
 };
 
 Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateStats* stats) {
     PIC_TRY(checkRuntimeLights(lights, mScene));
+    PIC_TRY_ASSIGN(const SkyLighting* sky, mSky.update(lights));
     mTexturesCurrent = false;
 
     const Clock::time_point start = Clock::now();
@@ -98,16 +103,25 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
     double& cacheMs = s.passMs["cache_lighting"];
 
     BounceSchedule schedule(mBounces, mRatioBound);
-    if (schedule.maxPasses() == 0) {
-        // No cache pass: the caches hold no light and no surfel needs lighting.
-        mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+    // After the last bounce, the caches take the direct sky (render/cpu/sky_caches.h).
+    auto finish = [&]() -> const CacheValues* {
+        if (sky) {
+            const Clock::time_point t = Clock::now();
+            addSkyToCaches(mBake, sky->caches, mValues);
+            s.passMs["sky_caches"] += millisecondsSince(t);
+        }
         s.totalMs = millisecondsSince(start);
         return &mValues;
+    };
+    if (schedule.maxPasses() == 0) {
+        // No cache pass: the caches hold no light but the sky's and no surfel needs lighting.
+        mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+        return finish();
     }
 
     const std::span<glm::vec3> leaves(mNodeFlux.data(), mBake.surfels.size());
     Clock::time_point t = Clock::now();
-    directSurfelFlux(mScene, mRays, mBake, lights, mDirectFlux);
+    directSurfelFlux(mScene, mRays, mBake, lights, mDirectFlux, sky ? &sky->sh : nullptr);
     std::copy(mDirectFlux.begin(), mDirectFlux.end(), leaves.begin());
     glm::dvec3 total = totalFlux(leaves);
     schedule.record(total);
@@ -136,8 +150,7 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
         surfelMs += millisecondsSince(t);
         if (!schedule.record(total)) break;
     }
-    s.totalMs = millisecondsSince(start);
-    return &mValues;
+    return finish();
 }
 
 Result<const CacheTextures*> CpuRuntime::textures() {

@@ -13,6 +13,7 @@
 
 #include "proto/pic.grpc.pb.h"
 #include "proto/wire.h"
+#include "render/sky_lighting.h"
 #include "server/audit_log.h"
 #include "server/limits.h"
 #include "server/metrics_http.h"
@@ -153,6 +154,8 @@ struct PicServer::State {
         if (!bake || stored.bakeId.empty())
             return fmt::format("its bake {} is not served here", stored.bakeId);
         if (auto checked = checkRuntimeLights(stored.lights, bake->scene()); !checked)
+            return checked.error().message;
+        if (auto checked = checkSkyLights(stored.lights, bake->scene(), bake->bake()); !checked)
             return checked.error().message;
         return {};
     }

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "proto/wire.h"
+#include "render/sky_lighting.h"
 #include "server/served_bake.h"
 
 namespace pic {
@@ -100,6 +101,7 @@ Session::~Session() {
 
 Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
     PIC_TRY(checkRuntimeLights(lights, mBake.scene()));
+    PIC_TRY(checkSkyLights(lights, mBake.scene(), mBake.bake()));
     // Versions are handed out only here, under the commit lock: the one read now is the one
     // taken below.
     std::lock_guard committing(mCommitMutex);
@@ -257,6 +259,7 @@ void Session::compute() {
     // A set that changes only what clients apply (the indirect scales) has the caches of the
     // last version: they are reused, and no pass runs.
     if (mStep.previous && job.lights.lights == mStep.previousLights.lights &&
+        job.lights.sky == mStep.previousLights.sky &&
         job.lights.emissiveScale == mStep.previousLights.emissiveScale) {
         *mStep.frame = *mStep.previous;
         mStep.updateMs = millisecondsSince(start);

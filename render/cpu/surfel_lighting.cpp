@@ -18,8 +18,10 @@ constexpr size_t kSurfelGrain = 256;
 }  // namespace
 
 void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
-                      const LightSet& lights, std::span<glm::vec3> directFlux) {
+                      const LightSet& lights, std::span<glm::vec3> directFlux,
+                      const std::array<glm::vec3, kSkyCoefficients>* skySh) {
     PIC_CHECK_EQ(directFlux.size(), bake.surfels.size());
+    PIC_CHECK(!skySh || bake.surfelSky.size() == bake.surfels.size() * kSkyCoefficients);
     // The light set scales emission per material name; resolve the names once, not per surfel.
     std::vector<float> emissiveScale(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m)
@@ -31,6 +33,13 @@ void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeDat
         glm::vec3 irradiance(0.0f);
         for (const Light& light : lights.lights)
             irradiance += visibleIrradiance(rays, surfel, light);
+        if (skySh) {
+            // The sky through the surfel's transfer; SH ringing may dip below zero.
+            const float* transfer = &bake.surfelSky[i * kSkyCoefficients];
+            glm::vec3 sky(0.0f);
+            for (int k = 0; k < kSkyCoefficients; ++k) sky += (*skySh)[k] * transfer[k];
+            irradiance += glm::max(sky, glm::vec3(0.0f));
+        }
         // Lambertian reflection of the direct light plus the material's own emission, both as
         // flux leaving the disc: B·A with B = ρ·E and B = π·L_e.
         glm::vec3 flux = surfel.albedo * (surfel.area * irradiance);

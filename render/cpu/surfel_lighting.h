@@ -8,6 +8,7 @@
 /// caches. The rays it shares with the GPU backend (visibleIrradiance, surfelVisibility,
 /// surfelStencils) are render/surfel_visibility.h.
 
+#include <array>
 #include <span>
 
 #include <glm/glm.hpp>
@@ -16,15 +17,19 @@
 #include "core/cache_values.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "core/sky.h"
 #include "rays/embree_scene.h"
 
 namespace pic {
 
-/// Direct flux of every surfel: ρ·A·Σ_lights E_light·V + π·L_e·A·emissiveScale(material),
+/// Direct flux of every surfel: ρ·A·(Σ_lights E_light·V + E_sky) + π·L_e·A·emissiveScale(material),
 /// with V the Embree visibility from the surfel (offset by rays.epsilon() along its normal) to
-/// the light. `directFlux` must hold nS entries.
+/// the light and E_sky = max(0, Σ_k s_k T_k) per channel, s the sky's radiance SH (`skySh`,
+/// null: no sky) and T the surfel's sky transfer (BakeData::surfelSky). `directFlux` must hold
+/// nS entries.
 void directSurfelFlux(const Scene& scene, const EmbreeScene& rays, const BakeData& bake,
-                      const LightSet& lights, std::span<glm::vec3> directFlux);
+                      const LightSet& lights, std::span<glm::vec3> directFlux,
+                      const std::array<glm::vec3, kSkyCoefficients>* skySh = nullptr);
 
 /// Flux of every surfel for one more bounce: directFlux + ρ·A·E_indirect, E_indirect the
 /// irradiance that the caches of `previousBounce` deliver at the surfel through its stencil

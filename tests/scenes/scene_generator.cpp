@@ -251,6 +251,22 @@ Result<void> buildSmallSpot(GltfBuilder& gltf, const SceneOptions&) {
     return {};
 }
 
+/// `open_plane`: a 4 × 4 m floor of albedo 0.5 open to the sky, nothing else: the sky's furnace
+/// (under a constant sky of radiance L the floor receives π·L and reflects ρ·L) and no lights.
+Result<void> buildOpenPlane(GltfBuilder& gltf, const SceneOptions&) {
+    const uint32_t grey = gltf.addMaterial({.name = "grey", .baseColor = {0.5, 0.5, 0.5}});
+    addMesh(gltf, "floor", grey, [](MeshBuilder& mesh) {
+        mesh.addQuad({-2.0f, 0.0f, -2.0f}, {-2.0f, 0.0f, 2.0f}, {2.0f, 0.0f, 2.0f},
+                     {2.0f, 0.0f, -2.0f}, 4, 4);
+    });
+    gltf.addCamera({.name = "camera",
+                    .eye = {0.0, 3.0, 4.0},
+                    .target = {0.0, 0.0, 0.0},
+                    .yfovDegrees = 60.0,
+                    .aspectRatio = 16.0 / 9.0});
+    return {};
+}
+
 /// `object_box`: a lone 1 m cube centred on the origin, in a light grey: a dynamic object to
 /// place into other scenes (`--object FILE --transform …`); no lights, no camera.
 Result<void> buildObjectBox(GltfBuilder& gltf, const SceneOptions&) {
@@ -933,6 +949,7 @@ constexpr SceneEntry kScenes[] = {
     {"atrium", buildAtrium},
     {"closed_box", buildClosedBox},
     {"object_box", buildObjectBox},
+    {"open_plane", buildOpenPlane},
     {"bad_points", buildBadPoints},
     {"bad_empty", buildBadEmpty},
     {"textured_quad", buildTexturedQuad},
