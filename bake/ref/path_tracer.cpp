@@ -44,16 +44,6 @@ float emittingSolidAngle(const Light& light) {
                                          : 4.0f * kPi;
 }
 
-/// Cosine-weighted direction around unit normal n (density cosθ/π).
-glm::vec3 sampleCosineHemisphere(const glm::vec3& n, float u1, float u2) {
-    float r = std::sqrt(u1);
-    float phi = 2.0f * kPi * u2;
-    float z = std::sqrt(std::max(0.0f, 1.0f - u1));
-    glm::vec3 t, b;
-    orthonormalBasis(n, t, b);
-    return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * n);
-}
-
 bool hasLobe(const PathTraceParams& params) {
     return params.glossyExponent > 0.0f && params.glossyWeight > 0.0f;
 }
@@ -80,8 +70,21 @@ bool isValidRadiance(const glm::vec3& v) {
            v.y >= 0.0f && v.z >= 0.0f;
 }
 
-PathTracer::PathTracer(const Scene& scene, const EmbreeScene& rays, const LightSet& lights)
+Result<PathTracer> PathTracer::create(const Scene& scene, const EmbreeScene& rays,
+                                      const LightSet& lights) {
+    std::optional<Sky> sky;
+    if (lights.sky) {
+        PIC_TRY_ASSIGN(sky, resolveSky(*lights.sky, scene.sourcePath));
+    }
+    return PathTracer(scene, rays, lights, std::move(sky));
+}
+
+PathTracer::PathTracer(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
+                       std::optional<Sky> sky)
     : mScene(&scene), mRays(&rays), mLights(lights) {
+    // A light set's sky must have been resolved (its environment read) by the caller.
+    PIC_CHECK(lights.sky.has_value() == sky.has_value());
+    if (sky) mSky.emplace(std::move(*sky));
     mMaterialEmissionScale.resize(scene.materials.size());
     for (size_t m = 0; m < scene.materials.size(); ++m)
         mMaterialEmissionScale[m] = lights.emissiveScaleOf(scene.materials[m].name);
@@ -233,6 +236,9 @@ glm::vec3 PathTracer::directLight(const glm::vec3& position, const glm::vec3& no
         direct += irradiance * (weight / kPi);
     }
 
+    // The sky is no delta: one sampled direction, shared with BSDF sampling by MIS.
+    if (mSky) direct += skyLight(shadowOrigin, normal, rng);
+
     if (mEmitters.empty()) return direct;
     // One emitter point: a triangle by the CDF, then a uniform point on it (square-root warp).
     float u = rng.uniform();
@@ -263,9 +269,23 @@ glm::vec3 PathTracer::directLight(const glm::vec3& position, const glm::vec3& no
     return direct;
 }
 
+glm::vec3 PathTracer::skyLight(const glm::vec3& shadowOrigin, const glm::vec3& normal,
+                               Rng& rng) const {
+    const float u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
+    const SkySampler::Sample sample = mSky->sample(normal, u1, u2, u3, u4);
+    const float cosSurface = glm::dot(normal, sample.direction);
+    if (!(sample.pdf > 0.0f) || cosSurface <= 0.0f || !(maxComponent(sample.radiance) > 0.0f))
+        return glm::vec3(0.0f);
+    // The sky is only where nothing blocks the ray, however far.
+    if (mRays->occluded(shadowOrigin, sample.direction, 0.0f, kInfinity)) return glm::vec3(0.0f);
+    const float bsdfPdf = cosSurface / kPi;
+    return sample.radiance * (cosSurface / kPi / sample.pdf) *
+           powerHeuristic(sample.pdf, bsdfPdf);
+}
+
 glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& direction,
                                     int maxReflections, PathTraceParams::Component component,
-                                    Rng& rng) const {
+                                    Rng& rng, Escape escape) const {
     using Component = PathTraceParams::Component;
     // Paths of k reflections count for k in [minK, maxK]; maxK < 0 means unlimited.
     const int minK = component == Component::Full ? 0
@@ -285,11 +305,23 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
     glm::vec3 rayOrigin = origin;
     glm::vec3 rayDirection = direction;
     float bsdfPdf = 0.0f;  // solid-angle density of rayDirection; unused for the first ray
+    glm::vec3 previousNormal(0.0f);  // of the vertex rayDirection leaves; unused for the first
 
     // k counts the reflections of the path so far, i.e. before the vertex this ray finds.
     for (int k = 0;; ++k) {
         std::optional<RayHit> hit = mRays->intersect(rayOrigin, rayDirection, 0.0f, kInfinity);
-        if (!hit) break;
+        if (!hit) {
+            // The sky ends a path of k reflections. After a reflection next-event estimation
+            // at the previous vertex sampled the same path (it ran it because k >= minK); the
+            // first ray sees it only where the caller asks (no background behind a camera).
+            if (mSky && k >= minK && (k > 0 || escape == Escape::Sky)) {
+                float weight = 1.0f;
+                if (k > 0)
+                    weight = powerHeuristic(bsdfPdf, mSky->pdf(previousNormal, rayDirection));
+                radiance += throughput * mSky->radiance(rayDirection) * weight;
+            }
+            break;
+        }
         const uint32_t t = hit->triangle;
 
         // Emission seen by this ray ends a path of k reflections. After a reflection the same
@@ -323,8 +355,8 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
                         directLight(position, normal, bsdfAreaPdf, rng, component != Component::Cached || k > 0);
         if (lightVertex && k + 2 >= minK && (unlimited || k + 2 <= maxK))
             radiance += throughput * albedo * connectLightVertex(position, normal, *lightVertex);
-        // Without emitters the continuation can only add longer paths than allowed.
-        if (!unlimited && k + 1 == maxK && mEmitters.empty()) break;
+        // Without emitters or a sky the continuation can only add longer paths than allowed.
+        if (!unlimited && k + 1 == maxK && mEmitters.empty() && !mSky) break;
 
         // Lambertian BRDF ρ/π sampled by cosθ/π: the throughput gains exactly ρ.
         throughput *= albedo;
@@ -337,6 +369,7 @@ glm::vec3 PathTracer::traceRadiance(const glm::vec3& origin, const glm::vec3& di
         rayDirection = sampleCosineHemisphere(normal, u1, u2);
         bsdfPdf = glm::dot(normal, rayDirection) / kPi;
         if (!(bsdfPdf > 0.0f)) break;
+        previousNormal = normal;
         rayOrigin = position + epsilon * normal;
     }
     return radiance;
@@ -356,8 +389,9 @@ glm::vec3 PathTracer::traceGlossy(const glm::vec3& origin, const glm::vec3& dire
     // The surface itself blocks the directions below it.
     if (glm::dot(incoming, normal) <= 0.0f) return glm::vec3(0.0f);
     const int further = maxReflections < 0 ? -1 : maxReflections - 1;
+    // The lobe's direction sees the sky where it escapes: a path of one reflection.
     return traceRadiance(position + mRays->epsilon() * normal, incoming, further,
-                         PathTraceParams::Component::Full, rng);
+                         PathTraceParams::Component::Full, rng, Escape::Sky);
 }
 
 Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const LightSet& lights,
@@ -384,7 +418,7 @@ Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const Light
     const bool lobe = hasLobe(params) && params.component != Component::Direct;
 
     auto start = std::chrono::steady_clock::now();
-    PathTracer tracer(scene, rays, lights);
+    PIC_TRY_ASSIGN(const PathTracer tracer, PathTracer::create(scene, rays, lights));
     CameraRays cameraRays(camera, params.width, params.height);
     // The camera-visible surface's reflection is not a bounce (ARCHITECTURE.md §5).
     const int maxReflections = params.bounces < 0 ? -1 : params.bounces + 1;
@@ -408,7 +442,8 @@ Result<Image> pathTrace(const Scene& scene, const EmbreeScene& rays, const Light
                         params.component == Component::Glossy
                             ? glm::vec3(0.0f)
                             : tracer.traceRadiance(cameraRays.origin(), direction,
-                                                   maxReflections, params.component, rng);
+                                                   maxReflections, params.component, rng,
+                                                   PathTracer::Escape::Black);
                     if (lobe)
                         radiance += params.glossyWeight *
                                     tracer.traceGlossy(cameraRays.origin(), direction,

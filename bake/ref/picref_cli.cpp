@@ -244,8 +244,8 @@ int picrefMain(int argc, char** argv) {
                        "indirect bounces B: 0 = direct light only, -1 = unlimited (default)"),
         app.add_option("--component", render.component,
                        "full (default), direct, indirect, cached (what pic's caches carry: the "
-                       "indirect light and the emitting surfaces' first reflection), or glossy "
-                       "(the --glossy lobe's term alone)")
+                       "indirect light and the emitting surfaces' and the sky's first "
+                       "reflection), or glossy (the --glossy lobe's term alone)")
             ->check(CLI::IsMember({"full", "direct", "indirect", "cached", "glossy"})),
         app.add_option("--glossy", render.glossyExponent,
                        "Phong exponent of a glossy lobe at the visible surface, as picclient "
@@ -277,7 +277,8 @@ int picrefMain(int argc, char** argv) {
                               "directions per cache (default 1024)");
     probesCommand->add_option(
         "--bounces", probes.params.bounces,
-        "reflections B before light reaches a cache (0 = emitters only, -1 = unlimited)");
+        "reflections B before light reaches a cache (0 = emitters and the sky only, "
+        "-1 = unlimited)");
     probesCommand->add_option("--seed", probes.params.seed, "random seed (default 1)");
     bool withPunctual = false;
     probesCommand->add_flag("--with-punctual", withPunctual,

@@ -30,7 +30,7 @@ Result<CacheValues> pathTraceProbes(const Scene& scene, const EmbreeScene& rays,
                     params.bounces);
 
     auto start = std::chrono::steady_clock::now();
-    PathTracer tracer(scene, rays, lights);
+    PIC_TRY_ASSIGN(const PathTracer tracer, PathTracer::create(scene, rays, lights));
     const size_t cacheCount = bake.caches.size();
     CacheValues values = CacheValues::zeros(cacheCount, bandsY, bandsC);
     std::vector<uint64_t> rejectedPerCache(cacheCount, 0);
@@ -50,9 +50,11 @@ Result<CacheValues> pathTraceProbes(const Scene& scene, const EmbreeScene& rays,
                 glm::vec3 direction = frame.toWorld(stratifiedDirection(
                     i, params.samples, rng.uniform(), phiOffset, frame.hemisphere));
                 // The cache is a shading point: what arrives there after at most B reflections,
-                // emitters seen directly included (the caches carry area lights too).
+                // emitters and the sky seen directly included (the caches carry area lights and
+                // the sky too).
                 glm::vec3 radiance = tracer.traceRadiance(cache.position, direction, params.bounces,
-                                                          PathTraceParams::Component::Full, rng);
+                                                          PathTraceParams::Component::Full, rng,
+                                                          PathTracer::Escape::Sky);
                 if (!isValidRadiance(radiance)) {
                     ++rejectedPerCache[c];
                     continue;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -149,6 +150,39 @@ TEST_F(PicrefCli, ImageFlagsDoNotApplyToProbes) {
                                 (mDir / "p.json").string());
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
+}
+
+TEST_F(PicrefCli, SkyLightSetLightsTheOpenBox) {
+    // The Cornell box is open at z = +0.5: a light set holding only a sky lights it through the
+    // opening, where without any light it is black. A missing environment names the file.
+    auto write = [&](const std::string& name, const std::string& json) {
+        std::ofstream(mDir / name) << json;
+        return (mDir / name).string();
+    };
+    const std::string dark = write("dark.json", R"({"lights": []})");
+    const std::string sky =
+        write("sky.json", R"({"lights": [{"id": "sky", "type": "sky", "intensity": 2.0}]})");
+    const std::string missing = write(
+        "missing.json",
+        R"({"lights": [{"id": "sky", "type": "sky", "environment": "no_such_sky.exr"}]})");
+    auto sum = [&](const std::string& lights) {
+        const std::string out = (mDir / "sky.exr").string();
+        test::CommandResult r = run(scene("cornell") + " --scene-camera 0 --size 12x8 --spp 4 "
+                                    "--quiet --lights " + lights + " --out " + out);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        auto image = readImage(out);
+        EXPECT_TRUE(image) << image.error().message;
+        double total = 0.0;
+        if (image)
+            for (const glm::vec3& p : image->pixels) total += p.x + p.y + p.z;
+        return total;
+    };
+    EXPECT_EQ(sum(dark), 0.0);
+    EXPECT_GT(sum(sky), 0.0);
+    test::CommandResult r = run(scene("cornell") + " --scene-camera 0 --size 4x4 --spp 1 " +
+                                "--lights " + missing + " --out " + (mDir / "x.exr").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("no_such_sky.exr"), std::string::npos) << r.err;
 }
 
 }  // namespace
