@@ -11,6 +11,7 @@
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
+#include "render/passes/sky_caches_pass.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/sh_tables.h"
 
@@ -41,7 +42,11 @@ Result<std::unique_ptr<GpuRuntime>> GpuRuntime::create(const Scene& scene, const
 }
 
 GpuRuntime::GpuRuntime(const Scene& scene, const BakeData& bake, const BounceParams& bounces)
-    : mScene(scene), mBake(bake), mBounces(bounces), mRatioBound(bounceRatioBound(bake)) {}
+    : mScene(scene),
+      mBake(bake),
+      mBounces(bounces),
+      mRatioBound(bounceRatioBound(bake)),
+      mSky(scene, bake) {}
 
 GpuRuntime::~GpuRuntime() = default;
 
@@ -111,6 +116,10 @@ Result<void> GpuRuntime::init(const EmbreeScene& rays, const GpuRuntimeOptions& 
     PIC_TRY(mPull->bind(ctx, mNodeFlux, mNodeLight));
     PIC_TRY(mCacheLighting->bind(ctx, mNodeLight, mCacheY, mCacheCo, mCacheCg, mCacheIrradiance,
                                  mShTables));
+    if (!mBake.cacheSky.empty()) {
+        PIC_TRY_ASSIGN(mSkyCaches, createPass<SkyCachesPass>(ctx, config));
+        PIC_TRY(mSkyCaches->bind(mCacheY, mCacheCo, mCacheCg));
+    }
     mLightmapCopyOnHost = options.lightmapCopyOnHost.value_or(ctx.isCpuDevice());
 
     mValues = CacheValues::zeros(nC, mBake.params.bandsY, mBake.params.bandsC);
@@ -141,7 +150,22 @@ Result<void> GpuRuntime::prepareLights(const LightSet& lights) {
         PIC_TRY(mRayVisibility->prepare(lights, reallocated));
     // A new depth image or visibility buffer invalidates the set that reads the old one.
     if (reallocated) PIC_TRY(bindVisibility());
+    PIC_TRY_ASSIGN(mSkyNow, mSky.update(lights));
+    PIC_TRY(mSurfels->setSky(mSkyNow ? &mSkyNow->sh : nullptr));
+    if (mSkyNow && mSkyCaches) PIC_TRY(mSkyCaches->setWeights(mSkyNow->caches));
     return mSurfels->setEmissiveScales(lights);
+}
+
+Result<void> GpuRuntime::addSkyToCaches(UpdateStats& stats) {
+    if (!mSkyNow || !mSkyCaches) return {};
+    return submitTimed(
+        [&](VkCommandBuffer cmd) {
+            mTimer.begin(cmd, "sky_caches");
+            mSkyCaches->record(cmd, {});
+            gpu::computeBarrier(cmd);
+            recordCacheReadback(cmd);
+        },
+        stats);
 }
 
 void GpuRuntime::recordShadowMaps(VkCommandBuffer cmd) {
@@ -181,9 +205,13 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
     BounceSchedule schedule(mBounces, mRatioBound);
     const uint32_t lightCount = uint32_t(lights.lights.size());
     if (schedule.maxPasses() == 0) {
-        // No cache pass: the caches, and so the textures, hold no light.
+        // No cache pass: the caches, and so the textures, hold no light but the sky's.
         mValues = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
         PIC_TRY(uploadCaches(mValues));
+        if (mSkyNow && mSkyCaches) {
+            PIC_TRY(addSkyToCaches(stats));
+            readCaches(mValues);
+        }
         stats.totalMs = millisecondsSince(start);
         return &mValues;
     }
@@ -241,6 +269,8 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         stats.surfelFlux = luminance(glm::vec3(sum));
     }
 
+    // After the last bounce, the direct sky.
+    PIC_TRY(addSkyToCaches(stats));
     readCaches(mValues);
     stats.totalMs = millisecondsSince(start);
     return &mValues;

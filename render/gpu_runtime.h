@@ -19,6 +19,7 @@
 #include "rays/embree_scene.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "render/runtime.h"
+#include "render/sky_lighting.h"
 
 namespace pic {
 
@@ -65,6 +66,7 @@ class RayVisibilityPass;
 class SurfelLightingPass;
 class PullPass;
 class CacheLightingPass;
+class SkyCachesPass;
 class LightmapCopyPass;
 }  // namespace gpu
 
@@ -144,6 +146,8 @@ private:
     Result<gpu::LightmapCopyPass*> lightmapCopyPass();
     /// The caches as the latest submission that recorded recordCacheReadback left them.
     void readCaches(CacheValues& values) const;
+    /// Adds the sky to the caches the last bounce left (SkyCachesPass) and reads them back.
+    Result<void> addSkyToCaches(UpdateStats& stats);
 
     const Scene& mScene;
     const BakeData& mBake;
@@ -156,6 +160,9 @@ private:
     std::unique_ptr<gpu::SurfelLightingPass> mSurfels;
     std::unique_ptr<gpu::PullPass> mPull;
     std::unique_ptr<gpu::CacheLightingPass> mCacheLighting;
+    std::unique_ptr<gpu::SkyCachesPass> mSkyCaches;  ///< bakes with sky transfer only
+    SkyState mSky;
+    const SkyLighting* mSkyNow = nullptr;  ///< the sky of the light set prepared, or null
     std::unique_ptr<gpu::LightmapCopyPass> mLightmapCopy;  ///< see lightmapCopyPass()
     bool mLightmapCopyOnHost = false;
     gpu::PassTimer mTimer;

@@ -1,7 +1,8 @@
 #version 460
 // Surfel lighting (paper 000 Figure 2 step 2): each leaf surfel's outgoing flux in W per RGB
-// channel. Direct mode: Φ = ρ·A·Σ E_light·V + π·L_e·A·emissiveScale, V from the shadow maps
-// or, in the rays mode, one bit per surfel and light traced on the host (RayVisibilityPass);
+// channel. Direct mode: Φ = ρ·A·(Σ E_light·V + E_sky) + π·L_e·A·emissiveScale, V from the
+// shadow maps or, in the rays mode, one bit per surfel and light traced on the host
+// (RayVisibilityPass), E_sky the sky through the surfel's precomputed transfer (core/sky.h);
 // bounce mode: Φ = Φ_direct + ρ·A·E with E the irradiance the previous bounce's caches deliver
 // at the surfel (its precomputed interpolation stencil: light-map caches on its surface through
 // their irradiance along their normal, others through their SH, cut at 0), plus on the last bounce
@@ -50,6 +51,10 @@ layout(std430, binding = 14) writeonly buffer NodeLight { uvec4 nodeLight[]; }; 
 layout(binding = 15) uniform samplerBuffer directFluxTexels;  // binding 5, read by the bounce
 // Per cache: RGB irradiance along a light-map cache's normal (cache lighting writes it).
 layout(binding = 16) uniform samplerBuffer cacheIrradiance;
+// The sky: each surfel's transfer T (kSkyCoefficients floats, BakeData::surfelSky) and the
+// sky's RGB radiance SH s, so that E_sky = max(0, Σ_k s_k T_k) per channel.
+layout(binding = 17) uniform samplerBuffer surfelSky;
+layout(std430, binding = 18) readonly buffer SkySh { vec4 skySh[9]; };
 layout(push_constant) uniform Push { SurfelLightingPush pc; };
 
 #include "lib/sh.glsl"
@@ -79,6 +84,12 @@ void main() {
                         : shadowVisible(light, surfel.position, surfel.normal,
                                         dot(surfel.normal, toLight), pc.epsilon);
                 if (visible) irradiance += e;
+            }
+            if (pc.sky != 0u) {
+                vec3 sky = vec3(0.0);
+                [[unroll]] for (uint k = 0u; k < 9u; ++k)
+                    sky += skySh[k].xyz * texelFetch(surfelSky, int(i * 9u + k)).x;
+                irradiance += max(sky, vec3(0.0));
             }
             flux = surfel.albedo * (surfel.area * irradiance) +
                    (kPi * surfel.area * texelFetch(emissiveScale, int(surfel.material)).x) * surfel.emission;

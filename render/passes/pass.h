@@ -38,11 +38,12 @@ enum class PassKind : uint32_t {
     SurfelLighting,
     Pull,
     CacheLighting,
+    SkyCaches,
     LightmapCopy,
     Gbuffer,
     CacheShading,
 };
-inline constexpr size_t kPassKinds = 8;
+inline constexpr size_t kPassKinds = 9;
 
 /// How the shadow-map pass draws the scene. The caster options are on by default; off only to
 /// measure what they save and to test what they change. The first two store the same depths;
@@ -65,7 +66,7 @@ struct ShadowMapOptions {
 /// pointers it reads must be set and outlive the pass.
 struct PassConfig {
     const Scene* scene = nullptr;  ///< shadow map, surfel lighting, G-buffer
-    /// Ray visibility, surfel lighting, pull, cache lighting, light-map copy.
+    /// Ray visibility, surfel lighting, pull, cache lighting, sky caches, light-map copy.
     const BakeData* bake = nullptr;
     const EmbreeScene* rays = nullptr;   ///< ray visibility; surfel lighting (stencils, ray offset)
     const NodeSpread* spread = nullptr;  ///< pull, cache lighting: nodeSpread(*bake)

@@ -10,6 +10,7 @@
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
+#include "render/passes/sky_caches_pass.h"
 #include "render/passes/surfel_lighting_pass.h"
 
 namespace pic::gpu {
@@ -28,6 +29,7 @@ constexpr std::array<PassEntry, kPassKinds> kPassTable = {
     row<SurfelLightingPass>("surfel_lighting"),
     row<PullPass>("pull"),
     row<CacheLightingPass>("cache_lighting"),
+    row<SkyCachesPass>("sky_caches"),
     row<LightmapCopyPass>("lightmap_copy"),
     row<GbufferPass>("gbuffer"),
     row<CacheShadingPass>("cache_shading"),

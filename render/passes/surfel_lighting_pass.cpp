@@ -12,12 +12,13 @@
 namespace pic::gpu {
 namespace {
 
-constexpr uint32_t kBindingCount = 17;
+constexpr uint32_t kBindingCount = 19;
 constexpr uint32_t kSamplerBinding = 4;
 constexpr uint32_t kShTablesBinding = 11;
 /// Bindings read as uniform texel buffers (shaders/surfel_lighting.comp says why).
-constexpr std::array<uint32_t, 10> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15, 16};
+constexpr std::array<uint32_t, 11> kTexelBindings = {0, 1, 3, 7, 8, 9, 10, 13, 15, 16, 17};
 constexpr VkBufferUsageFlags kTexels = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
+static_assert(kSkyCoefficients == 9, "shaders/surfel_lighting.comp reads 9 sky coefficients");
 
 }  // namespace
 
@@ -110,6 +111,18 @@ Result<std::unique_ptr<Pass>> SurfelLightingPass::create(Context& context,
         pass->mGroupFlux,
         Buffer::create(context, 2 * groupsFor(nS, kSurfelLightingGroup) * sizeof(glm::vec4), 0,
                        MemoryUse::Readback, "surfel flux sums"));
+    // The sky's transfer, or a placeholder for bakes without one (the pass then adds no sky).
+    pass->mHasSkyTransfer = !bake.surfelSky.empty();
+    const std::vector<float> noTransfer(1, 0.0f);
+    PIC_TRY_ASSIGN(pass->mSurfelSky,
+                   Buffer::createWith(context,
+                                      std::span<const float>(pass->mHasSkyTransfer ? bake.surfelSky
+                                                                                   : noTransfer),
+                                      kTexels, "surfel sky transfer"));
+    PIC_TRY_ASSIGN(pass->mSurfelSkyView, TexelView::create(context, pass->mSurfelSky,
+                                                           VK_FORMAT_R32_SFLOAT, "surfel sky"));
+    PIC_TRY_ASSIGN(pass->mSkySh, Buffer::create(context, kSkyCoefficients * sizeof(glm::vec4), 0,
+                                                MemoryUse::Device, "sky SH"));
     // Both modes share one shader, which declares both sources: the one not in use is bound to
     // a placeholder.
     if (rays) {
@@ -162,6 +175,8 @@ Result<void> SurfelLightingPass::bind(const SurfelLightingResources& r) {
         BindingResource::storage(14, *r.nodeRadiance),
         BindingResource::texels(15, mDirectFluxView),
         BindingResource::texels(16, mIrradianceView),
+        BindingResource::texels(17, mSurfelSkyView),
+        BindingResource::storage(18, mSkySh),
     };
     PIC_TRY_ASSIGN(mDirectSet, mDirect.makeSet(resources));
     PIC_TRY_ASSIGN(mBounceSet, mBounce.makeSet(resources));
@@ -175,6 +190,15 @@ Result<void> SurfelLightingPass::setEmissiveScales(const LightSet& lights) {
     return mContext.uploadWithNextSubmit(mEmissiveScale, scales.data(), scales.size() * sizeof(float));
 }
 
+Result<void> SurfelLightingPass::setSky(const std::array<glm::vec3, kSkyCoefficients>* sh) {
+    mSky = sh != nullptr;
+    if (!sh) return {};
+    PIC_CHECK(mHasSkyTransfer);
+    std::array<glm::vec4, kSkyCoefficients> padded;
+    for (int k = 0; k < kSkyCoefficients; ++k) padded[size_t(k)] = glm::vec4((*sh)[size_t(k)], 0.0f);
+    return mContext.uploadWithNextSubmit(mSkySh, padded.data(), sizeof(padded));
+}
+
 void SurfelLightingPass::record(VkCommandBuffer cmd, const FrameResources& frame) {
     PIC_CHECK(frame.sumSlot < 2);
     PIC_CHECK(mDirectSet != VK_NULL_HANDLE && mBounceSet != VK_NULL_HANDLE);
@@ -184,6 +208,7 @@ void SurfelLightingPass::record(VkCommandBuffer cmd, const FrameResources& frame
     push.epsilon = mEpsilon;
     push.sumSlot = frame.sumSlot;
     push.tail = glm::vec4(frame.tail, 0.0f);
+    push.sky = mSky && !frame.bounce ? 1u : 0u;
     const Kernel& kernel = frame.bounce ? mBounce : mDirect;
     kernel.dispatch(cmd, frame.bounce ? mBounceSet : mDirectSet, &push,
                     groupsFor(mSurfelCount, kSurfelLightingGroup));
@@ -202,7 +227,8 @@ Result<glm::dvec3> SurfelLightingPass::totalFlux(uint32_t sumSlot) {
 
 VkDeviceSize SurfelLightingPass::bytes() const {
     return mSurfels.size() + mStencils.size() + mEmissiveScale.size() + mDirectFlux.size() +
-           mGroupFlux.size() + mUnusedLayers.size() + mUnusedVisibility.size();
+           mGroupFlux.size() + mUnusedLayers.size() + mUnusedVisibility.size() +
+           mSurfelSky.size() + mSkySh.size();
 }
 
 }  // namespace pic::gpu

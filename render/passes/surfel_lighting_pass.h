@@ -1,6 +1,6 @@
 #pragma once
 /// Surfel lighting on the GPU (paper 000 Figure 2 step 2): the direct flux of every surfel
-/// from the shadow-mapped lights and its emission, then, per further bounce, that plus the
+/// from the shadow-mapped lights, the sky and its emission, then, per further bounce, that plus the
 /// light the previous bounce's caches deliver to it. CPU twin: render/cpu/surfel_lighting.h.
 /// The direct light's visibility comes from shadow maps or from host-traced rays.
 
@@ -17,6 +17,7 @@
 #include "core/cache_values.h"
 #include "core/light_set.h"
 #include "core/scene.h"
+#include "core/sky.h"
 #include "gpu/device.h"
 #include "gpu/kernel.h"
 #include "gpu/resources.h"
@@ -69,6 +70,10 @@ public:
     Result<void> bind(const SurfelLightingResources& resources);
     /// Writes the per-material emission scales of `lights`.
     Result<void> setEmissiveScales(const LightSet& lights);
+    /// The sky's RGB radiance SH (core/sky.h) the direct part adds through each surfel's sky
+    /// transfer, uploaded with the next submission; null: no sky. A sky needs a bake with sky
+    /// transfer.
+    Result<void> setSky(const std::array<glm::vec3, kSkyCoefficients>* sh);
     /// Records the direct part (directFlux and the leaves) of frame.lightCount lights or, with
     /// frame.bounce, a bounce (the leaves; with a frame.tail, each leaf's new flux S' becomes
     /// S' + tail·max(S' − S, 0), as the CPU twin's bounceSurfelFlux); the pass's flux sum goes
@@ -111,6 +116,11 @@ private:
     TexelView mVisibilityView;
     std::array<TexelView, 3> mCacheViews;  ///< Y, Co, Cg
     TexelView mIrradianceView;             ///< CacheValues::irradiance, RGBA32F
+    bool mHasSkyTransfer = false;  ///< the bake has BakeData::surfelSky
+    bool mSky = false;             ///< the direct part adds the sky (setSky)
+    Buffer mSurfelSky;             ///< float, nS·kSkyCoefficients (or 1 placeholder)
+    TexelView mSurfelSkyView;
+    Buffer mSkySh;                 ///< vec4 × kSkyCoefficients
 };
 
 }  // namespace pic::gpu

@@ -37,8 +37,12 @@ struct SurfelLightingPush {
     float epsilon;     // metres: the CPU twin's ray offset along the normal
     uint sumSlot;      // 0 or 1: which half of groupFlux takes this pass's workgroup sums
     vec4 tail;         // bounce: xyz per channel, leaves = S' + tail·max(S' − S, 0) (BounceSchedule)
+    uint sky;          // direct: 1 adds the sky through each surfel's transfer
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
-PIC_STRUCT_CHECK(SurfelLightingPush, 32);
+PIC_STRUCT_CHECK(SurfelLightingPush, 48);
 
 PIC_NAMESPACE_END
 

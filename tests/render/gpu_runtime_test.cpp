@@ -7,11 +7,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include <unistd.h>
+
+#include "core/image.h"
 #include "core/light_set.h"
 #include "render/cpu_runtime.h"
 #include "render/gpu_runtime.h"
@@ -199,6 +203,52 @@ TEST(GpuRuntime, LightmapCopyIsOnTheHostOnACpuDeviceByDefault) {
     auto gpu = test::gpuFor(b);
     ASSERT_TRUE(gpu);
     EXPECT_EQ(gpu->lightmapCopyOnHost(), gpu->context().isCpuDevice());
+}
+
+TEST(GpuRuntime, SkyMatchesTheCpuRuntime) {
+    // The Cornell box opens towards +Z: a sky with a bright patch, turned so that the patch
+    // looks in, lights it through the surfels' transfer and the caches' visibility. Both
+    // backends with a point light too, with every bounce count: none (the caches hold the sky
+    // alone) and progressive.
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    ASSERT_FALSE(b.bake.cacheSky.empty());
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                      ("pic_gpu_sky_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    Image image(32, 16);
+    for (glm::vec3& texel : image.pixels) texel = glm::vec3(0.3f, 0.4f, 0.6f);
+    for (uint32_t x = 14; x < 18; ++x)
+        for (uint32_t y = 5; y < 8; ++y) image.at(x, y) = glm::vec3(30.0f, 24.0f, 16.0f);
+    ASSERT_TRUE(writeImage((dir / "patch.exr").string(), image));
+    Scene scene = b.scene;
+    scene.sourcePath = (dir / "cornell.gltf").string();
+
+    LightSet lights = defaultLightSet(b.scene);
+    lights.sky = SkyLight{.color = {1.0f, 0.9f, 0.8f}, .intensity = 2.0f,
+                          .environment = "patch.exr", .rotationDegrees = 20.0f};
+    for (const BounceParams bounces : {BounceParams{.bounces = 0}, BounceParams{}}) {
+        auto gpu = GpuRuntime::create(scene, *b.rays, b.bake, bounces, {});
+        ASSERT_TRUE(gpu) << gpu.error().message;
+        auto cpu = createCpuRuntime(scene, *b.rays, b.bake, bounces);
+        ASSERT_TRUE(cpu);
+        UpdateStats gpuStats, cpuStats;
+        auto cpuValues = (*cpu)->setLights(lights, &cpuStats);
+        ASSERT_TRUE(cpuValues) << cpuValues.error().message;
+        auto gpuValues = (*gpu)->setLights(lights, &gpuStats);
+        ASSERT_TRUE(gpuValues) << gpuValues.error().message;
+        EXPECT_EQ(gpuStats.bounces, cpuStats.bounces);
+        EXPECT_TRUE(gpuStats.passMs.contains("sky_caches"));
+        EXPECT_LE(test::relativeL2(**gpuValues, **cpuValues), 0.01) << bounces.bounces;
+        // The sky is there: without it the caches differ by far more.
+        LightSet noSky = lights;
+        noSky.sky.reset();
+        auto darker = (*cpu)->setLights(noSky, nullptr);
+        ASSERT_TRUE(darker);
+        EXPECT_GT(test::relativeL2(**darker, **gpuValues), 0.1) << bounces.bounces;
+        EXPECT_EQ((*gpu)->context().validationMessages(), 0u);
+    }
+    std::filesystem::remove_all(dir);
 }
 
 TEST(GpuRuntime, RefusesInvalidLights) {

@@ -16,6 +16,7 @@
 #include "render/passes/pull_pass.h"
 #include "render/passes/ray_visibility_pass.h"
 #include "render/passes/shadow_map_pass.h"
+#include "render/passes/sky_caches_pass.h"
 #include "render/passes/surfel_lighting_pass.h"
 #include "tests/render/gpu_fixture.h"
 #include "tests/render/renderer_fixture.h"
@@ -72,6 +73,7 @@ TEST(PassTable, EveryRowMakesItsPass) {
     EXPECT_TRUE(madeAs<gpu::SurfelLightingPass>(make(PassKind::SurfelLighting)));
     EXPECT_TRUE(madeAs<gpu::PullPass>(make(PassKind::Pull)));
     EXPECT_TRUE(madeAs<gpu::CacheLightingPass>(make(PassKind::CacheLighting)));
+    EXPECT_TRUE(madeAs<gpu::SkyCachesPass>(make(PassKind::SkyCaches)));
     EXPECT_TRUE(madeAs<gpu::LightmapCopyPass>(make(PassKind::LightmapCopy)));
     EXPECT_TRUE(madeAs<gpu::GbufferPass>(make(PassKind::Gbuffer)));
     EXPECT_TRUE(madeAs<gpu::CacheShadingPass>(make(PassKind::CacheShading)));
