@@ -347,14 +347,18 @@ Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, Bak
     linkParams.cacheEnd = part.cacheEnd;
     PIC_TRY_ASSIGN(LinkResult links, generateLinks(*rays, bake.surfels, bake.nodes, bake.caches, linkParams, weights));
     // Links of a cache are packed from its first slot, so a cache sees a surfel when its first
-    // link does; it sees the sky when its visibility's band 0 (∫ V·y_0) is positive. A cache
-    // that sees either is kept: under a sky, a texel of an open floor that sees no surface
-    // still receives light.
+    // link does; it sees the sky when its visibility's band 0 (∫ V·y_0) is positive. A
+    // light-map cache that sees either is kept: under a sky, a texel of an open floor that
+    // sees no surface still receives light, and only its own surface reads it. A grid cache
+    // must see a surfel: one outside a room's walls that sees only the sky would bring the sky
+    // into the room to points inside that interpolate it.
     const size_t skyPerCache = p.skyRays ? size_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
     part.seesSurfel.resize(part.cacheEnd - part.cacheBegin);
     for (size_t c = 0; c < part.seesSurfel.size(); ++c)
-        part.seesSurfel[c] = links.visibleSolidAngle[c * p.linksPerCache] > 0.0f ||
-                             (skyPerCache && bake.cacheSky[c * skyPerCache] > 0.0f);
+        part.seesSurfel[c] =
+            links.visibleSolidAngle[c * p.linksPerCache] > 0.0f ||
+            (skyPerCache && bake.caches[part.cacheBegin + c].kind == gpu::kCacheKindLightmap &&
+             bake.cacheSky[c * skyPerCache] > 0.0f);
     bake.links = std::move(links.links);
     bake.surfelWeights = weights.empty() ? std::vector<float>(bake.surfels.size(), 1.0f) : weights;
     report.links = links.stats;

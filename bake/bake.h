@@ -113,8 +113,8 @@ private:
     std::vector<std::string> mNames; ///< per shard: the part given for it, empty while missing
 };
 
-/// Removes caches whose links see no surfel and that see no sky (e.g. on the outside of a
-/// closed room's walls): their radiance is zero whatever the lights, so their grid vertices and
+/// Removes caches whose links see no surfel, but light-map caches that see the sky (e.g. grid
+/// caches on the outside of a room's walls): their radiance is zero whatever the lights, so their grid vertices and
 /// light-map texels become kNoCache, which the runtime reads as zero. `seesSurfel` holds one
 /// flag per cache, 1 for the caches to keep. Returns how many were dropped.
 uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel);

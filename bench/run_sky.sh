@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Sky light (docs/accuracy.md, "Sky light"): scenes lit by a sky, relit from a bake's sky
+# transfer and shaded from the caches on the CPU (picref shade, exact shadow rays) and on the
+# GPU backend (lavapipe here), against the path tracer with the same light set, full image,
+# per pixel and over 4×4 blocks. The environment case copies the Cornell box into
+# ${OUT}/environment/ beside a ground-and-sky gradient made with oiiotool. Writes images and
+# JSON into ${OUT:-out/sky}/ and prints a table.
+# Usage: bash bench/run_sky.sh [build-dir]; SPP (default 2048) is the reference's.
+set -euo pipefail
+BUILD=${1:-build}
+OUT=${OUT:-out/sky}
+SPP=${SPP:-2048}
+PICBAKE=$BUILD/bake/picbake
+PICREF=$BUILD/bake/ref/picref
+PICBENCH=$BUILD/bench/picbench
+LIGHTSETS=$(dirname "$0")/lightsets
+mkdir -p "$OUT/environment"
+
+rmse_at() { awk -v b="$2x$2" '$1 == b { print $2 }' <<<"$1"; }
+
+# run_case NAME SCENE LIGHTS SIZE
+run_case() {
+  local name=$1 scene=$2 lights=$3 size=$4
+  local bake="$OUT/$name.pic" ref="$OUT/${name}_ref.exr"
+  [ -f "$bake" ] || "$PICBAKE" --quiet bake "$scene" -o "$bake" > "$OUT/${name}_bake.log"
+  [ -f "$ref" ] || "$PICREF" --quiet "$scene" --scene-camera 0 --lights "$lights" --size "$size" \
+    --spp "$SPP" --out "$ref" 2> /dev/null
+  local row="| $name $size |"
+  for backend in cpu gpu; do
+    local ours="$OUT/${name}_${backend}.exr"
+    "$PICREF" shade --quiet "$scene" --bake "$bake" --scene-camera 0 --lights "$lights" \
+      --size "$size" --backend "$backend" --out "$ours" 2> /dev/null
+    local e
+    e=$("$PICBENCH" --quiet compare "$ours" "$ref" --blocks 1 4 --json "$OUT/${name}_${backend}.json")
+    row+=" $(rmse_at "$e" 1) / $(rmse_at "$e" 4) |"
+  done
+  echo "$row"
+}
+
+# A ground-and-sky gradient, +Y up (v = 0 the zenith): blue above, brown below.
+ENV_DIR=$OUT/environment
+cp "$BUILD/scenes/cornell.gltf" "$BUILD/scenes/cornell.bin" "$ENV_DIR/"
+oiiotool --pattern fill:top=0.5,0.65,1.0:bottom=0.25,0.2,0.15 128x64 3 -d float -o "$ENV_DIR/sky.exr"
+
+echo "| scene, size | CPU shading: pixel / 4×4 | GPU backend: pixel / 4×4 |"
+echo "| --- | --- | --- |"
+run_case cornell_sky "$BUILD/scenes/cornell.gltf" "$LIGHTSETS/sky_only.json" 128x128
+run_case cornell_environment "$ENV_DIR/cornell.gltf" "$LIGHTSETS/sky_environment.json" 128x128
+run_case atrium_day "$BUILD/scenes/atrium.gltf" "$LIGHTSETS/atrium_day.json" 192x108
