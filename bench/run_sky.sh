@@ -4,7 +4,8 @@
 # GPU backend (lavapipe here), against the path tracer with the same light set, full image,
 # per pixel and over 4×4 blocks. The environment case copies the Cornell box into
 # ${OUT}/environment/ beside a ground-and-sky gradient made with oiiotool. Writes images and
-# JSON into ${OUT:-out/sky}/ and prints a table.
+# JSON into ${OUT:-out/sky}/ (PNGs of the environment case and the atrium, exposure 2) and
+# prints a table; the atrium also without its sky, for what the sky adds.
 # Usage: bash bench/run_sky.sh [build-dir]; SPP (default 2048) is the reference's.
 set -euo pipefail
 BUILD=${1:-build}
@@ -18,17 +19,19 @@ mkdir -p "$OUT/environment"
 
 rmse_at() { awk -v b="$2x$2" '$1 == b { print $2 }' <<<"$1"; }
 
-# run_case NAME SCENE LIGHTS SIZE
+# run_case NAME SCENE LIGHTS SIZE [CAMERA] (default: the scene's first camera)
 run_case() {
   local name=$1 scene=$2 lights=$3 size=$4
+  local camera=(--scene-camera 0)
+  [ -z "${5:-}" ] || camera=(--camera "$5")
   local bake="$OUT/$name.pic" ref="$OUT/${name}_ref.exr"
   [ -f "$bake" ] || "$PICBAKE" --quiet bake "$scene" -o "$bake" > "$OUT/${name}_bake.log"
-  [ -f "$ref" ] || "$PICREF" --quiet "$scene" --scene-camera 0 --lights "$lights" --size "$size" \
+  [ -f "$ref" ] || "$PICREF" --quiet "$scene" "${camera[@]}" --lights "$lights" --size "$size" \
     --spp "$SPP" --out "$ref" 2> /dev/null
   local row="| $name $size |"
   for backend in cpu gpu; do
     local ours="$OUT/${name}_${backend}.exr"
-    "$PICREF" shade --quiet "$scene" --bake "$bake" --scene-camera 0 --lights "$lights" \
+    "$PICREF" shade --quiet "$scene" --bake "$bake" "${camera[@]}" --lights "$lights" \
       --size "$size" --backend "$backend" --out "$ours" 2> /dev/null
     local e
     e=$("$PICBENCH" --quiet compare "$ours" "$ref" --blocks 1 4 --json "$OUT/${name}_${backend}.json")
@@ -47,3 +50,17 @@ echo "| --- | --- | --- |"
 run_case cornell_sky "$BUILD/scenes/cornell.gltf" "$LIGHTSETS/sky_only.json" 128x128
 run_case cornell_environment "$ENV_DIR/cornell.gltf" "$LIGHTSETS/sky_environment.json" 128x128
 run_case atrium_day "$BUILD/scenes/atrium.gltf" "$LIGHTSETS/atrium_day.json" 192x108
+run_case atrium_sun "$BUILD/scenes/atrium.gltf" "$LIGHTSETS/atrium_noon_sun.json" 192x108
+# The OpenArena level (../shared/scenes, when present), view a of docs/accuracy.md's level.
+OPENARENA=$(dirname "$0")/../../shared/scenes/openarena_oa_rpg3dm2.glb
+if [ -f "$OPENARENA" ]; then
+  run_case openarena_day "$OPENARENA" "$LIGHTSETS/openarena_day.json" 160x120 -5,8.2,-30,-5,7,-10,0,1,0,70
+  run_case openarena_sun "$OPENARENA" "$LIGHTSETS/openarena_sun.json" 160x120 -5,8.2,-30,-5,7,-10,0,1,0,70
+fi
+
+for name in cornell_environment atrium_day; do
+  for image in cpu ref; do
+    oiiotool "$OUT/${name}_${image}.exr" --mulc 2 --colorconvert linear sRGB -d uint8 \
+      -o "$OUT/${name}_${image}.png"
+  done
+done

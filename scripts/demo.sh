@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds pic and runs the whole story on one scene (default: the
-# generated atrium; pass any .gltf/.glb path, and optionally a light set JSON for it; set
-# PIC_CAMERA for scenes without a camera):
+# generated atrium under a high sun and a blue sky, with a box placed in the courtyard that
+# the bake never saw; pass any .gltf/.glb path, and optionally a light set JSON for it; set
+# PIC_CAMERA for scenes without a camera, PIC_OBJECT=FILE and PIC_TRANSFORM=tx,ty,tz,rx,ry,rz,s
+# to place an object):
 #   bake → picserver (GPU backend: a GPU, else lavapipe) → a session → a light change pushed
 #   by an editor → a frame rendered by the thin client from the streamed caches → a short
 #   load test; prints the timings, the latencies and where the image is.
@@ -11,13 +13,26 @@ bash scripts/build.sh
 BUILD_DIR=${PIC_BUILD_DIR:-build}
 SCENE=${1:-$BUILD_DIR/scenes/atrium.gltf}
 LIGHTS=${2:-}
-if [[ -z "$LIGHTS" && $# -eq 0 ]]; then LIGHTS=bench/lightsets/atrium_evening.json; fi
+OBJECT=${PIC_OBJECT:-}
+TRANSFORM=${PIC_TRANSFORM:-}
+if [[ $# -eq 0 ]]; then
+  LIGHTS=bench/lightsets/atrium_day.json
+  OBJECT=${PIC_OBJECT:-$BUILD_DIR/scenes/object_box.gltf}
+  TRANSFORM=${PIC_TRANSFORM:--6,0.75,0.5,0,30,0,1.5}
+fi
 OUT_DIR=${PIC_OUT_DIR:-out}
 mkdir -p "$OUT_DIR"
 NAME=$(basename "${SCENE%.*}")
 BAKE="$OUT_DIR/$NAME.pic"
 
-"$BUILD_DIR/bake/picbake" bake "$SCENE" -o "$BAKE"
+# A placed object reads the grid caches where it stands: the bake fills the free space with them.
+BAKE_ARGS=()
+OBJECT_ARGS=()
+if [[ -n "$OBJECT" ]]; then
+  BAKE_ARGS=(--grid-caches space)
+  OBJECT_ARGS=(--object "$OBJECT" --transform "${TRANSFORM:-0,0,0,0,0,0,1}")
+fi
+"$BUILD_DIR/bake/picbake" bake "$SCENE" "${BAKE_ARGS[@]}" -o "$BAKE"
 "$BUILD_DIR/bake/picbake" info "$BAKE"
 echo "bake written to $BAKE (timings in $BAKE.timings.json)"
 
@@ -49,7 +64,7 @@ if [[ -n "${PIC_CAMERA:-}" ]]; then CAMERA_ARGS=(--camera "$PIC_CAMERA"); fi
 LIGHT_ARGS=()
 if [[ -n "$LIGHTS" ]]; then LIGHT_ARGS=(--lights "$LIGHTS"); fi
 "$BUILD_DIR/client/picclient" render --server "$ADDRESS" --session "$SESSION" --token "$EDITOR" \
-  "${LIGHT_ARGS[@]}" "${CAMERA_ARGS[@]}" --size 640x360 --out "$IMAGE"
+  "${LIGHT_ARGS[@]}" "${CAMERA_ARGS[@]}" "${OBJECT_ARGS[@]}" --size 640x360 --out "$IMAGE"
 
 REPORT="$OUT_DIR/${NAME}_load.json"
 "$BUILD_DIR/client/picclient" load --server "$ADDRESS" --session "$SESSION" --token "$EDITOR" \

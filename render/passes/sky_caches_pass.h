@@ -3,6 +3,7 @@
 /// its sky visibility from the bake times the update's folded sky (SkyCacheWeights), into the
 /// half-float caches. CPU twin: render/cpu/sky_caches.h.
 
+#include <array>
 #include <memory>
 
 #include "core/bake_data.h"
@@ -20,7 +21,8 @@ public:
     /// Uploads the sky visibility of config.bake's caches; InvalidInput when the bake has none
     /// (baked with --sky-rays 0) or no caches.
     static Result<std::unique_ptr<Pass>> create(Context& context, const PassConfig& config);
-    /// Binds the caches (half, cache-major) the sky is added to.
+    /// Binds the caches (half, cache-major) the sky is added to; their usage must allow
+    /// uniform texel buffers (VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT).
     Result<void> bind(const Buffer& cacheY, const Buffer& cacheCo, const Buffer& cacheCg);
     /// Uploads the sky of this update with the next submission (made for the bake's lY, lC).
     Result<void> setWeights(const SkyCacheWeights& weights);
@@ -35,6 +37,8 @@ private:
     uint32_t mCacheCount = 0;
     int mBandsY = 0, mBandsC = 0;
     Buffer mVisibility;  ///< float, nC·nV (BakeData::cacheSky)
+    TexelView mVisibilityView;
+    std::array<TexelView, 3> mCacheViews;  ///< Y, Co, Cg as R16F texels
     Buffer mWeights;     ///< float, (lY² + 2·lC²)·nV
     VkDescriptorSet mSet = VK_NULL_HANDLE;
 };

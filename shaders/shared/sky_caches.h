@@ -7,6 +7,8 @@
 PIC_NAMESPACE_BEGIN
 
 PIC_CONST(uint, kSkyCachesGroup, 64u);
+// The weights' uniform buffer in vec4s: (lY² + 2·lC²)·nV floats, at most (64 + 128)·64.
+PIC_CONST(uint, kMaxSkyWeightVec4s, 3072u);
 
 struct SkyCachesPush {
     uint cacheCount;
