@@ -434,9 +434,28 @@ Result<CacheTextures> GpuRuntime::runLightmapCopy(const CacheValues& values) {
     return textures;
 }
 
+Result<CacheValues> GpuRuntime::runSkyCaches(const CacheValues& values,
+                                             const SkyCacheWeights& weights) {
+    if (!mSkyCaches)
+        return fail(ErrorCode::InvalidInput,
+                    "the bake has no sky transfer (baked with --sky-rays 0)");
+    PIC_TRY(uploadCaches(values));
+    PIC_TRY(mSkyCaches->setWeights(weights));
+    PIC_TRY(mContext->submit([&](VkCommandBuffer cmd) {
+        mSkyCaches->record(cmd, {});
+        gpu::computeBarrier(cmd);
+        recordCacheReadback(cmd);
+    }));
+    CacheValues out = CacheValues::zeros(mBake.caches.size(), mValues.bandsY, mValues.bandsC);
+    readCaches(out);
+    mTexturesCurrent = false;
+    return out;
+}
+
 std::vector<std::pair<std::string, uint64_t>> GpuRuntime::memory() const {
     return {
         {"links", mCacheLighting->bytes()},
+        {"sky", mSkyCaches ? mSkyCaches->bytes() : 0},
         {"surfels", mSurfels->bytes()},
         {"pull_nodes", mPull->bytes()},
         {"node_flux", mNodeFlux.size()},

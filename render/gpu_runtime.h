@@ -113,6 +113,9 @@ public:
     Result<std::vector<glm::uvec4>> nodeLight();
     /// Light-map copy of `values` into the textures.
     Result<CacheTextures> runLightmapCopy(const CacheValues& values);
+    /// The sky of `weights` (made for the bake's lY, lC) added to `values`; InvalidInput for a
+    /// bake without sky transfer.
+    Result<CacheValues> runSkyCaches(const CacheValues& values, const SkyCacheWeights& weights);
 
     /// Device memory per buffer group, bytes, for the benchmark (paper 000 Table 4).
     std::vector<std::pair<std::string, uint64_t>> memory() const;
