@@ -448,19 +448,18 @@ Result<void> BakeJoiner::add(BakePart part, const std::string& name) {
 
     if (!mBake) {
         mSees.assign(nC, 0);
+        const BakeParams& p = part.bake.params;
+        mSkyPerCache = p.skyRays ? size_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
         mBake = std::move(part.bake);
         if (part.count > 1) {
             // Room for every cache's links; this part's go in their place below.
             LinkSet own = std::move(mBake->links);
             mBake->links = paddingLinks(own.mode, own.linksPerCache, own.bands, nC);
             placeLinks(mBake->links, own, begin);
+            // Likewise the caches' sky visibility.
             std::vector<float> ownSky = std::move(mBake->cacheSky);
-            const size_t perCache = end > begin ? ownSky.size() / (end - begin) : 0;
-            mSkyPerCache = perCache;
-            mBake->cacheSky.assign(nC * perCache, 0.0f);
-            std::ranges::copy(ownSky, mBake->cacheSky.begin() + begin * perCache);
-        } else {
-            mSkyPerCache = end > begin ? mBake->cacheSky.size() / (end - begin) : 0;
+            mBake->cacheSky.assign(nC * mSkyPerCache, 0.0f);
+            std::ranges::copy(ownSky, mBake->cacheSky.begin() + begin * mSkyPerCache);
         }
     } else {
         placeLinks(mBake->links, part.bake.links, begin);
