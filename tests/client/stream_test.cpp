@@ -683,6 +683,44 @@ TEST(Stream, FramesCarryTheirLightSetAndScaleOnlyChangesReuseTheCaches) {
     EXPECT_TRUE(reader.errors().empty());
 }
 
+TEST(Stream, ASkyIsRelitStreamedAndCarriedBackAndABadOneRefused) {
+    // The Cornell box opens at the front: a sky over the wire relights it, the frame carries
+    // the sky back, and turning the sky relights it again; an environment that is not there is
+    // refused by the session before any version is taken.
+    Served served = serve();
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    LightSet lights = pointLight(0.1f);
+    auto lamp = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(lamp);
+    ASSERT_TRUE(reader.waitFor(*lamp));
+    const auto lampOnly = served.server->session(session->session())->latestUpdate();
+
+    lights.sky = SkyLight{.id = "daylight", .color = {0.6f, 0.75f, 1.0f}, .intensity = 2.0f};
+    auto sky = served.connection->setLights(session->session(), session->editor_token(), lights);
+    ASSERT_TRUE(sky) << sky.error().message;
+    ASSERT_TRUE(reader.waitFor(*sky));
+    const auto skyLit = served.server->session(session->session())->latestUpdate();
+    EXPECT_GT(skyLit->broadcast->bounces(), 0u);
+    EXPECT_TRUE(skyLit->broadcast->pass_ms().contains("sky_caches"));
+    EXPECT_FALSE(*skyLit->frame == *lampOnly->frame);
+    ASSERT_TRUE(reader.lights());
+    EXPECT_EQ(reader.lights()->sky, lights.sky);
+    EXPECT_TRUE(reader.frame() == *skyLit->frame);
+
+    const uint64_t before = served.server->session(session->session())->latestVersion();
+    LightSet missing = lights;
+    missing.sky->environment = "absent.hdr";
+    auto refused = served.connection->setLights(session->session(), session->editor_token(), missing);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("absent.hdr"), std::string::npos)
+        << refused.error().message;
+    EXPECT_EQ(served.server->session(session->session())->latestVersion(), before);
+    EXPECT_TRUE(reader.errors().empty());
+}
+
 TEST(Stream, ClientIndirectRenderFromTheStreamMatchesTheCpuShading) {
     Served served = serve();
     ASSERT_TRUE(served.connection);
