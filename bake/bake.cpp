@@ -63,7 +63,7 @@ uint32_t dropBlindCaches(BakeData& bake, const std::vector<uint8_t>& seesSurfel)
         if (seesSurfel[c]) remap[c] = kept++;
     const uint32_t dropped = static_cast<uint32_t>(nC - kept);
     if (dropped == 0) return 0;
-    const size_t skyPerCache = nC ? bake.cacheSky.size() / nC : 0;
+    const size_t skyPerCache = skyValuesPerCache(bake.params);
 
     LinkSet& links = bake.links;
     const size_t coefficients = links.mode == LinkMode::Sh ? size_t{links.bands} * links.bands : 0;
@@ -352,7 +352,7 @@ Result<BakePart> runBakePart(const Scene& scene, const BakeOptions& options, Bak
     // sees no surface still receives light, and only its own surface reads it. A grid cache
     // must see a surfel: one outside a room's walls that sees only the sky would bring the sky
     // into the room to points inside that interpolate it.
-    const size_t skyPerCache = p.skyRays ? size_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
+    const size_t skyPerCache = skyValuesPerCache(p);
     part.seesSurfel.resize(part.cacheEnd - part.cacheBegin);
     for (size_t c = 0; c < part.seesSurfel.size(); ++c)
         part.seesSurfel[c] =
@@ -448,8 +448,7 @@ Result<void> BakeJoiner::add(BakePart part, const std::string& name) {
 
     if (!mBake) {
         mSees.assign(nC, 0);
-        const BakeParams& p = part.bake.params;
-        mSkyPerCache = p.skyRays ? size_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
+        mSkyPerCache = skyValuesPerCache(part.bake.params);
         mBake = std::move(part.bake);
         if (part.count > 1) {
             // Room for every cache's links; this part's go in their place below.

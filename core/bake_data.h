@@ -171,7 +171,7 @@ struct BakeData {
     LinkSet links;
     /// Sky transfer (core/sky.h, bake/sky_transfer.h), empty when params.skyRays is 0:
     std::vector<float> surfelSky;  ///< nS·kSkyCoefficients: T_k = ∫ V·max(0, n·ω)·y_k per surfel
-    std::vector<float> cacheSky;   ///< nC·skyVisibilityBands(lY)²: v_k = ∫ V·y_k per cache
+    std::vector<float> cacheSky;   ///< nC·skyValuesPerCache(params): v_k = ∫ V·y_k per cache
     std::map<std::string, std::string> defaults;  ///< parameter → how its default was chosen
 };
 

@@ -347,7 +347,7 @@ Result<void> checkLinks(const BakeView& v, uint64_t nC, ErrorCode code, const st
 /// skyVisibilityBands(lY)² per linked cache.
 Result<void> checkSky(const BakeView& v, const BakeParams& p, uint64_t linkedCaches,
                       ErrorCode code, const std::string& what) {
-    const uint64_t perCache = p.skyRays ? uint64_t(shCount(skyVisibilityBands(int(p.bandsY)))) : 0;
+    const uint64_t perCache = skyValuesPerCache(p);
     const uint64_t perSurfel = p.skyRays ? uint64_t(kSkyCoefficients) : 0;
     if (v.surfelSky.size() != v.surfels.size() * perSurfel)
         return fail(code, "{}: {} surfel sky transfer values for {} surfels and {} sky rays, "

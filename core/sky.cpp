@@ -47,6 +47,10 @@ struct EnvironmentKey {
 
 }  // namespace
 
+size_t skyValuesPerCache(const BakeParams& params) {
+    return params.skyRays ? size_t(shCount(skyVisibilityBands(int(params.bandsY)))) : 0;
+}
+
 glm::vec3 skyDirection(float u, float v) {
     const float theta = glm::pi<float>() * v;
     const float phi = glm::two_pi<float>() * u;

@@ -25,6 +25,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/bake_data.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/light_set.h"
@@ -44,6 +45,10 @@ inline constexpr uint32_t kMaxEnvironmentSide = 16384;
 constexpr int skyVisibilityBands(int bandsY) {
     return bandsY + kSkyBands - 1 < 8 ? bandsY + kSkyBands - 1 : 8;
 }
+
+/// Sky visibility values a bake stores per cache (BakeData::cacheSky): skyVisibilityBands(lY)²
+/// with sky transfer, 0 without.
+size_t skyValuesPerCache(const BakeParams& params);
 
 /// The direction texel coordinate (u, v) of an environment image looks along (unit).
 glm::vec3 skyDirection(float u, float v);

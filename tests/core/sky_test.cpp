@@ -105,22 +105,30 @@ TEST(SkyProjection, OneBrightTexelProjectsAsItsSolidAngleTimesTheBasis) {
     expectVecNear(sky.radiance(-d), {0.0f, 0.0f, 0.0f}, 0.0f);
 }
 
-/// ∫ y_i y_j y_k over the sphere by a fine midpoint rule in (cos θ, φ).
-double bruteForceGaunt(int i, int j, int k) {
-    const int nz = 400, nphi = 800;
-    double sum = 0.0;
-    float basis[64];
+/// Calls visit(direction, solid angle) at the nodes of a midpoint rule over the sphere,
+/// nz × nphi cells in (cos θ, φ) of equal solid angle.
+template <class Visit>
+void forSphereCells(int nz, int nphi, Visit&& visit) {
+    const double dOmega = (2.0 / nz) * (2.0 * std::numbers::pi / nphi);
     for (int a = 0; a < nz; ++a) {
         const double z = -1.0 + 2.0 * (a + 0.5) / nz;
         const double s = std::sqrt(1.0 - z * z);
         for (int b = 0; b < nphi; ++b) {
             const double phi = 2.0 * std::numbers::pi * (b + 0.5) / nphi;
-            shEvaluate(8, glm::vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(z)),
-                       basis);
-            sum += double(basis[i]) * double(basis[j]) * double(basis[k]);
+            visit(glm::vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(z)), dOmega);
         }
     }
-    return sum * (2.0 / nz) * (2.0 * std::numbers::pi / nphi);
+}
+
+/// ∫ y_i y_j y_k over the sphere by a fine midpoint rule.
+double bruteForceGaunt(int i, int j, int k) {
+    double sum = 0.0;
+    float basis[64];
+    forSphereCells(400, 800, [&](const glm::vec3& direction, double dOmega) {
+        shEvaluate(8, direction, basis);
+        sum += double(basis[i]) * double(basis[j]) * double(basis[k]) * dOmega;
+    });
+    return sum;
 }
 
 TEST(SkyGaunt, MatchesBruteForceQuadrature) {
@@ -164,27 +172,18 @@ TEST(SkyCacheWeights, FoldTheSkyTimesTheVisibility) {
     std::vector<float> visibility(nV);
     for (float& v : visibility) v = uniform(rng);
 
-    const int nz = 200, nphi = 400;
     std::vector<glm::dvec3> expected(shCount(bandsY), glm::dvec3(0.0));
     float basis[64];
-    for (int a = 0; a < nz; ++a) {
-        const double z = -1.0 + 2.0 * (a + 0.5) / nz;
-        const double s = std::sqrt(1.0 - z * z);
-        for (int b = 0; b < nphi; ++b) {
-            const double phi = 2.0 * std::numbers::pi * (b + 0.5) / nphi;
-            shEvaluate(w.visibilityBands,
-                       glm::vec3(float(s * std::cos(phi)), float(s * std::sin(phi)), float(z)),
-                       basis);
-            glm::dvec3 radiance(0.0);
-            for (int j = 0; j < kSkyCoefficients; ++j) radiance += glm::dvec3(sky[j]) * double(basis[j]);
-            double v = 0.0;
-            for (int k = 0; k < nV; ++k) v += double(visibility[k]) * basis[k];
-            for (int i = 0; i < shCount(bandsY); ++i) expected[i] += radiance * v * double(basis[i]);
-        }
-    }
-    const double dOmega = (2.0 / nz) * (2.0 * std::numbers::pi / nphi);
+    forSphereCells(200, 400, [&](const glm::vec3& direction, double dOmega) {
+        shEvaluate(w.visibilityBands, direction, basis);
+        glm::dvec3 radiance(0.0);
+        for (int j = 0; j < kSkyCoefficients; ++j) radiance += glm::dvec3(sky[j]) * double(basis[j]);
+        double v = 0.0;
+        for (int k = 0; k < nV; ++k) v += double(visibility[k]) * basis[k];
+        for (int i = 0; i < shCount(bandsY); ++i) expected[i] += radiance * v * double(basis[i]) * dOmega;
+    });
     for (int i = 0; i < shCount(bandsY); ++i) {
-        const glm::vec3 ycocg = rgbToYCoCg(glm::vec3(expected[i] * dOmega));
+        const glm::vec3 ycocg = rgbToYCoCg(glm::vec3(expected[i]));
         float y = 0.0f, co = 0.0f, cg = 0.0f;
         for (int k = 0; k < nV; ++k) {
             y += w.y[size_t(i) * nV + k] * visibility[k];
