@@ -13,6 +13,7 @@
 #include "bench/runtime_benchmark.h"
 #include "bench/stability_benchmark.h"
 #include "bench/soak_benchmark.h"
+#include "bench/budget_benchmark.h"
 #include "bench/stream_benchmark.h"
 #include "bench/sweep_benchmark.h"
 #include "core/cli.h"
@@ -250,6 +251,28 @@ int picbenchMain(int argc, char** argv) {
         ->check(CLI::Range(1, 19));
     codec->add_option("--json", codecParams.jsonPath, "JSON file (default out/codec_benchmark.json)");
 
+    CLI::App* budget = app.add_subcommand(
+        "budget", "picserver --update-budget-ms: time to the first visible change and to the "
+                  "final state against the budget, under load");
+    BudgetBenchmarkParams budgetParams;
+    addSceneOption(*budget, budgetParams.scenePath);
+    budget->add_option("--bake", budgetParams.bakePath, "the scene's bake (default: one at --setting)")
+        ->check(CLI::ExistingFile);
+    addSettingOption(*budget, budgetParams.setting);
+    budget->add_option("--backend", budgetParams.backend, "server backend (default: gpu)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    budget->add_option("--budgets", budgetParams.budgets,
+                       "budgets in ms, 0 the unbudgeted baseline (default: 0 5 10 20 40 80)")
+        ->check(CLI::Range(0.0, 1e6));
+    budget->add_option("--clients", budgetParams.clients, "subscribers (default 64)")
+        ->check(CLI::Range(1u, 10000u));
+    budget->add_option("--duration", budgetParams.duration, "seconds of light changes per budget (default 10)")
+        ->check(CLI::Range(0.1, 3600.0));
+    budget->add_option("--update-rate", budgetParams.updateRate, "light changes per second (default 2)")
+        ->check(CLI::Range(0.01, 1000.0));
+    budget->add_option("--picserver", budgetParams.picserver, "picserver binary (default: the build tree's)");
+    budget->add_option("--json", budgetParams.jsonPath, "JSON file (default out/budget_benchmark.json)");
+
     CLI::App* stream = app.add_subcommand(
         "stream", "the server under load: light-change latency to N subscribers, server CPU per "
                   "update, bytes per key and delta frame");
@@ -401,6 +424,7 @@ int picbenchMain(int argc, char** argv) {
     if (runtime->parsed()) return runRuntimeBenchmark(runtimeParams);
     if (shadows->parsed()) return runShadowBenchmark(shadowParams);
     if (codec->parsed()) return runCodecBenchmark(codecParams);
+    if (budget->parsed()) return runBudgetBenchmark(budgetParams);
     if (stream->parsed()) return runStreamBenchmark(streamParams);
     if (soak->parsed()) return runSoakBenchmark(soakParams);
     if (links->parsed()) {

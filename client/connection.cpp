@@ -487,10 +487,13 @@ FrameDecoder::FrameDecoder(const v1::SceneHeader& header) {
 }
 
 Result<void> FrameDecoder::apply(v1::Frame& frame) {
-    if (frame.base_version() != 0 && frame.base_version() != mVersion)
+    if (frame.base_version() != 0 &&
+        (frame.base_version() != mVersion || frame.base_part() != mPart))
         return fail(ErrorCode::Corrupt,
-                    "frame of version {} is a delta against version {}, but version {} is held",
-                    frame.version(), frame.base_version(), mVersion);
+                    "frame of version {} part {} is a delta against version {} part {}, but "
+                    "version {} part {} is held",
+                    frame.version(), frame.part(), frame.base_version(), frame.base_part(),
+                    mVersion, mPart);
     std::optional<LightSet> lights;
     if (frame.has_lights()) {
         auto parsed = wire::fromProto(frame.lights());
@@ -517,6 +520,7 @@ Result<void> FrameDecoder::apply(v1::Frame& frame) {
         PIC_TRY(decodeFrame(encoded, mFrame));
     }
     mVersion = frame.version();
+    mPart = frame.part();
     if (lights) mLights = std::move(*lights);
     return {};
 }

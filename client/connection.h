@@ -157,12 +157,19 @@ public:
     /// A decoder for the frames of a session on `header`'s bake: a frame whose planes do not
     /// hold that bake's caches is refused before anything is allocated for it.
     explicit FrameDecoder(const v1::SceneHeader& header);
-    /// Decodes `frame` (its bytes are moved out). Corrupt when it is a delta against a version
+    /// Decodes `frame` (its bytes are moved out). Corrupt when it is a delta against a state
     /// other than the one held, does not decode or carries a light set that does not parse;
-    /// the held version is then unchanged.
+    /// the held state is then unchanged.
     Result<void> apply(v1::Frame& frame);
     /// The version held, 0 before the first key frame.
     uint64_t version() const { return mVersion; }
+    /// The part of it held: 0, its final state; k ≥ 1, the k-th earlier part of a budgeted
+    /// update (v1::Frame::part).
+    uint32_t part() const { return mPart; }
+    /// Whether what is held is at least `version`'s final state (or any part of a newer one).
+    bool holds(uint64_t version) const {
+        return mVersion > version || (mVersion == version && mPart == 0);
+    }
     const HalfFrame& frame() const { return mFrame; }
     /// The light set of the newest frame that carried one (null before): the direct light and
     /// indirect scales to shade the held caches with.
@@ -171,6 +178,7 @@ public:
 private:
     HalfFrame mFrame;
     uint64_t mVersion = 0;
+    uint32_t mPart = 0;
     std::optional<LightSet> mLights;
     std::array<size_t, kFramePlanes> mExpected{};  ///< values per plane
 };

@@ -27,11 +27,19 @@ double percentile(std::vector<double> values, double p) {
     return values[std::min(values.size() - 1, index == 0 ? 0 : index - 1)];
 }
 
-/// What one subscriber saw: when it held each version, and what frames cost.
+/// A state a subscriber came to hold (a version's final state, or an earlier part: part ≥ 1).
+struct Held {
+    uint64_t version = 0;
+    uint32_t part = 0;
+    Clock::time_point when;
+};
+
+/// What one subscriber saw: when it held each state, and what frames cost.
 struct Received {
-    std::vector<std::pair<uint64_t, Clock::time_point>> versions;  ///< in arrival order
+    std::vector<Held> versions;  ///< in arrival order
     uint64_t keyBytes = 0, keyFrames = 0, deltaBytes = 0, deltaFrames = 0;
     uint64_t skipped = 0;
+    uint64_t partialFrames = 0;  ///< earlier parts of budgeted versions
     std::vector<std::string> errors;
     std::map<uint64_t, std::pair<double, double>> serverMs;  ///< version → update, encode ms
 };
@@ -58,8 +66,9 @@ void subscribeLoop(FrameStream& stream, const v1::SceneHeader& header, Received&
         if (!first && frame.version() > previous + 1) received.skipped += frame.version() - previous - 1;
         (key ? received.keyBytes : received.deltaBytes) += bytes;
         ++(key ? received.keyFrames : received.deltaFrames);
-        received.versions.emplace_back(frame.version(), now);
-        received.serverMs[frame.version()] = serverMs;
+        received.versions.push_back({frame.version(), frame.part(), now});
+        if (frame.part() == 0) received.serverMs[frame.version()] = serverMs;
+        else ++received.partialFrames;
         if (first) ready.fetch_add(1);
         first = false;
     }
@@ -68,6 +77,13 @@ void subscribeLoop(FrameStream& stream, const v1::SceneHeader& header, Received&
         std::lock_guard lock(mutex);
         received.errors.push_back(wire::fromStatus(status, "Subscribe").message);
     }
+}
+
+/// Whether the subscriber held `version`'s final state or any state of a newer version.
+bool holdsFinal(const Received& received, uint64_t version) {
+    if (received.versions.empty()) return false;
+    const Held& last = received.versions.back();
+    return last.version > version || (last.version == version && last.part == 0);
 }
 
 }  // namespace
@@ -152,7 +168,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     const auto holdsLast = [&] {
         std::lock_guard lock(mutex);
         for (const Received& r : received)
-            if (r.versions.empty() || r.versions.back().first < lastVersion) return false;
+            if (!holdsFinal(r, lastVersion)) return false;
         return true;
     };
     const auto drainStart = Clock::now();
@@ -163,9 +179,10 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     for (auto& stream : streams) stream->cancel();
     for (auto& thread : threads) thread.join();
 
-    std::vector<double> latencies;
+    std::vector<double> latencies, firstChanges;
     std::map<uint64_t, std::pair<double, double>> serverMs;
     uint64_t frames = 0, skipped = 0, keyBytes = 0, keyFrames = 0, deltaBytes = 0, deltaFrames = 0;
+    uint64_t partialFrames = 0;
     uint64_t missingLast = 0;
     std::vector<std::string> errors = editorErrors;
     for (const Received& r : received) {
@@ -175,16 +192,26 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
         keyFrames += r.keyFrames;
         deltaBytes += r.deltaBytes;
         deltaFrames += r.deltaFrames;
+        partialFrames += r.partialFrames;
         errors.insert(errors.end(), r.errors.begin(), r.errors.end());
         for (const auto& [version, ms] : r.serverMs)
             if (sent.contains(version)) serverMs[version] = ms;
-        if (r.versions.empty() || r.versions.back().first < lastVersion) ++missingLast;
+        if (!holdsFinal(r, lastVersion)) ++missingLast;
         // Each version the editor set counts once per subscriber: the time until the
-        // subscriber held it or a newer one.
-        auto next = sent.begin();
-        for (const auto& [version, when] : r.versions)
-            for (; next != sent.end() && next->first <= version; ++next)
-                latencies.push_back(std::chrono::duration<double, std::milli>(when - next->second).count());
+        // subscriber held its final state or any state of a newer version, and (the first
+        // visible change) until it held any state of it or of a newer one.
+        const auto ms = [](Clock::time_point when, Clock::time_point call) {
+            return std::chrono::duration<double, std::milli>(when - call).count();
+        };
+        auto next = sent.begin(), nextSeen = sent.begin();
+        for (const Held& held : r.versions) {
+            for (; nextSeen != sent.end() && nextSeen->first <= held.version; ++nextSeen)
+                firstChanges.push_back(ms(held.when, nextSeen->second));
+            for (; next != sent.end() && (next->first < held.version ||
+                                          (next->first == held.version && held.part == 0));
+                 ++next)
+                latencies.push_back(ms(held.when, next->second));
+        }
     }
     if (missingLast > 0)
         errors.push_back(fmt::format("{} subscribers never received the last version {}",
@@ -196,6 +223,9 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
     report["duration_s"] = elapsed;
     report["update_rate"] = options.updateRate;
     report["updates"] = sent.size();
+    report["first_change_ms"] = {{"p50", percentile(firstChanges, 0.50)},
+                                 {"p95", percentile(firstChanges, 0.95)},
+                                 {"p99", percentile(firstChanges, 0.99)}};
     report["latency_ms"] = {{"p50", percentile(latencies, 0.50)},
                             {"p95", percentile(latencies, 0.95)},
                             {"p99", percentile(latencies, 0.99)},
@@ -212,6 +242,7 @@ Result<nlohmann::ordered_json> runLoadTest(PicConnection& connection, const Load
                            {"encode_p50", percentile(encodeMs, 0.5)},
                            {"versions_computed", serverMs.size()}};
     report["frames_received"] = frames;
+    report["partial_frames"] = partialFrames;
     report["versions_skipped"] = skipped;
     report["bytes_per_frame"] = {{"key", keyFrames ? double(keyBytes) / double(keyFrames) : 0.0},
                                  {"delta", deltaFrames ? double(deltaBytes) / double(deltaFrames) : 0.0},

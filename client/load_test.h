@@ -31,7 +31,10 @@ struct LoadOptions {
 };
 
 /// Runs the load test against the server behind `connection` and returns the report:
-/// `latency_ms` {`p50`, `p95`, `p99`, `max`, `mean`}, `updates`, `frames_received`, `errors`,
+/// `latency_ms` {`p50`, `p95`, `p99`, `max`, `mean`} until a subscriber held each version's
+/// final state, `first_change_ms` {`p50`, `p95`, `p99`} until it held any part of it (the
+/// same, unless the server streams budgeted parts), `partial_frames`, `updates`,
+/// `frames_received`, `errors`,
 /// `subscribers_without_last` (those that never held the last version: lost final states),
 /// `versions_skipped`, `bytes_per_frame` {`key`, `delta`}, `clients`, `duration_s`,
 /// `update_rate`, `session` and the first error messages. The editor moves the first light of

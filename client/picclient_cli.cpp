@@ -149,9 +149,11 @@ int runWatch(const Common& common, uint64_t count, double seconds) {
                                   .count();
         size_t bytes = 0;
         for (const v1::Plane& plane : frame.planes()) bytes += plane.data().size();
-        const std::string kind = frame.base_version() == 0
-                                     ? std::string("key")
-                                     : fmt::format("delta:{}", frame.base_version());
+        std::string kind = frame.base_version() == 0 ? std::string("key")
+                           : frame.base_part() == 0
+                               ? fmt::format("delta:{}", frame.base_version())
+                               : fmt::format("delta:{}.{}", frame.base_version(), frame.base_part());
+        if (frame.part() != 0) kind += fmt::format(", part {}", frame.part());
         const uint64_t version = frame.version();
         const double updateMs = frame.update_ms(), encodeMs = frame.encode_ms();
         const double latencyMs = double(nowNs - frame.lights_set_unix_ns()) / 1e6;
@@ -204,10 +206,15 @@ int runLoad(const Common& common, const LoadOptions& options, const std::string&
     out << report->dump(2) << "\n";
     if (!out) return reportError(Error{ErrorCode::Io, fmt::format("cannot write {}", reportPath)});
     const auto& latency = (*report)["latency_ms"];
-    std::printf("updates %llu, frames %llu, skipped %llu, errors %llu; latency ms p50 %.1f p95 %.1f "
-                "p99 %.1f max %.1f; bytes per key frame %.0f, per delta %.0f -> %s\n",
+    std::string parts;
+    if (const uint64_t partial = (*report)["partial_frames"].get<uint64_t>(); partial > 0)
+        parts = fmt::format(" ({} earlier parts; first change p50 {:.1f} p99 {:.1f})", partial,
+                            (*report)["first_change_ms"]["p50"].get<double>(),
+                            (*report)["first_change_ms"]["p99"].get<double>());
+    std::printf("updates %llu, frames %llu%s, skipped %llu, errors %llu; latency ms p50 %.1f p95 "
+                "%.1f p99 %.1f max %.1f; bytes per key frame %.0f, per delta %.0f -> %s\n",
                 (unsigned long long)(*report)["updates"].get<uint64_t>(),
-                (unsigned long long)(*report)["frames_received"].get<uint64_t>(),
+                (unsigned long long)(*report)["frames_received"].get<uint64_t>(), parts.c_str(),
                 (unsigned long long)(*report)["versions_skipped"].get<uint64_t>(),
                 (unsigned long long)(*report)["errors"].get<uint64_t>(),
                 latency["p50"].get<double>(), latency["p95"].get<double>(),
@@ -352,7 +359,9 @@ int runRender(const Common& common, const RenderCommand& command) {
     v1::Frame frame;
     double decodeMs = 0.0, serverMs = 0.0;
     size_t bytes = 0;
-    while (decoder.version() < wanted && stream->next(frame)) {
+    // A budgeted server streams earlier parts first (v1::Frame::part): the image waits for the
+    // final state.
+    while (!decoder.holds(wanted) && stream->next(frame)) {
         bytes = 0;
         for (const v1::Plane& plane : frame.planes()) bytes += plane.data().size();
         serverMs = frame.update_ms() + frame.encode_ms();
@@ -368,7 +377,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     // Writing the caches into the textures the renderer samples ends the latency.
     Result<CacheTextures> textures = fail(ErrorCode::Internal, "no frame decoded");
     double texturesMs = 0.0;
-    if (decoder.version() >= wanted) {
+    if (decoder.holds(wanted)) {
         const auto texturesStart = Clock::now();
         textures = cacheTexturesOf(*client, decoder.frame());
         texturesMs = since(texturesStart);
@@ -377,7 +386,7 @@ int runRender(const Common& common, const RenderCommand& command) {
     done = true;
     timer.join();
     stream->cancel();
-    if (decoder.version() < wanted) {
+    if (!decoder.holds(wanted)) {
         grpc::Status status = stream->status();
         if (!status.ok() && status.error_code() != grpc::StatusCode::CANCELLED)
             return reportError(wire::fromStatus(status, "Subscribe"));

@@ -62,7 +62,8 @@ public:
         mLinks = unpackLinks(bake, mSpread);
     }
 
-    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
+    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats,
+                                         const BounceObserver& observer) override;
     Result<const CacheTextures*> textures() override;
     const char* name() const override { return "cpu"; }
 
@@ -89,7 +90,8 @@ private:
     bool mTexturesCurrent = false;
 };
 
-Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateStats* stats) {
+Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateStats* stats,
+                                                 const BounceObserver& observer) {
     PIC_TRY(checkRuntimeLights(lights, mScene));
     PIC_TRY_ASSIGN(const SkyLighting* sky, mSky.update(lights));
     mTexturesCurrent = false;
@@ -141,6 +143,7 @@ Result<const CacheValues*> CpuRuntime::setLights(const LightSet& lights, UpdateS
         s.bounces = bounce;
         s.surfelFlux = luminance(glm::vec3(total));
         const BounceStep step = schedule.afterBounce(bounce);
+        if (observer) observer(bounce, mValues, !step.another);
         if (!step.another) break;
 
         // The next bounce: direct flux plus what the surfels receive from these caches.

@@ -194,7 +194,8 @@ Result<void> GpuRuntime::submitTimed(const std::function<void(VkCommandBuffer)>&
     return {};
 }
 
-Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateStats* statsOut) {
+Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateStats* statsOut,
+                                                 const BounceObserver& observer) {
     const Clock::time_point start = Clock::now();
     UpdateStats local;
     UpdateStats& stats = statsOut ? *statsOut : local;
@@ -252,6 +253,13 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         },
         stats));
     addVisibilityStats(stats);
+    // The caches each submission read back, for an observer.
+    const auto observe = [&](int bounce) {
+        if (!observer) return;
+        readCaches(mValues);
+        observer(bounce, mValues, !step.another);
+    };
+    observe(1);
     PIC_TRY_ASSIGN(glm::dvec3 sum, mSurfels->totalFlux(0));
     schedule.record(sum);
     stats.bounces = 1;
@@ -267,6 +275,7 @@ Result<const CacheValues*> GpuRuntime::setLights(const LightSet& lights, UpdateS
         PIC_TRY(submitTimed([&](VkCommandBuffer cmd) { cacheBounce(cmd, step, slot); }, stats));
         stats.bounces = bounce;
         stats.surfelFlux = luminance(glm::vec3(sum));
+        observe(bounce);
     }
 
     // After the last bounce, the direct sky.

@@ -87,7 +87,8 @@ public:
                                                       const GpuRuntimeOptions& options = {});
     ~GpuRuntime() override;
 
-    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats) override;
+    Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats,
+                                         const BounceObserver& observer = {}) override;
     Result<const CacheTextures*> textures() override;
     const char* name() const override { return "gpu"; }
 

@@ -2,6 +2,7 @@
 /// The runtime of paper 000 Figure 2 behind one API with two backends (GPU, CPU twin):
 /// a light change in, cache radiance out.
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -80,12 +81,20 @@ struct UpdateStats {
     int lightsTraced = 0;  ///< lights whose visibility rays were traced (GPU, rays)
 };
 
+/// Called after each bounce's cache pass with that bounce's caches (before the direct sky,
+/// which follows the last bounce) and whether the runtime knows it is the last: what a
+/// budgeted server streams before the update ends (server/progressive.h). Both backends have
+/// the caches on the host then anyway (the GPU reads them back after every submission).
+using BounceObserver = std::function<void(int bounce, const CacheValues& caches, bool last)>;
+
 /// A runtime backend over one bake of one scene.
 class Runtime {
 public:
     virtual ~Runtime() = default;
-    /// Relights the scene with `lights` and returns the caches' incident radiance.
-    virtual Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats = nullptr) = 0;
+    /// Relights the scene with `lights` and returns the caches' incident radiance; `observer`,
+    /// when set, sees every bounce's caches as they are computed.
+    virtual Result<const CacheValues*> setLights(const LightSet& lights, UpdateStats* stats = nullptr,
+                                                 const BounceObserver& observer = {}) = 0;
     /// The last update's caches as the grid and light-map textures renderers sample
     /// (core/cache_textures.h layout), made on demand: `picref shade` shades from them;
     /// picserver streams the caches themselves and never asks.

@@ -45,8 +45,19 @@ void logUpdate(const UpdateLog& log) {
     for (const auto& [pass, ms] : update.stats.passMs) passes += fmt::format(" {}_ms={:.1f}", pass, ms);
     size_t bytes = 0;
     for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
-    std::string base = update.baseVersion == 0 ? std::string("key")
-                                               : fmt::format("delta:{}", update.baseVersion);
+    std::string base = update.base.version == 0 ? std::string("key")
+                       : update.base.part == 0 ? fmt::format("delta:{}", update.base.version)
+                                               : fmt::format("delta:{}.{}", update.base.version,
+                                                             update.base.part);
+    if (update.part != 0) {
+        std::printf("part session=%s version=%llu part=%u bounces=%d update_ms=%.1f "
+                    "encode_ms=%.1f bytes=%zu frame=%s subscribers=%zu\n",
+                    log.session.c_str(), (unsigned long long)update.version, update.part,
+                    update.stats.bounces, update.broadcast->update_ms(), update.encodeMs, bytes,
+                    base.c_str(), log.subscribers);
+        std::fflush(stdout);
+        return;
+    }
     std::printf("update session=%s version=%llu bounces=%d%s runtime_ms=%.1f update_ms=%.1f "
                 "encode_ms=%.1f "
                 "bytes=%zu frame=%s subscribers=%zu\n",
@@ -116,6 +127,11 @@ int picserverMain(int argc, char** argv) {
                    "light sets a second one session accepts (as many at once); beyond, "
                    "RESOURCE_EXHAUSTED with the delay to wait (default 30)")
         ->check(CLI::Range(0.01, 1e6));
+    app.add_option("--update-budget-ms", options.session.updateBudgetMs,
+                   "an update expected to take longer than this (the session's last one did) "
+                   "streams its caches in parts, one every M ms, most changed first, then its "
+                   "exact final state; 0: never (default 0)")
+        ->check(CLI::Range(0.0, 1e6));
     app.add_option("--max-sessions-per-client", options.maxSessionsPerClient,
                    "sessions one API key (without keys: one peer host) may hold; 0: only "
                    "--max-sessions (default 0)")

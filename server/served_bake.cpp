@@ -126,9 +126,10 @@ Result<void> ServedBake::warmUp() {
     return {};
 }
 
-Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame) {
+Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
+                                 const BounceObserver& observer) {
     std::lock_guard lock(mRuntimeMutex);
-    PIC_TRY_ASSIGN(const CacheValues* values, mRuntime->setLights(lights, &stats));
+    PIC_TRY_ASSIGN(const CacheValues* values, mRuntime->setLights(lights, &stats, observer));
     frame = halfFrameOf(*values);
     return {};
 }

@@ -60,7 +60,9 @@ public:
     /// planes (core/frame_codec.h), one call at a time (the runtime keeps per-light state such
     /// as shadow maps). The server's relight pool calls it for one session of the bake at a
     /// time already, taking them in turns (server/relight_pool.h).
-    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame);
+    /// `observer` sees every bounce's caches (Runtime::setLights).
+    Result<void> relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,
+                         const BounceObserver& observer = {});
 
 private:
     ServedBake() = default;

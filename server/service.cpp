@@ -398,10 +398,11 @@ private:
         std::shared_ptr<const v1::Frame> frame = update->frameFor(mHeld);
         if (!frame) {
             finishOnce(grpc::Status(grpc::StatusCode::INTERNAL,
-                                    fmt::format("no frame for version {}", update->version)));
+                                    fmt::format("no frame for version {} part {}",
+                                                update->version, update->part)));
             return;
         }
-        mHeld = update->version;
+        mHeld = update->id();
         uint64_t bytes = 0;
         for (const v1::Plane& plane : frame->planes()) bytes += plane.data().size();
         mSession->countSent(bytes);
@@ -423,7 +424,7 @@ private:
     std::shared_ptr<Link> mLink;
     std::shared_ptr<SubscriberSlot> mSlot;
     std::shared_ptr<const v1::Frame> mInFlight;  ///< alive until its write is done
-    uint64_t mHeld = 0;                          ///< version the client holds
+    StateId mHeld;                               ///< the state the client holds
     bool mWriting = false;
     bool mCancelled = false;
     bool mFinished = false;
@@ -808,14 +809,17 @@ Result<std::unique_ptr<PicServer>> PicServer::start(std::vector<std::unique_ptr<
     server->mState->bakes = std::move(bakes);
     server->mState->pool = std::make_unique<RelightPool>(
         options.relightThreads > 0 ? options.relightThreads : unsigned(server->mState->bakes.size() + 1));
-    // Every computed version goes into the metrics, then to the caller's log.
+    // Every computed version goes into the metrics (a budgeted one's earlier parts count in
+    // the bytes sent only), then every version and part to the caller's log.
     options.session.log = [metrics = server->mState->metrics,
                            log = std::move(options.session.log)](const UpdateLog& entry) {
         const Update& update = *entry.update;
-        uint64_t bytes = 0;
-        for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
-        metrics->recordUpdate(entry.session, update.stats.passMs, update.broadcast->update_ms(),
-                              update.encodeMs, bytes, update.baseVersion == 0);
+        if (update.part == 0) {
+            uint64_t bytes = 0;
+            for (const v1::Plane& plane : update.broadcast->planes()) bytes += plane.data().size();
+            metrics->recordUpdate(entry.session, update.stats.passMs, update.broadcast->update_ms(),
+                                  update.encodeMs, bytes, update.base.version == 0);
+        }
         if (log) log(entry);
     };
     server->mState->options = options;

@@ -5,6 +5,7 @@
 
 #include "proto/wire.h"
 #include "render/sky_lighting.h"
+#include "server/progressive.h"
 #include "server/served_bake.h"
 
 namespace pic {
@@ -19,18 +20,19 @@ double millisecondsSince(Clock::time_point start) {
 
 }  // namespace
 
-std::shared_ptr<const v1::Frame> Update::frameFor(uint64_t held) const {
-    if (baseVersion == 0 || held == baseVersion) return broadcast;
+std::shared_ptr<const v1::Frame> Update::frameFor(StateId held) const {
+    if (base.version == 0 || held == base) return broadcast;
     std::call_once(mKeyOnce, [this] {
         const auto start = Clock::now();
         auto encoded = encodeFrame(*frame, nullptr, zstdLevel);
         if (!encoded) {
-            std::fprintf(stderr, "picserver: key frame of version %llu failed: %s\n",
-                         (unsigned long long)version, encoded.error().message.c_str());
+            std::fprintf(stderr, "picserver: key frame of version %llu part %u failed: %s\n",
+                         (unsigned long long)version, part, encoded.error().message.c_str());
             return;
         }
         auto key = std::make_shared<v1::Frame>(*broadcast);
         key->set_base_version(0);
+        key->set_base_part(0);
         wire::toProto(*encoded, *key);
         key->set_encode_ms(millisecondsSince(start));
         mKey = std::move(key);
@@ -195,8 +197,10 @@ size_t Session::subscribers() const {
 
 bool Session::waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const {
     std::unique_lock lock(mMutex);
-    return mChanged.wait_for(lock, timeout,
-                             [&] { return mLatest && mLatest->version >= version; });
+    return mChanged.wait_for(lock, timeout, [&] {
+        return mLatest && (mLatest->version > version ||
+                           (mLatest->version == version && mLatest->part == 0));
+    });
 }
 
 void Session::countSent(uint64_t bytes) {
@@ -226,15 +230,19 @@ void Session::publish(std::shared_ptr<const Update> update) {
         slots = mSlots;
         uint64_t bytes = 0;
         for (const v1::Plane& plane : update->broadcast->planes()) bytes += plane.data().size();
-        mStats.set_versions_computed(mStats.versions_computed() + 1);
-        if (update->baseVersion == 0)
-            mStats.set_key_frames(mStats.key_frames() + 1);
-        else
-            mStats.set_delta_frames(mStats.delta_frames() + 1);
         mStats.set_broadcast_bytes(mStats.broadcast_bytes() + bytes);
         mStats.set_last_frame_bytes(bytes);
-        mUpdateMsTotal += update->broadcast->update_ms();
-        mEncodeMsTotal += update->encodeMs;
+        if (update->part != 0) {
+            mStats.set_partial_frames(mStats.partial_frames() + 1);
+        } else {
+            mStats.set_versions_computed(mStats.versions_computed() + 1);
+            if (update->base.version == 0)
+                mStats.set_key_frames(mStats.key_frames() + 1);
+            else
+                mStats.set_delta_frames(mStats.delta_frames() + 1);
+            mUpdateMsTotal += update->broadcast->update_ms();
+            mEncodeMsTotal += update->encodeMs;
+        }
     }
     mChanged.notify_all();
     for (const auto& slot : slots) slot->put(update);
@@ -265,13 +273,76 @@ void Session::compute() {
         mStep.updateMs = millisecondsSince(start);
         return;
     }
-    if (auto relit = mBake.relight(job.lights, mStep.update->stats, *mStep.frame); !relit) {
+    // Budgeted: the bounces are kept (the next update's baseline), and when this update is
+    // expected to take longer than the budget, its parts are published as they are due.
+    BounceObserver observer;
+    std::optional<ProgressiveUpdate> parts;
+    double partsMs = 0.0;  // spent encoding and publishing parts
+    mStep.bounces.clear();
+    if (mOptions.updateBudgetMs > 0.0) {
+        if (mStep.streamedId == StateId{mStep.previousVersion, 0})
+            parts.emplace(mOptions.updateBudgetMs, mStep.relightMs, mStep.previous.get(),
+                          mStep.previousBounces);
+        observer = [&](int bounce, const CacheValues& caches, bool last) {
+            mStep.bounces.push_back(caches);
+            mStep.bounces.back().irradiance = {};
+            if (!parts) return;
+            auto state = parts->afterBounce(bounce, caches, millisecondsSince(start), last);
+            if (!state) return;
+            const auto partStart = Clock::now();
+            publishPart(std::move(*state), bounce, millisecondsSince(start));
+            partsMs += millisecondsSince(partStart);
+        };
+    }
+    if (auto relit = mBake.relight(job.lights, mStep.update->stats, *mStep.frame, observer); !relit) {
         std::fprintf(stderr, "picserver: session %s: version %llu failed: %s\n", mId.c_str(),
                      (unsigned long long)job.version, relit.error().message.c_str());
         mStep.job.reset();
+        mStep.bounces.clear();
         return;
     }
     mStep.updateMs = millisecondsSince(start);
+    mStep.relightMs = mStep.updateMs - partsMs;
+    if (mOptions.updateBudgetMs > 0.0) std::swap(mStep.previousBounces, mStep.bounces);
+}
+
+void Session::publishPart(HalfFrame state, int bounce, double elapsedMs) {
+    const Pending& job = *mStep.job;
+    const auto start = Clock::now();
+    auto frame = std::make_shared<const HalfFrame>(std::move(state));
+    auto encoded = encodeFrame(*frame, mStep.streamed.get(), mOptions.zstdLevel);
+    if (!encoded) {
+        std::fprintf(stderr, "picserver: session %s: encoding a part of version %llu failed: %s\n",
+                     mId.c_str(), (unsigned long long)job.version, encoded.error().message.c_str());
+        return;
+    }
+    auto update = std::make_shared<Update>();
+    update->version = job.version;
+    update->part = mStep.streamedId.version == job.version ? mStep.streamedId.part + 1 : 1;
+    update->base = mStep.streamedId;
+    update->zstdLevel = mOptions.zstdLevel;
+    update->keysOnDemand = mKeysOnDemand;
+    update->stats.bounces = bounce;
+    auto wireFrame = std::make_shared<v1::Frame>();
+    wireFrame->set_version(update->version);
+    wireFrame->set_part(update->part);
+    wireFrame->set_bake_id(mBake.id());
+    wireFrame->set_base_version(update->base.version);
+    wireFrame->set_base_part(update->base.part);
+    wire::toProto(*encoded, *wireFrame);
+    update->encodeMs = millisecondsSince(start);
+    wireFrame->set_bounces(uint32_t(bounce));
+    wireFrame->set_update_ms(elapsedMs);
+    wireFrame->set_encode_ms(update->encodeMs);
+    wireFrame->set_lights_set_unix_ns(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(job.accepted.time_since_epoch()).count());
+    // The new direct light shows with the first part; the indirect follows the parts.
+    *wireFrame->mutable_lights() = wire::toProto(job.lights);
+    update->frame = frame;
+    update->broadcast = std::move(wireFrame);
+    mStep.streamed = std::move(frame);
+    mStep.streamedId = update->id();
+    publish(std::move(update));
 }
 
 void Session::finish() {
@@ -282,7 +353,7 @@ void Session::finish() {
 
     const bool key = !mStep.previous || mStep.deltasSinceKey + 1 >= mOptions.keyframeInterval;
     const auto encodeStart = Clock::now();
-    auto encoded = encodeFrame(*frame, key ? nullptr : mStep.previous.get(), mOptions.zstdLevel);
+    auto encoded = encodeFrame(*frame, key ? nullptr : mStep.streamed.get(), mOptions.zstdLevel);
     if (!encoded) {
         std::fprintf(stderr, "picserver: session %s: encoding version %llu failed: %s\n",
                      mId.c_str(), (unsigned long long)job.version, encoded.error().message.c_str());
@@ -291,7 +362,9 @@ void Session::finish() {
     auto wireFrame = std::make_shared<v1::Frame>();
     wireFrame->set_version(update->version);
     wireFrame->set_bake_id(mBake.id());
-    wireFrame->set_base_version(key ? 0 : mStep.previousVersion);
+    const StateId base = key ? StateId{} : mStep.streamedId;
+    wireFrame->set_base_version(base.version);
+    wireFrame->set_base_part(base.part);
     wire::toProto(*encoded, *wireFrame);
     update->encodeMs = millisecondsSince(encodeStart);
     wireFrame->set_bounces(uint32_t(update->stats.bounces));
@@ -302,9 +375,11 @@ void Session::finish() {
         std::chrono::duration_cast<std::chrono::nanoseconds>(job.accepted.time_since_epoch()).count());
     *wireFrame->mutable_lights() = wire::toProto(job.lights);
 
-    update->baseVersion = wireFrame->base_version();
+    update->base = base;
     update->frame = frame;
     update->broadcast = std::move(wireFrame);
+    mStep.streamed = frame;
+    mStep.streamedId = update->id();
     mStep.previous = std::move(frame);
     mStep.previousVersion = update->version;
     mStep.previousLights = job.lights;

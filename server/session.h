@@ -36,11 +36,21 @@ namespace pic {
 
 class ServedBake;
 
-/// One computed version: its caches as halves and its frames on the wire.
+/// A state subscribers hold: a version's final state (part 0) or one of its earlier parts
+/// (server/progressive.h).
+struct StateId {
+    uint64_t version = 0;  ///< 0: nothing
+    uint32_t part = 0;
+    bool operator==(const StateId&) const = default;
+};
+
+/// One computed version, or an earlier part of one: its caches as halves and its frames on
+/// the wire.
 class Update {
 public:
     uint64_t version = 0;
-    uint64_t baseVersion = 0;               ///< what `broadcast` applies to; 0 when it is a key frame
+    uint32_t part = 0;                      ///< 0: the version's final state
+    StateId base;                           ///< what `broadcast` applies to; version 0: a key frame
     std::shared_ptr<const HalfFrame> frame;  ///< the caches, kept while anyone may need a key frame
     std::shared_ptr<const v1::Frame> broadcast;
     UpdateStats stats;
@@ -48,10 +58,11 @@ public:
     int zstdLevel = kDefaultZstdLevel;     ///< for the key frame encoded on demand
     std::shared_ptr<std::atomic<uint64_t>> keysOnDemand;  ///< counts it, when set
 
-    /// The frame for a subscriber that holds version `held` (0: none): `broadcast` when it
-    /// applies to `held`, else this version's key frame.
-    std::shared_ptr<const v1::Frame> frameFor(uint64_t held) const;
-    /// Whether a key frame besides `broadcast` was encoded for this version.
+    StateId id() const { return {version, part}; }
+    /// The frame for a subscriber that holds `held` (version 0: nothing): `broadcast` when it
+    /// applies to `held`, else this state's key frame.
+    std::shared_ptr<const v1::Frame> frameFor(StateId held) const;
+    /// Whether a key frame besides `broadcast` was encoded for this state.
     bool keyEncoded() const { return mKeyEncoded.load(); }
 
 private:
@@ -88,7 +99,8 @@ private:
     bool mClosed = false;
 };
 
-/// One update's line for the log: version, ms per pass, encode ms, bytes, subscribers.
+/// One update's (or part's) line for the log: version, ms per pass, encode ms, bytes,
+/// subscribers.
 struct UpdateLog {
     std::string session;
     const Update* update = nullptr;
@@ -102,6 +114,9 @@ struct SessionOptions {
     /// Light sets a second the session accepts (burst: as many); beyond, SetLights is refused
     /// with the time until the next one would be accepted.
     double setLightsPerSecond = 30.0;
+    /// Milliseconds an update may take before its caches are streamed in parts (0: never;
+    /// server/progressive.h).
+    double updateBudgetMs = 0.0;
 };
 
 /// Where a session starts: version 1 with the scene's own lights, or, for a session restored
@@ -154,7 +169,8 @@ public:
     /// The newest accepted version and light set.
     uint64_t latestVersion() const;
     LightSet latestLights() const;
-    /// The newest computed update, null before the first one.
+    /// The newest update published (an earlier part of a budgeted version, or a version's
+    /// final state), null before the first one.
     std::shared_ptr<const Update> latestUpdate() const;
 
     /// A new subscriber: its slot holds the newest computed update at once (if any; `wake`
@@ -175,7 +191,8 @@ public:
     /// The session's counters (GetStats).
     v1::SessionStats stats() const;
 
-    /// Blocks until an update of version ≥ `version` is published or `timeout` passes.
+    /// Blocks until the final state of version ≥ `version`, or any part of a newer one, is
+    /// published or `timeout` passes.
     bool waitForVersion(uint64_t version, std::chrono::milliseconds timeout) const;
 
 private:
@@ -183,6 +200,8 @@ private:
     /// session's meanwhile), finish() encodes and publishes it.
     void compute() override;
     void finish() override;
+    /// Encodes and publishes an earlier part of the version compute() relights.
+    void publishPart(HalfFrame state, int bounce, double elapsedMs);
     void publish(std::shared_ptr<const Update> update);
 
     std::string mId;
@@ -228,6 +247,15 @@ private:
         uint64_t previousVersion = 0;
         LightSet previousLights;                    ///< and its light set
         uint32_t deltasSinceKey = 0;
+        /// The last state published (the previous version's final state, or a part of this
+        /// one): what the next frame is a delta against.
+        std::shared_ptr<const HalfFrame> streamed;
+        StateId streamedId;
+        /// Budgeted sessions: the bounce caches of the previous relight (the estimates'
+        /// baseline), those of this one, and how long the previous relight took.
+        std::vector<CacheValues> previousBounces;
+        std::vector<CacheValues> bounces;
+        double relightMs = 0.0;
     } mStep;
 };
 

@@ -36,11 +36,11 @@ Served serve(const std::string& backend, uint32_t keyframeInterval,
     return serveWith(options, backend);
 }
 
-Served serveWith(const ServerOptions& serverOptions, const std::string& backend) {
+Served serveWith(const ServerOptions& serverOptions, const std::string& backend, int bounces) {
     Served served;
     ServeOptions options;
     options.backend = backend;
-    options.bounces.bounces = 1;
+    options.bounces.bounces = bounces;
     auto bake = ServedBake::load(bakePath(), kScene, options);
     EXPECT_TRUE(bake) << (bake ? "" : bake.error().message);
     if (!bake) return served;

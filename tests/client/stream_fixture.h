@@ -41,8 +41,9 @@ Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
              std::chrono::milliseconds sessionIdle = std::chrono::hours(1),
              const std::string& dbPath = "");
 
-/// The same with every server option given.
-Served serveWith(const ServerOptions& options, const std::string& backend = "cpu");
+/// The same with every server option given, and the runtime's bounce count.
+Served serveWith(const ServerOptions& options, const std::string& backend = "cpu",
+                 int bounces = 1);
 
 /// Starts a server over the test bake with the session database at `dbPath`.
 Result<std::unique_ptr<PicServer>> startWithDatabase(const std::string& dbPath);
@@ -88,6 +89,16 @@ public:
         std::lock_guard lock(mMutex);
         return keyFrames;
     }
+    /// Each frame's part (v1::Frame::part: 0 for a version's final state).
+    std::vector<uint32_t> parts() {
+        std::lock_guard lock(mMutex);
+        return mParts;
+    }
+    /// Whether the final state of `version` (or anything newer) was decoded.
+    bool holds(uint64_t version) {
+        std::lock_guard lock(mMutex);
+        return mDecoder.holds(version);
+    }
     HalfFrame frame() {
         std::lock_guard lock(mMutex);
         return mDecoder.frame();
@@ -121,6 +132,7 @@ private:
         while (mStream->next(frame)) {
             std::lock_guard lock(mMutex);
             keyFrames.push_back(frame.base_version() == 0);
+            mParts.push_back(frame.part());
             const uint64_t version = frame.version();
             if (auto applied = mDecoder.apply(frame); !applied)
                 mErrors.push_back(applied.error().message);
@@ -137,6 +149,7 @@ private:
     std::mutex mMutex;
     std::vector<uint64_t> versions;
     std::vector<bool> keyFrames;
+    std::vector<uint32_t> mParts;
     std::vector<std::string> mErrors;
     bool mEnded = false;
     std::string mEndCode;

@@ -17,6 +17,7 @@
 #include <grpcpp/generic/generic_stub.h>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -49,7 +50,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using namespace test;
 
-/// The CPU twin on the test bake, set up as serve() runs it (one bounce): it is
+/// The CPU twin on the test bake, set up as serve() runs it (one bounce, unless told): it is
 /// deterministic, so it gives the served caches for the same lights.
 struct Twin {
     Scene scene;
@@ -58,7 +59,7 @@ struct Twin {
     std::unique_ptr<Runtime> runtime;
 };
 
-std::unique_ptr<Twin> cpuTwin() {
+std::unique_ptr<Twin> cpuTwin(int bounces = 1) {
     auto twin = std::make_unique<Twin>();
     auto scene = loadScene(kScene);
     auto bake = readBakeFile(bakePath());
@@ -70,7 +71,7 @@ std::unique_ptr<Twin> cpuTwin() {
     EXPECT_TRUE(rays);
     if (!rays) return nullptr;
     twin->rays = std::move(*rays);
-    auto runtime = createCpuRuntime(twin->scene, *twin->rays, twin->bake, BounceParams{1});
+    auto runtime = createCpuRuntime(twin->scene, *twin->rays, twin->bake, BounceParams{bounces});
     EXPECT_TRUE(runtime);
     if (!runtime) return nullptr;
     twin->runtime = std::move(*runtime);
@@ -146,7 +147,7 @@ TEST(Stream, LateJoinerFirstFrameIsAKeyFrameOfTheLatestVersion) {
     }
     const auto latest = live->latestUpdate();
     ASSERT_TRUE(latest);
-    EXPECT_NE(latest->baseVersion, 0u) << "the broadcast frame of version 4 is a delta";
+    EXPECT_NE(latest->base.version, 0u) << "the broadcast frame of version 4 is a delta";
     Reader late(*served.connection, session->session(), session->viewer_token());
     ASSERT_TRUE(late.waitFor(latest->version));
     ASSERT_FALSE(late.keys().empty());
@@ -168,12 +169,14 @@ TEST(Stream, KeyFrameOnDemandIsEncodedOncePerVersionForAnyNumberOfSubscribers) {
     ASSERT_TRUE(version);
     ASSERT_TRUE(live->waitForVersion(*version, 30s));
     const auto update = live->latestUpdate();
-    ASSERT_NE(update->baseVersion, 0u);
-    EXPECT_EQ(update->frameFor(update->baseVersion), update->broadcast);
-    const auto key = update->frameFor(0);
+    ASSERT_NE(update->base.version, 0u);
+    EXPECT_EQ(update->frameFor(update->base), update->broadcast);
+    const auto key = update->frameFor({});
     ASSERT_TRUE(key);
     EXPECT_EQ(key->base_version(), 0u);
-    for (uint64_t held : {0u, 1u, 7u}) EXPECT_EQ(update->frameFor(held).get(), held == update->baseVersion ? update->broadcast.get() : key.get());
+    for (uint64_t held : {0u, 1u, 7u})
+        EXPECT_EQ(update->frameFor({held, 0}).get(),
+                  held == update->base.version ? update->broadcast.get() : key.get());
 }
 
 TEST(Stream, StalledSubscriberDoesNotDelayTheOthersAndSkipsToTheLast) {
@@ -681,6 +684,97 @@ TEST(Stream, FramesCarryTheirLightSetAndScaleOnlyChangesReuseTheCaches) {
     ASSERT_TRUE(reader.waitFor(*moved));
     EXPECT_GT(served.server->session(session->session())->latestUpdate()->broadcast->bounces(), 0u);
     EXPECT_TRUE(reader.errors().empty());
+}
+
+// picserver --update-budget-ms: an update over the budget streams earlier parts (estimates)
+// before its final state, which is bit for bit the unbudgeted update's; every part is a delta
+// against the state before it, and a subscriber that decodes them in order ends there.
+TEST(Stream, ABudgetedUpdateStreamsItsPartsThenExactlyTheFullUpdate) {
+    constexpr int kBounces = 3;
+    ServerOptions options;
+    options.session.setLightsPerSecond = 1e6;
+    // Every update is over a budget this small, so each one after the first (which has no
+    // previous version to estimate from) streams its caches in parts as its bounces end (the
+    // first bounce, or the first two: the share due grows with the time spent), then its
+    // final state. How parts pace themselves: progressive_test.cpp.
+    options.session.updateBudgetMs = 1e-3;
+    Served served = serveWith(options, "cpu", kBounces);
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    ASSERT_TRUE(live->waitForVersion(1, 30s));
+    // A subscriber that takes every update as it is published, and one on the wire.
+    std::vector<std::shared_ptr<const Update>> published;
+    std::mutex mutex;
+    std::shared_ptr<SubscriberSlot> slot;
+    slot = live->subscribe([&] {
+        std::lock_guard lock(mutex);
+        if (auto update = slot->take()) published.push_back(std::move(update));
+    });
+    {
+        std::lock_guard lock(mutex);
+        if (auto first = slot->take()) published.push_back(std::move(first));
+    }
+    Reader reader(*served.connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(reader.waitFor(1));
+
+    auto twin = cpuTwin(kBounces);
+    ASSERT_TRUE(twin);
+    std::vector<HalfFrame> expected;
+    for (int i = 0; i < 3; ++i) {
+        const LightSet lights = pointLight(-0.2f + 0.2f * float(i));
+        auto version = served.connection->setLights(session->session(), session->editor_token(), lights);
+        ASSERT_TRUE(version);
+        ASSERT_TRUE(live->waitForVersion(*version, 30s));
+        auto values = twin->runtime->setLights(lights);
+        ASSERT_TRUE(values);
+        expected.push_back(halfFrameOf(**values));
+        const auto start = std::chrono::steady_clock::now();
+        while (!reader.holds(*version) && std::chrono::steady_clock::now() - start < 30s)
+            std::this_thread::sleep_for(2ms);
+        EXPECT_TRUE(reader.frame() == expected.back()) << "version " << *version;
+    }
+    live->unsubscribe(slot.get());
+    EXPECT_TRUE(reader.errors().empty()) << reader.errors().front();
+    const uint64_t parts = live->stats().partial_frames();
+    EXPECT_GE(parts, 3u) << "one part at least for each of versions 2 to 4";
+    EXPECT_LE(parts, 6u) << "one part at most for each of their first two bounces";
+    EXPECT_EQ(live->stats().versions_computed(), 4u);
+
+    // Version 1 alone, then each version's parts and its final state, each a delta against
+    // the state before it (or a key frame), decoded in order to the twin's caches.
+    std::lock_guard lock(mutex);
+    ASSERT_EQ(published.size(), 4u + parts);
+    EXPECT_EQ(published[0]->id(), (StateId{1, 0}));
+    FrameDecoder decoder(sceneHeaderOf(*served.connection));
+    size_t finals = 0;
+    for (size_t i = 0; i < published.size(); ++i) {
+        const Update& update = *published[i];
+        if (i > 0) {
+            const StateId before = published[i - 1]->id();
+            EXPECT_TRUE(update.base == before || update.base.version == 0) << "update " << i;
+            // Parts 1, 2, … of the version after the last final state, then its final state.
+            EXPECT_EQ(update.version, before.part == 0 ? before.version + 1 : before.version);
+            if (update.part != 0) EXPECT_EQ(update.part, before.part + 1);
+        }
+        v1::Frame frame = *update.broadcast;
+        ASSERT_TRUE(decoder.apply(frame)) << "update " << i;
+        EXPECT_EQ(decoder.part(), update.part);
+        EXPECT_TRUE(decoder.frame() == *update.frame);
+        if (i > 0 && update.part == 0) {
+            EXPECT_TRUE(decoder.frame() == expected[finals]) << "the final state is exact";
+            ++finals;
+            // The part before it held estimates: not yet this version's caches.
+            EXPECT_NE(published[i - 1]->part, 0u);
+            EXPECT_FALSE(*published[i - 1]->frame == decoder.frame());
+        }
+    }
+    EXPECT_EQ(finals, 3u);
+    // A delta against another part than the one held is refused.
+    v1::Frame wrongBase = *published.back()->broadcast;
+    wrongBase.set_base_part(2);
+    EXPECT_FALSE(decoder.apply(wrongBase));
 }
 
 TEST(Stream, ASkyIsRelitStreamedAndCarriedBackAndABadOneRefused) {
