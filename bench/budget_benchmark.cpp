@@ -1,7 +1,10 @@
 #include "bench/budget_benchmark.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <thread>
 
 #include <unistd.h>
 
@@ -11,10 +14,80 @@
 #include "client/connection.h"
 #include "client/load_test.h"
 #include "core/bake_file.h"
+#include "core/color.h"
 
 namespace pic {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// One more subscriber of the load test's session that keeps, per version, the luma plane of
+/// its first earlier part and of its final state: how far what a client shows before the final
+/// state is from it.
+class StateWatcher {
+public:
+    StateWatcher(PicConnection& connection, const std::string& session, const std::string& token,
+                 const v1::SceneHeader& header)
+        : mDecoder(header), mStream(connection.subscribe(session, token)),
+          mThread([this] { run(); }) {}
+    ~StateWatcher() { stop(); }
+
+    void stop() {
+        if (!mThread.joinable()) return;
+        mStream->cancel();
+        mThread.join();
+    }
+
+    /// Medians over the versions that reached their final state: the relative RMS difference
+    /// of the luma coefficients from it, of the previous final state (what an unbudgeted
+    /// client shows until the final state arrives) and of the first part (when one came).
+    nlohmann::ordered_json report() const {
+        std::vector<double> stale, first;
+        const std::vector<float>* previous = nullptr;
+        for (const auto& [version, final] : mFinals) {
+            if (previous) stale.push_back(relativeRms(*previous, final));
+            if (auto part = mFirstParts.find(version); part != mFirstParts.end())
+                first.push_back(relativeRms(part->second, final));
+            previous = &final;
+        }
+        return {{"previous_final", median(stale)}, {"first_part", median(first)},
+                {"versions", stale.size()}, {"with_parts", first.size()}};
+    }
+
+private:
+    void run() {
+        v1::Frame frame;
+        while (mStream->next(frame)) {
+            const uint32_t part = frame.part();
+            if (!mDecoder.apply(frame)) continue;
+            const std::vector<uint16_t>& y = mDecoder.frame().planes[0];
+            std::vector<float> luma(y.size());
+            for (size_t i = 0; i < y.size(); ++i) luma[i] = halfToFloat(y[i]);
+            if (part == 0)
+                mFinals[mDecoder.version()] = std::move(luma);
+            else if (!mFirstParts.contains(mDecoder.version()))
+                mFirstParts[mDecoder.version()] = std::move(luma);
+        }
+    }
+
+    static double relativeRms(const std::vector<float>& shown, const std::vector<float>& final) {
+        double error = 0.0, norm = 0.0;
+        for (size_t i = 0; i < final.size(); ++i) {
+            const double d = double(shown[i]) - double(final[i]);
+            error += d * d;
+            norm += double(final[i]) * double(final[i]);
+        }
+        return norm > 0.0 ? std::sqrt(error / norm) : 0.0;
+    }
+
+    FrameDecoder mDecoder;
+    std::unique_ptr<FrameStream> mStream;
+    std::map<uint64_t, std::vector<float>> mFinals, mFirstParts;
+    std::thread mThread;
+};
+
+}  // namespace
 
 int runBudgetBenchmark(const BudgetBenchmarkParams& params) {
     if (params.budgets.empty()) return reportError(Error{ErrorCode::InvalidInput, "--budgets is empty"});
@@ -36,9 +109,9 @@ int runBudgetBenchmark(const BudgetBenchmarkParams& params) {
         params.picserver.empty() ? siblingProgram("server", "picserver") : params.picserver;
 
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-    std::printf("%9s %8s %11s %12s %12s %12s %12s %10s %8s\n", "budget ms", "updates",
+    std::printf("%9s %8s %11s %12s %12s %12s %12s %10s %10s %10s %10s %8s\n", "budget ms", "updates",
                 "parts/upd", "first p50", "first p99", "final p50", "final p99", "update ms",
-                "errors");
+                "server CPU", "stale err", "part err", "errors");
     int exit = 0;
     std::string device;
     for (const double budget : params.budgets) {
@@ -52,13 +125,25 @@ int runBudgetBenchmark(const BudgetBenchmarkParams& params) {
         if (!connection) return reportError(connection.error());
         if (device.empty())
             if (auto bakes = (*connection)->listBakes(); bakes) device = bakes->device();
+        auto created = (*connection)->createSession();
+        if (!created) return reportError(created.error());
+        auto header = (*connection)->sceneHeader(created->bake_id());
+        if (!header) return reportError(header.error());
+        StateWatcher watcher(**connection, created->session(), created->viewer_token(), *header);
         LoadOptions load;
+        load.session = created->session();
+        load.editorToken = created->editor_token();
         load.clients = params.clients;
         load.durationSeconds = params.duration;
         load.updateRate = params.updateRate;
         load.moveMetres = 0.01f * inputs->scene.bounds.diagonal();
+        // The server's CPU while the editor changes lights (parts cost it encodes and sends).
+        double cpuBefore = 0.0, cpuAfter = 0.0;
+        load.onChangesStart = [&] { cpuBefore = cpuSeconds(server.pid); };
+        load.onChangesEnd = [&] { cpuAfter = cpuSeconds(server.pid); };
         auto report = runLoadTest(**connection, load);
         if (!report) return reportError(report.error());
+        watcher.stop();
         nlohmann::ordered_json row;
         row["budget_ms"] = budget;
         const double updates = std::max(1.0, double((*report)["updates"].get<uint64_t>()));
@@ -66,13 +151,18 @@ int runBudgetBenchmark(const BudgetBenchmarkParams& params) {
         const double parts = double((*report)["partial_frames"].get<uint64_t>()) /
                              (updates * double(params.clients));
         row["parts_per_update"] = parts;
+        row["server_cpu_ms_per_update"] = 1000.0 * (cpuAfter - cpuBefore) / updates;
+        row["luma_error"] = watcher.report();
         row["load"] = *report;
         const auto& first = (*report)["first_change_ms"];
         const auto& final = (*report)["latency_ms"];
-        std::printf("%9.1f %8.0f %11.2f %12.1f %12.1f %12.1f %12.1f %10.1f %8llu\n", budget,
-                    updates, parts, first["p50"].get<double>(), first["p99"].get<double>(),
+        std::printf("%9.1f %8.0f %11.2f %12.1f %12.1f %12.1f %12.1f %10.1f %10.1f %10.3f %10.3f %8llu\n",
+                    budget, updates, parts, first["p50"].get<double>(), first["p99"].get<double>(),
                     final["p50"].get<double>(), final["p99"].get<double>(),
                     (*report)["server_ms"]["update_p50"].get<double>(),
+                    row["server_cpu_ms_per_update"].get<double>(),
+                    row["luma_error"]["previous_final"].get<double>(),
+                    row["luma_error"]["first_part"].get<double>(),
                     (unsigned long long)(*report)["errors"].get<uint64_t>());
         std::fflush(stdout);
         if ((*report)["errors"].get<uint64_t>() > 0) exit = 1;
@@ -82,8 +172,8 @@ int runBudgetBenchmark(const BudgetBenchmarkParams& params) {
 
     // Budgets on the x axis; the unbudgeted run (budget 0) as dashed lines across.
     Chart chart;
-    chart.title = fmt::format("Light change to a subscriber's frame, {} subscribers, {}",
-                              params.clients, params.backend);
+    chart.title = fmt::format("Light change to a subscriber's frame, {} subscribers, {} on {}",
+                              params.clients, params.backend, device);
     chart.xLabel = "update budget (ms)";
     chart.yLabel = "ms";
     ChartSeries first{"first visible change p50", {0.2f, 0.6f, 0.2f}};

@@ -5,7 +5,8 @@
 /// editor moving the first light `updateRate` times a second while N subscribers decode every
 /// frame. Per budget it prints, from the editor's call to a subscriber holding the frame, the
 /// time to the first visible change (any part of the version) and to the final state (p50,
-/// p99), the earlier parts per update and the server's update time. Writes JSON and a chart.
+/// p99), the earlier parts per update, the server's update time and CPU per update, and how
+/// far the luma SH a client shows before the final state are from it. Writes JSON and a chart.
 
 #include <cstdint>
 #include <string>

@@ -89,11 +89,6 @@ public:
         std::lock_guard lock(mMutex);
         return keyFrames;
     }
-    /// Each frame's part (v1::Frame::part: 0 for a version's final state).
-    std::vector<uint32_t> parts() {
-        std::lock_guard lock(mMutex);
-        return mParts;
-    }
     /// Whether the final state of `version` (or anything newer) was decoded.
     bool holds(uint64_t version) {
         std::lock_guard lock(mMutex);
@@ -132,7 +127,6 @@ private:
         while (mStream->next(frame)) {
             std::lock_guard lock(mMutex);
             keyFrames.push_back(frame.base_version() == 0);
-            mParts.push_back(frame.part());
             const uint64_t version = frame.version();
             if (auto applied = mDecoder.apply(frame); !applied)
                 mErrors.push_back(applied.error().message);
@@ -149,7 +143,6 @@ private:
     std::mutex mMutex;
     std::vector<uint64_t> versions;
     std::vector<bool> keyFrames;
-    std::vector<uint32_t> mParts;
     std::vector<std::string> mErrors;
     bool mEnded = false;
     std::string mEndCode;

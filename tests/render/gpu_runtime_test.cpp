@@ -54,6 +54,53 @@ TEST_P(GpuRuntimeForms, ProgressiveUpdateMatchesTheCpuRuntime) {
     EXPECT_EQ(gpu->context().validationMessages(), 0u);
 }
 
+// What a budgeted server streams early (server/progressive.h): both backends show every
+// bounce's caches as they compute them, the last one flagged, and the GPU's bounces are the
+// CPU twin's.
+TEST(GpuRuntime, EveryBouncesCachesAreObservedAsTheCpuRuntimesAre) {
+    const test::BakedScene& b = test::smallBake("cornell", LinkMode::Rtp);
+    ASSERT_TRUE(b.ok);
+    auto cpu = createCpuRuntime(b.scene, *b.rays, b.bake, BounceParams{3});
+    ASSERT_TRUE(cpu);
+    auto gpu3 = test::gpuFor(b, {3});
+    ASSERT_TRUE(gpu3);
+    struct Seen {
+        std::vector<int> bounces;
+        std::vector<bool> last;
+        std::vector<CacheValues> caches;
+    };
+    const auto observer = [](Seen& seen) {
+        return [&seen](int bounce, const CacheValues& caches, bool last) {
+            seen.bounces.push_back(bounce);
+            seen.last.push_back(last);
+            seen.caches.push_back(caches);
+        };
+    };
+    const LightSet lights = defaultLightSet(b.scene);
+    Seen onCpu, onGpu;
+    auto cpuValues = (*cpu)->setLights(lights, nullptr, observer(onCpu));
+    ASSERT_TRUE(cpuValues) << cpuValues.error().message;
+    auto gpuValues = gpu3->setLights(lights, nullptr, observer(onGpu));
+    ASSERT_TRUE(gpuValues) << gpuValues.error().message;
+    for (const Seen* seen : {&onCpu, &onGpu}) {
+        EXPECT_EQ(seen->bounces, (std::vector<int>{1, 2, 3}));
+        EXPECT_EQ(seen->last, (std::vector<bool>{false, false, true}));
+    }
+    ASSERT_EQ(onGpu.caches.size(), 3u);
+    for (size_t i = 0; i < 3; ++i)
+        EXPECT_LE(test::relativeL2(onGpu.caches[i], onCpu.caches[i]), 0.01) << "bounce " << i + 1;
+    // Without a sky the last bounce's caches are the result; each bounce adds light.
+    EXPECT_EQ(onCpu.caches.back().y, (*cpuValues)->y);
+    EXPECT_EQ(onGpu.caches.back().y, (*gpuValues)->y);
+    const auto luma = [](const CacheValues& values) {
+        double sum = 0.0;
+        for (const float v : values.y) sum += v;
+        return sum;
+    };
+    EXPECT_LT(luma(onCpu.caches[0]), luma(onCpu.caches[1]));
+    EXPECT_LT(luma(onCpu.caches[1]), luma(onCpu.caches[2]));
+}
+
 /// "ShadowMaps" or "Rays", for test names.
 std::string visibilityName(gpu::DirectVisibility visibility) {
     return visibility == gpu::DirectVisibility::Rays ? "Rays" : "ShadowMaps";
