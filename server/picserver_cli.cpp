@@ -104,6 +104,9 @@ int picserverMain(int argc, char** argv) {
     app.add_option("--metrics-listen", options.metricsListen,
                    "HOST:PORT to serve Prometheus metrics on (GET /metrics); port 0 picks a "
                    "free one");
+    app.add_option("--web-listen", options.webListen,
+                   "HOST:PORT to serve browsers on: the session streams over WebSocket at "
+                   "/v1/stream?session=ID&token=T; port 0 picks a free one");
     double idleMinutes = 60.0;
     app.add_option("--session-idle-minutes", idleMinutes,
                    "remove a session without subscribers after this long unused")
@@ -241,6 +244,9 @@ int picserverMain(int argc, char** argv) {
     if (!(*server)->metricsAddress().empty())
         std::fprintf(stderr, "picserver: metrics on http://%s/metrics\n",
                      (*server)->metricsAddress().c_str());
+    if (!(*server)->webAddress().empty())
+        std::fprintf(stderr, "picserver: browsers' streams on ws://%s/v1/stream\n",
+                     (*server)->webAddress().c_str());
 
     serving = true;
     const int signal = stopped.get_future().get();

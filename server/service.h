@@ -23,6 +23,8 @@
 
 namespace pic {
 
+class WebServer;
+
 struct ServerOptions {
     SessionOptions session;
     size_t maxSessions = 64;   ///< CreateSession beyond this: RESOURCE_EXHAUSTED
@@ -34,6 +36,9 @@ struct ServerOptions {
     /// Where to serve the Prometheus metrics (GET /metrics; server/metrics.h), "HOST:PORT";
     /// empty: nowhere.
     std::string metricsListen;
+    /// Where to serve browsers the session streams over WebSocket (server/web_server.h),
+    /// "HOST:PORT"; empty: nowhere.
+    std::string webListen;
     /// Called once the server listens, with its address, before it restores the sessions of
     /// the database: whatever it prints comes before any update the restored sessions log.
     std::function<void(const std::string& address)> onListening;
@@ -95,6 +100,8 @@ public:
 
     /// "HOST:PORT" of the metrics endpoint, empty without one.
     std::string metricsAddress() const { return mMetricsServer ? mMetricsServer->address() : std::string(); }
+    /// "HOST:PORT" of the browsers' endpoint, empty without one.
+    std::string webAddress() const;
 
     /// A session by id (null when none): for tests and the log.
     std::shared_ptr<Session> session(const std::string& id) const;
@@ -113,6 +120,7 @@ private:
     bool mShutDown = false;
     std::thread mReaper;  ///< housekeeping: idle sessions, the database; until shutdown
     std::unique_ptr<MetricsServer> mMetricsServer;
+    std::unique_ptr<WebServer> mWebServer;
 };
 
 }  // namespace pic
