@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -70,6 +71,19 @@ public:
         std::lock_guard lock(mMutex);
         return mDecoder ? mDecoder->frame() : HalfFrame{};
     }
+    /// Stops reading (the next message waits in the data handler until release()): a browser
+    /// tab that falls behind.
+    void stall() {
+        std::lock_guard lock(mMutex);
+        mStalled = true;
+    }
+    void release() {
+        {
+            std::lock_guard lock(mMutex);
+            mStalled = false;
+        }
+        mChanged.notify_all();
+    }
     std::string reason() {
         std::lock_guard lock(mMutex);
         return mReason;
@@ -84,7 +98,8 @@ private:
         auto* reader = static_cast<WebReader*>(self);
         const int opcode = bits & 0x0f;
         {
-            std::lock_guard lock(reader->mMutex);
+            std::unique_lock lock(reader->mMutex);
+            reader->mChanged.wait(lock, [&] { return !reader->mStalled; });
             if (opcode == MG_WEBSOCKET_OPCODE_BINARY) {
                 v1::Frame frame;
                 if (!frame.ParseFromArray(data, int(length))) {
@@ -121,6 +136,7 @@ private:
     int mCloseCode = 0;
     std::string mReason;
     bool mClosed = false;
+    bool mStalled = false;
 };
 
 ServerOptions withWeb() {
@@ -171,6 +187,44 @@ TEST(WebStream, ABrowserGetsTheGrpcStreamsFramesAndDecodesTheServersCaches) {
     ASSERT_TRUE(late.waitForFrames(1));
     EXPECT_EQ(late.frames().front().base_version(), 0u);
     EXPECT_EQ(late.frames().front().version(), live->latestVersion());
+}
+
+// Latest wins on the WebSocket too: a browser that stops reading holds up nobody, and once it
+// reads again it gets what the sockets had buffered, then the newest state (a key frame where
+// it skipped), never every version.
+TEST(WebStream, AStalledBrowserDelaysNobodyAndSkipsToTheLast) {
+    Served served = serveWith(withWeb());
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    auto live = served.server->session(session->session());
+    ASSERT_TRUE(live->waitForVersion(1, 30s));
+    const v1::SceneHeader header = sceneHeaderOf(*served.connection);
+    WebReader stalled(served.server->webAddress(), session->session(), session->viewer_token(),
+                      &header);
+    ASSERT_TRUE(stalled.waitForVersion(1));
+    stalled.stall();
+    WebReader fast(served.server->webAddress(), session->session(), session->viewer_token(),
+                   &header);
+    ASSERT_TRUE(fast.waitForVersion(1));
+
+    constexpr int kUpdates = 200;
+    uint64_t last = 0;
+    for (int i = 0; i < kUpdates; ++i) {
+        auto version = served.connection->setLights(session->session(), session->editor_token(),
+                                                    pointLight(0.01f * float(i % 20)));
+        ASSERT_TRUE(version);
+        last = *version;
+        ASSERT_TRUE(fast.waitForVersion(last)) << "the fast browser waited on the stalled one";
+    }
+    stalled.release();
+    ASSERT_TRUE(stalled.waitForVersion(last));
+    EXPECT_TRUE(stalled.errors().empty()) << stalled.errors().front();
+    EXPECT_TRUE(stalled.decoded() == *live->latestUpdate()->frame);
+    const size_t frames = stalled.frames().size();
+    std::printf("the stalled browser received %zu frames for %llu versions\n", frames,
+                (unsigned long long)last);
+    EXPECT_LT(frames, size_t(last));
 }
 
 TEST(WebStream, ARefusalSaysWhyInTheCloseFrame) {
