@@ -24,6 +24,17 @@ namespace fs = std::filesystem;
 
 }  // namespace
 
+Result<nlohmann::ordered_json> runLoadOn(const ServerProcess& server, PicConnection& connection,
+                                         LoadOptions load) {
+    double cpuBefore = 0.0, cpuAfter = 0.0;
+    load.onChangesStart = [&] { cpuBefore = cpuSeconds(server.pid); };
+    load.onChangesEnd = [&] { cpuAfter = cpuSeconds(server.pid); };
+    PIC_TRY_ASSIGN(nlohmann::ordered_json report, runLoadTest(connection, load));
+    const double updates = std::max(1.0, double(report["updates"].get<uint64_t>()));
+    report["server_cpu_ms_per_update"] = 1000.0 * (cpuAfter - cpuBefore) / updates;
+    return report;
+}
+
 int runStreamBenchmark(const StreamBenchmarkParams& params) {
     auto inputs = loadBenchInputs(params.scenePath, "");
     if (!inputs) return 2;
@@ -62,16 +73,10 @@ int runStreamBenchmark(const StreamBenchmarkParams& params) {
         load.durationSeconds = params.duration;
         load.updateRate = params.updateRate;
         load.moveMetres = 0.01f * inputs->scene.bounds.diagonal();
-        // Server CPU while the editor changes lights: the subscribers' first key frames and
-        // their stream setup are outside the window.
-        double cpuBefore = 0.0, cpuAfter = 0.0;
-        load.onChangesStart = [&] { cpuBefore = cpuSeconds(server.pid); };
-        load.onChangesEnd = [&] { cpuAfter = cpuSeconds(server.pid); };
-        auto report = runLoadTest(**connection, load);
+        auto report = runLoadOn(server, **connection, load);
         if (!report) return reportError(report.error());
         nlohmann::ordered_json row = *report;
         const double updates = std::max(1.0, double(row["updates"].get<uint64_t>()));
-        row["server_cpu_ms_per_update"] = 1000.0 * (cpuAfter - cpuBefore) / updates;
         row["values_per_frame"] = values;
         const double keyBytes = row["bytes_per_frame"]["key"].get<double>();
         const double deltaBytes = row["bytes_per_frame"]["delta"].get<double>();

@@ -12,6 +12,11 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "bench/server_process.h"
+#include "client/load_test.h"
+
 namespace pic {
 
 struct StreamBenchmarkParams {
@@ -28,5 +33,12 @@ struct StreamBenchmarkParams {
 };
 
 int runStreamBenchmark(const StreamBenchmarkParams& params);
+
+/// `picclient load`'s test through `connection` to `server`, its report with
+/// `server_cpu_ms_per_update` added: the server's CPU while the editor changed lights (the
+/// subscribers' first key frames and their stream setup are outside that window), per update.
+Result<nlohmann::ordered_json> runLoadOn(const ServerProcess& server, PicConnection& connection,
+                                         LoadOptions load);
+
 
 }  // namespace pic

@@ -1,5 +1,6 @@
 #include "server/web_server.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
@@ -7,6 +8,7 @@
 
 #include <civetweb.h>
 
+#include "server/civetweb_server.h"
 #include "server/service_state.h"
 
 namespace pic {
@@ -186,31 +188,19 @@ void onClose(const mg_connection* connection, void*) {
 
 Result<std::unique_ptr<WebServer>> WebServer::start(const std::string& listen,
                                                     std::shared_ptr<PicServer::State> state) {
-    const size_t colon = listen.rfind(':');
-    if (colon == std::string::npos || colon == 0 || colon + 1 == listen.size())
-        return fail(ErrorCode::InvalidInput, "--web-listen must be HOST:PORT, got \"{}\"", listen);
-    static std::once_flag initialised;
-    std::call_once(initialised, [] { mg_init_library(MG_FEATURES_WEBSOCKET); });
-    std::unique_ptr<WebServer> server(new WebServer());
-    server->mState = std::move(state);
     // civetweb gives every open WebSocket a thread of its own for the connection's life: as
     // many threads as one host may hold streams, plus a few for the handshakes.
     const std::string threads =
-        std::to_string(std::min<size_t>(server->mState->options.maxStreamsPerPeer, 1000) + 4);
-    const char* options[] = {"listening_ports", listen.c_str(), "num_threads", threads.c_str(),
-                             "websocket_timeout_ms", "3600000", nullptr};
-    mg_callbacks callbacks{};
-    callbacks.log_message = [](const mg_connection*, const char*) { return 1; };
-    server->mContext = mg_start(&callbacks, nullptr, options);
-    if (!server->mContext)
-        return fail(ErrorCode::InvalidInput,
-                    "--web-listen: cannot listen on \"{}\" (address in use or invalid)", listen);
+        std::to_string(std::min<size_t>(state->options.maxStreamsPerPeer, 1000) + 4);
+    PIC_TRY_ASSIGN(CivetwebServer started,
+                   startCivetweb("--web-listen", listen,
+                                 {{"num_threads", threads}, {"websocket_timeout_ms", "3600000"}}));
+    std::unique_ptr<WebServer> server(new WebServer());
+    server->mState = std::move(state);
+    server->mContext = started.context;
+    server->mAddress = std::move(started.address);
     mg_set_websocket_handler(server->mContext, "/v1/stream$", onConnect, onReady, onData, onClose,
                              &server->mState);
-    mg_server_port port{};
-    if (mg_get_server_ports(server->mContext, 1, &port) != 1)
-        return fail(ErrorCode::Internal, "--web-listen {}: no port bound", listen);
-    server->mAddress = listen.substr(0, colon) + ":" + std::to_string(port.port);
     return server;
 }
 

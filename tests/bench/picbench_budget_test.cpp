@@ -19,16 +19,13 @@ protected:
 };
 
 TEST_F(PicbenchBudget, ABudgetBelowTheUpdateStreamsPartsAndTheBaselineNone) {
-    const std::string scene = std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf";
-    const fs::path bake = mDir / "cornell.pic";
-    CommandResult baked = runCommand(std::string(PIC_PICBAKE) + " --quiet bake " + scene + " -o " +
-                                         bake.string() + " --surfels 4096 --links 32",
-                                     mDir.path());
-    ASSERT_EQ(baked.exitCode, 0) << baked.err;
+    const std::string scene = cornellScene();
+    const std::string bake = smallCornellBake();
+    ASSERT_FALSE(bake.empty());
     const fs::path json = mDir / "budget.json";
     std::string err;
     // Any update takes longer than a microsecond: every one after the first comes in parts.
-    const int exit = run("budget --scene " + scene + " --bake " + bake.string() +
+    const int exit = run("budget --scene " + scene + " --bake " + bake +
                              " --backend cpu --budgets 0 0.001 --clients 4 --duration 2 "
                              "--update-rate 4 --json " + json.string(),
                          err);

@@ -24,6 +24,19 @@ protected:
         return result.exitCode;
     }
 
+    /// A small bake of the Cornell box (4,096 surfels, 32 links) in the scratch directory: its
+    /// path, empty (with the failure added) when picbake fails.
+    std::string smallCornellBake() {
+        const std::string path = (mDir.path() / "cornell.pic").string();
+        CommandResult baked = runCommand(std::string(PIC_PICBAKE) + " --quiet bake " +
+                                             cornellScene() + " -o " + path +
+                                             " --surfels 4096 --links 32",
+                                         mDir.path());
+        EXPECT_EQ(baked.exitCode, 0) << baked.err;
+        return baked.exitCode == 0 ? path : std::string();
+    }
+    static std::string cornellScene() { return std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf"; }
+
     ScratchDir mDir;
 };
 

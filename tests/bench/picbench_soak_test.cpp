@@ -19,15 +19,12 @@ protected:
 };
 
 TEST_F(PicbenchSoak, TwoHundredSubscribersForThirtySecondsLoseNoFinalState) {
-    const std::string scene = std::string(PIC_TEST_SCENE_DIR) + "/cornell.gltf";
-    const fs::path bake = mDir / "cornell.pic";
-    CommandResult baked = runCommand(std::string(PIC_PICBAKE) + " --quiet bake " + scene + " -o " +
-                                         bake.string() + " --surfels 4096 --links 32",
-                                     mDir.path());
-    ASSERT_EQ(baked.exitCode, 0) << baked.err;
+    const std::string scene = cornellScene();
+    const std::string bake = smallCornellBake();
+    ASSERT_FALSE(bake.empty());
     const fs::path json = mDir / "soak.json";
     std::string err;
-    const int exit = run("soak --scene " + scene + " --bake " + bake.string() +
+    const int exit = run("soak --scene " + scene + " --bake " + bake +
                              " --backend cpu --clients 200 --update-rate 10 --duration 30 --json " +
                              json.string(),
                          err);

@@ -36,17 +36,21 @@ Served serve(const std::string& backend, uint32_t keyframeInterval,
     return serveWith(options, backend);
 }
 
-Served serveWith(const ServerOptions& serverOptions, const std::string& backend, int bounces) {
-    Served served;
-    ServeOptions options;
-    options.backend = backend;
-    options.bounces.bounces = bounces;
-    auto bake = ServedBake::load(bakePath(), kScene, options);
-    EXPECT_TRUE(bake) << (bake ? "" : bake.error().message);
-    if (!bake) return served;
+Result<std::unique_ptr<PicServer>> startOn(const ServerOptions& options,
+                                           const std::string& backend, int bounces) {
+    ServeOptions serveOptions;
+    serveOptions.backend = backend;
+    serveOptions.bounces.bounces = bounces;
+    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
+    if (!bake) return std::unexpected(bake.error());
     std::vector<std::unique_ptr<ServedBake>> bakes;
     bakes.push_back(std::move(*bake));
-    auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", serverOptions);
+    return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+}
+
+Served serveWith(const ServerOptions& serverOptions, const std::string& backend, int bounces) {
+    Served served;
+    auto server = startOn(serverOptions, backend, bounces);
     EXPECT_TRUE(server) << (server ? "" : server.error().message);
     if (!server) return served;
     served.server = std::move(*server);
@@ -57,15 +61,9 @@ Served serveWith(const ServerOptions& serverOptions, const std::string& backend,
 }
 
 Result<std::unique_ptr<PicServer>> startWithDatabase(const std::string& dbPath) {
-    ServeOptions serveOptions;
-    serveOptions.backend = "cpu";
-    auto bake = ServedBake::load(bakePath(), kScene, serveOptions);
-    if (!bake) return std::unexpected(bake.error());
-    std::vector<std::unique_ptr<ServedBake>> bakes;
-    bakes.push_back(std::move(*bake));
     ServerOptions options;
     options.dbPath = dbPath;
-    return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+    return startOn(options, "cpu", -1);
 }
 
 LightSet pointLight(float x) {

@@ -45,6 +45,11 @@ Served serve(const std::string& backend = "cpu", uint32_t keyframeInterval = 32,
 Served serveWith(const ServerOptions& options, const std::string& backend = "cpu",
                  int bounces = 1);
 
+/// Starts a server over the test bake with `options`, the backend and bounce count (−1:
+/// progressive); its error when it cannot.
+Result<std::unique_ptr<PicServer>> startOn(const ServerOptions& options,
+                                           const std::string& backend = "cpu", int bounces = 1);
+
 /// Starts a server over the test bake with the session database at `dbPath`.
 Result<std::unique_ptr<PicServer>> startWithDatabase(const std::string& dbPath);
 

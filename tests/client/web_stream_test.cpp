@@ -259,14 +259,7 @@ TEST(WebStream, AServerThatStopsEndsTheStreamSayingSubscribeAgain) {
 TEST(WebStream, AnAddressThatCannotBeServedIsRefusedNamingIt) {
     ServerOptions options = withWeb();
     options.webListen = "no-port";
-    ServeOptions serve;
-    serve.backend = "cpu";
-    serve.bounces.bounces = 1;
-    auto bake = ServedBake::load(bakePath(), kScene, serve);
-    ASSERT_TRUE(bake);
-    std::vector<std::unique_ptr<ServedBake>> bakes;
-    bakes.push_back(std::move(*bake));
-    auto server = PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+    auto server = startOn(options);
     ASSERT_FALSE(server);
     EXPECT_EQ(server.error().code, ErrorCode::InvalidInput);
     EXPECT_NE(server.error().message.find("no-port"), std::string::npos) << server.error().message;
