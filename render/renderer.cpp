@@ -119,6 +119,10 @@ ClientLayout clientLayoutOf(const BakeData& bake) {
     return layout;
 }
 
+float rendererEpsilonOf(const Scene& scene) {
+    return std::max(1e-6f, 1e-5f * scene.bounds.diagonal());
+}
+
 Renderer::Renderer(gpu::Context& context, const Scene& scene, ClientLayout layout)
     : mContext(context), mScene(scene), mLayout(std::move(layout)) {}
 
@@ -137,7 +141,7 @@ Result<void> Renderer::init(const RendererOptions& options) {
     using namespace gpu;
     // The CPU twin's ray offset (rays/embree_scene.h EmbreeScene::epsilon), so that shadow
     // tests start from the same height above the surface.
-    mEpsilon = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
+    mEpsilon = rendererEpsilonOf(mScene);
     // Every pass is made through the pass table (render/passes/pass.h) from one config.
     const PassConfig config{
         .scene = &mScene,
@@ -195,7 +199,7 @@ Result<Image> Renderer::render(const LightSet& lights, const Camera& camera,
         mBound = true;
     }
 
-    const float near = std::max(1e-6f, 1e-5f * mScene.bounds.diagonal());
+    const float near = rendererEpsilonOf(mScene);
 
     // What the G-buffer and shading passes record with: the shading's push here, the
     // G-buffer's per subsample.

@@ -56,6 +56,11 @@ struct ClientLayout {
 /// The client layout of a bake.
 ClientLayout clientLayoutOf(const BakeData& bake);
 
+/// The renderer's ray offset above surfaces and its camera's near-plane distance for `scene`,
+/// metres: the CPU twin's (rays/embree_scene.h EmbreeScene::epsilon), 1e-5 of the bounds'
+/// diagonal and at least 1e-6.
+float rendererEpsilonOf(const Scene& scene);
+
 /// How to build a renderer.
 struct RendererOptions {
     uint32_t shadowMapSize = 1024;  ///< texels per side of each shadow-map layer, 16..16384

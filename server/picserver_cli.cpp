@@ -106,7 +106,12 @@ int picserverMain(int argc, char** argv) {
                    "free one");
     app.add_option("--web-listen", options.webListen,
                    "HOST:PORT to serve browsers on: the session streams over WebSocket at "
-                   "/v1/stream?session=ID&token=T; port 0 picks a free one");
+                   "/v1/stream?session=ID&token=T, the scene, light sets and pages over HTTP; "
+                   "port 0 picks a free one");
+    app.add_option("--web-root", options.webRoot,
+                   "folder of the pages --web-listen serves under / (index.html at /, the "
+                   "scripts' libraries in its node_modules/)")
+        ->capture_default_str();
     double idleMinutes = 60.0;
     app.add_option("--session-idle-minutes", idleMinutes,
                    "remove a session without subscribers after this long unused")
@@ -245,8 +250,8 @@ int picserverMain(int argc, char** argv) {
         std::fprintf(stderr, "picserver: metrics on http://%s/metrics\n",
                      (*server)->metricsAddress().c_str());
     if (!(*server)->webAddress().empty())
-        std::fprintf(stderr, "picserver: browsers' streams on ws://%s/v1/stream\n",
-                     (*server)->webAddress().c_str());
+        std::fprintf(stderr, "picserver: browsers on http://%s/ (streams at ws://%s/v1/stream)\n",
+                     (*server)->webAddress().c_str(), (*server)->webAddress().c_str());
 
     serving = true;
     const int signal = stopped.get_future().get();

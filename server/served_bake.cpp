@@ -1,6 +1,7 @@
 #include "server/served_bake.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "core/light_set.h"
 #include "render/cpu_runtime.h"
 #include "render/gpu_runtime.h"
+#include "server/web_scene.h"
 
 namespace pic {
 
@@ -116,6 +118,24 @@ Result<void> ServedBake::buildAssets(const std::string& scenePath) {
     add("layout/grid_caches", bytesOf(mBake.grid.cacheIndex));
     add("layout/lightmap_caches", bytesOf(mBake.lightmap.cacheIndex));
     return {};
+}
+
+const Result<std::string>& ServedBake::webScene() const {
+    std::call_once(mWebSceneBuilt, [&] {
+        const auto start = std::chrono::steady_clock::now();
+        mWebScene = webSceneOf(mScene, mBake, mId);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        if (mWebScene)
+            std::fprintf(stderr,
+                         "picserver: bake %s: the browsers' scene takes %zu bytes (%.0f ms)\n",
+                         mId.c_str(), mWebScene->size(), ms);
+        else
+            std::fprintf(stderr, "picserver: bake %s: no browsers' scene: %s\n", mId.c_str(),
+                         mWebScene.error().message.c_str());
+    });
+    return mWebScene;
 }
 
 Result<void> ServedBake::warmUp() {

@@ -1,6 +1,7 @@
 #pragma once
 /// A bake as the server serves it (ARCHITECTURE §1): the scene, the bake data, the one
-/// runtime that relights it for every session on it, and the assets thin clients download.
+/// runtime that relights it for every session on it, and what thin clients and browsers
+/// download.
 
 #include <atomic>
 #include <cstdint>
@@ -47,6 +48,9 @@ public:
     /// The header GetScene sends first; the assets' bytes follow in its order.
     const v1::SceneHeader& header() const { return mHeader; }
     const std::vector<std::string>& assetBytes() const { return mAssetBytes; }
+    /// The browsers' scene (server/web_scene.h), built on the first call from any thread and
+    /// kept; every call gives what the first built, its size logged then.
+    const Result<std::string>& webScene() const;
     /// The Vulkan device of the GPU backend, empty for the CPU twin.
     const std::string& device() const { return mDevice; }
     /// Where the GPU backend's direct visibility comes from ("shadow-maps", "rays"), empty
@@ -85,6 +89,8 @@ private:
     v1::BakeSummary mSummary;
     v1::SceneHeader mHeader;
     std::vector<std::string> mAssetBytes;
+    mutable std::once_flag mWebSceneBuilt;
+    mutable Result<std::string> mWebScene;  ///< set once, under mWebSceneBuilt
 };
 
 }  // namespace pic

@@ -348,60 +348,14 @@ public:
         Access access = authorise(*mState, request->session(), request->token());
         const Call call{"SetLights", roleName(access.role), request->session()};
         if (!access.status.ok()) return finish(context, call, access.status);
-        if (access.role != v1::EDITOR)
-            return finish(context, call, grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
-                                                "only an editor token may set lights"));
-        if (const auto wait = access.session->takeSetLightsTurn(); wait.count() > 0) {
-            // The delay goes in the trailing metadata too, for clients that wait and retry.
-            context->AddTrailingMetadata(wire::kRetryAfterMetadata, std::to_string(wait.count()));
-            return finish(context, call,
-                          grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                                       fmt::format("session {} takes at most {:g} light sets a second; "
-                                                   "retry in {} ms",
-                                                   access.session->id(),
-                                                   mState->options.session.setLightsPerSecond,
-                                                   wait.count())));
-        }
-        auto lights = wire::fromProto(request->lights());
-        if (!lights) return finish(context, call, wire::toStatus(lights.error()));
-        // Durable before the reply: the set is committed to the database, then queued.
-        const std::shared_ptr<Session>& session = access.session;
-        bool moved = false;
-        std::optional<grpc::Status> storeStatus;
-        Session::Commit commit;
-        if (mState->store)
-            commit = [&](uint64_t version, const LightSet& set) -> Result<void> {
-                auto saved = mState->timedStore("save", [&](SessionStore& db) {
-                    return db.save(PicServer::State::row(*session, version, set));
-                });
-                if (!saved) {
-                    storeStatus = mState->storeFailed(saved.error());
-                    return std::unexpected(saved.error());
-                }
-                if (!*saved) {
-                    moved = true;
-                    return fail(ErrorCode::Io, "session {} moved to another server", session->id());
-                }
-                return {};
-            };
-        auto version = session->setLights(std::move(*lights), commit);
-        if (moved) {
-            mState->evict(session);
-            return finish(context, call,
-                          grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                                       fmt::format("session {} moved to another server; the light "
-                                                   "set was not applied, send it again",
-                                                   session->id())));
-        }
-        if (storeStatus) return finish(context, call, *storeStatus);
-        if (!version) {
-            if (version.error().code == ErrorCode::Io)  // closed while it was being set
-                return finish(context, call, grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                                                    version.error().message));
-            return finish(context, call, wire::toStatus(version.error()));
-        }
-        response->set_version(*version);
-        return finish(context, call, grpc::Status::OK);
+        const SetLightsOutcome outcome =
+            setLights(*mState, access, [&] { return wire::fromProto(request->lights()); });
+        // The delay goes in the trailing metadata too, for clients that wait and retry.
+        if (outcome.retryAfter.count() > 0)
+            context->AddTrailingMetadata(wire::kRetryAfterMetadata,
+                                         std::to_string(outcome.retryAfter.count()));
+        if (outcome.status.ok()) response->set_version(outcome.version);
+        return finish(context, call, outcome.status);
     }
 
     grpc::ServerWriteReactor<v1::Frame>* Subscribe(grpc::CallbackServerContext* context,

@@ -25,6 +25,10 @@ namespace pic {
 
 class WebServer;
 
+/// Where the browsers' endpoint finds its pages without --web-root: the source tree's
+/// client/web, compiled in.
+std::string defaultWebRoot();
+
 struct ServerOptions {
     SessionOptions session;
     size_t maxSessions = 64;   ///< CreateSession beyond this: RESOURCE_EXHAUSTED
@@ -36,9 +40,12 @@ struct ServerOptions {
     /// Where to serve the Prometheus metrics (GET /metrics; server/metrics.h), "HOST:PORT";
     /// empty: nowhere.
     std::string metricsListen;
-    /// Where to serve browsers the session streams over WebSocket (server/web_server.h),
-    /// "HOST:PORT"; empty: nowhere.
+    /// Where to serve browsers (server/web_server.h): the session streams over WebSocket, the
+    /// scene, light sets and pages over HTTP; "HOST:PORT", empty: nowhere.
     std::string webListen;
+    /// The folder of the pages, scripts and their libraries (node_modules/) the browsers'
+    /// endpoint serves under GET /; one that does not exist serves none.
+    std::string webRoot = defaultWebRoot();
     /// Called once the server listens, with its address, before it restores the sessions of
     /// the database: whatever it prints comes before any update the restored sessions log.
     std::function<void(const std::string& address)> onListening;

@@ -1,13 +1,14 @@
 #pragma once
 /// What the server's transports share (internal to server/): the served bakes, the sessions,
 /// the database, the metrics and the audit log, and who may do what in a session. The gRPC
-/// service (server/service.cpp) and the browsers' WebSocket (server/web_server.cpp) both
+/// service (server/service.cpp) and the browsers' endpoint (server/web_server.cpp) both
 /// answer from it, so a browser meets the same tokens, quotas and sessions as picclient.
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -269,5 +270,23 @@ inline Access authorise(PicServer::State& state, const std::string& id, const st
 inline const char* roleName(v1::Role role) {
     return role == v1::EDITOR ? "editor" : role == v1::VIEWER ? "viewer" : "none";
 }
+
+/// How a light set sent to a session went.
+struct SetLightsOutcome {
+    grpc::Status status;
+    uint64_t version = 0;  ///< the set's version, when status is OK
+    /// When status is RESOURCE_EXHAUSTED by the session's rate limit: how long to wait.
+    std::chrono::milliseconds retryAfter{0};
+};
+
+/// SetLights for both transports: an editor's light set (else PERMISSION_DENIED) for the
+/// session `access` admitted, at most SessionOptions::setLightsPerSecond of them
+/// (RESOURCE_EXHAUSTED with the wait), `parse`d only once the rate limit let it through
+/// (its error's status), checked against the scene (INVALID_ARGUMENT), committed to the
+/// database before it returns, then queued. UNAVAILABLE when the session moved to another
+/// server (evicted here; the set was not applied) or closed while it was set, or the
+/// database failed. `access.status` must be OK.
+SetLightsOutcome setLights(PicServer::State& state, const Access& access,
+                           const std::function<Result<LightSet>()>& parse);
 
 }  // namespace pic

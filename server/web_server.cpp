@@ -3,11 +3,22 @@
 #include <algorithm>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <mutex>
+#include <string_view>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <civetweb.h>
+#include <nlohmann/json.hpp>
 
+#include "core/light_set.h"
+#include "embedded/pic_proto_text.h"
+#include "embedded/sh_basis_text.h"
 #include "server/civetweb_server.h"
 #include "server/service_state.h"
 
@@ -110,6 +121,238 @@ std::string queryVariable(const mg_request_info* request, const char* name) {
     return length < 0 ? std::string() : value.substr(0, size_t(length));
 }
 
+/// An HTTP reply: `status`, the body's type and length, `headers`, then `body` (none for a
+/// HEAD request).
+void reply(mg_connection* connection, int status, const char* contentType, std::string_view body,
+           const std::vector<std::pair<const char*, std::string>>& headers = {}) {
+    mg_response_header_start(connection, status);
+    mg_response_header_add(connection, "Content-Type", contentType, -1);
+    const std::string length = std::to_string(body.size());
+    mg_response_header_add(connection, "Content-Length", length.c_str(), -1);
+    for (const auto& [name, value] : headers)
+        mg_response_header_add(connection, name, value.c_str(), int(value.size()));
+    mg_response_header_send(connection);
+    if (std::string_view(mg_get_request_info(connection)->request_method) != "HEAD" &&
+        !body.empty())
+        mg_write(connection, body.data(), body.size());
+}
+
+/// The HTTP status of a refusal with gRPC code `code`.
+int httpStatusOf(grpc::StatusCode code) {
+    switch (code) {
+    case grpc::StatusCode::INVALID_ARGUMENT: return 400;
+    case grpc::StatusCode::UNAUTHENTICATED: return 401;
+    case grpc::StatusCode::PERMISSION_DENIED: return 403;
+    case grpc::StatusCode::NOT_FOUND: return 404;
+    case grpc::StatusCode::RESOURCE_EXHAUSTED: return 429;
+    case grpc::StatusCode::UNAVAILABLE: return 503;
+    default: return 500;
+    }
+}
+
+/// Answers a refusal: {"error": message, "code": code name} with `httpStatus`, and with the
+/// wait rounded up to whole seconds as Retry-After when there is one.
+int refuse(mg_connection* connection, const grpc::Status& status, int httpStatus,
+           std::chrono::milliseconds retryAfter = std::chrono::milliseconds(0)) {
+    const nlohmann::json body = {{"error", status.error_message()},
+                                 {"code", wire::statusName(status.error_code())}};
+    std::vector<std::pair<const char*, std::string>> headers = {{"Cache-Control", "no-store"}};
+    if (retryAfter.count() > 0)
+        headers.push_back({"Retry-After", std::to_string((retryAfter.count() + 999) / 1000)});
+    reply(connection, httpStatus, "application/json",
+          body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), headers);
+    return httpStatus;
+}
+
+int refuse(mg_connection* connection, const grpc::Status& status,
+           std::chrono::milliseconds retryAfter = std::chrono::milliseconds(0)) {
+    return refuse(connection, status, httpStatusOf(status.error_code()), retryAfter);
+}
+
+/// Refuses a request whose method the route does not take (405, naming those it takes).
+int wrongMethod(mg_connection* connection, const char* allowed) {
+    const nlohmann::json body = {
+        {"error", fmt::format("{} takes only {}", mg_get_request_info(connection)->local_uri,
+                              allowed)},
+        {"code", wire::statusName(grpc::StatusCode::UNIMPLEMENTED)}};
+    reply(connection, 405, "application/json", body.dump(), {{"Allow", allowed}});
+    return 405;
+}
+
+/// A session route's request: who sent it and for which session, or why it cannot be one.
+struct SessionRequest {
+    std::string sessionId;
+    std::string token;
+    std::string peer;       ///< the connection's remote host
+    std::string forwarded;  ///< its X-Forwarded-For header, empty without one
+    grpc::Status status;    ///< INVALID_ARGUMENT without a session or token
+};
+
+SessionRequest sessionRequestOf(const mg_connection* connection) {
+    const mg_request_info* request = mg_get_request_info(connection);
+    SessionRequest out;
+    out.sessionId = queryVariable(request, "session");
+    out.token = queryVariable(request, "token");
+    out.peer = request->remote_addr;
+    if (const char* forwarded = mg_get_header(connection, "X-Forwarded-For"))
+        out.forwarded = forwarded;
+    if (out.sessionId.empty())
+        out.status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                  "the query needs the parameter session=ID");
+    else if (out.token.empty())
+        out.status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                  "the query needs the parameter token=T");
+    return out;
+}
+
+/// GET /v1/scene?session=ID&token=T: the session's bake as server/web_scene.h lays it out.
+int serveScene(mg_connection* connection, void* data) {
+    if (std::string_view(mg_get_request_info(connection)->request_method) != "GET")
+        return wrongMethod(connection, "GET");
+    PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
+    const SessionRequest request = sessionRequestOf(connection);
+    Access access;
+    access.status = request.status;
+    if (access.status.ok()) access = authorise(state, request.sessionId, request.token);
+    const Result<std::string>* scene = nullptr;
+    if (access.status.ok()) {
+        access.session->touch();
+        scene = &access.session->bake().webScene();
+        // The bake's fault, not the request's: INTERNAL whatever the error.
+        if (!*scene)
+            access.status = grpc::Status(grpc::StatusCode::INTERNAL,
+                                         fmt::format("the scene of bake {} cannot be sent: {}",
+                                                     access.session->bake().id(),
+                                                     scene->error().message));
+    }
+    state.recordCall(request.peer, request.forwarded, "WebScene", roleName(access.role),
+                     request.sessionId, access.status);
+    if (!access.status.ok()) return refuse(connection, access.status);
+    // The bake's id names the bytes: a browser that holds them asks with If-None-Match.
+    const std::string etag = "\"" + access.session->bake().id() + "\"";
+    std::vector<std::pair<const char*, std::string>> headers = {
+        {"Cache-Control", "private, max-age=3600"}, {"ETag", etag}};
+    if (const char* held = mg_get_header(connection, "If-None-Match"); held && etag == held) {
+        mg_response_header_start(connection, 304);
+        for (const auto& [name, value] : headers)
+            mg_response_header_add(connection, name, value.c_str(), int(value.size()));
+        mg_response_header_send(connection);
+        return 304;
+    }
+    reply(connection, 200, "application/octet-stream", **scene, headers);
+    return 200;
+}
+
+/// POST /v1/lights?session=ID&token=T with a light set's JSON: the gRPC SetLights.
+int serveLights(mg_connection* connection, void* data) {
+    const mg_request_info* info = mg_get_request_info(connection);
+    if (std::string_view(info->request_method) != "POST") return wrongMethod(connection, "POST");
+    PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
+    const SessionRequest request = sessionRequestOf(connection);
+    // The body, up to one byte more than a request may hold (as gRPC's largest message).
+    std::string body;
+    bool tooLarge = info->content_length > int64_t(wire::kMaxRequestBytes);
+    if (!tooLarge) {
+        char buffer[16384];
+        for (int n; (n = mg_read(connection, buffer, sizeof buffer)) > 0;) {
+            body.append(buffer, size_t(n));
+            if (body.size() > wire::kMaxRequestBytes) {
+                tooLarge = true;
+                break;
+            }
+        }
+    }
+    Access access;
+    SetLightsOutcome outcome;
+    if (!request.status.ok()) {
+        outcome.status = request.status;
+    } else if (tooLarge) {
+        outcome.status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                                      fmt::format("a light set takes at most {} bytes",
+                                                  wire::kMaxRequestBytes));
+    } else {
+        access = authorise(state, request.sessionId, request.token);
+        outcome.status = access.status;
+        if (access.status.ok())
+            outcome = setLights(state, access, [&] { return parseLightSet(body); });
+    }
+    state.recordCall(request.peer, request.forwarded, "WebSetLights", roleName(access.role),
+                     request.sessionId, outcome.status);
+    if (tooLarge && request.status.ok()) return refuse(connection, outcome.status, 413);
+    if (!outcome.status.ok()) return refuse(connection, outcome.status, outcome.retryAfter);
+    reply(connection, 200, "application/json",
+          nlohmann::json{{"version", outcome.version}}.dump(), {{"Cache-Control", "no-store"}});
+    return 200;
+}
+
+/// GET of a text built into the server (`text` is the handler's data): /v1/pic.proto, the
+/// API's wire contract; /v1/sh_basis.glsl, the shaders' SH basis for the browser's shaders.
+int serveText(mg_connection* connection, void* text) {
+    const std::string_view method = mg_get_request_info(connection)->request_method;
+    if (method != "GET" && method != "HEAD") return wrongMethod(connection, "GET, HEAD");
+    reply(connection, 200, "text/plain; charset=utf-8", *static_cast<const std::string_view*>(text),
+          {{"Cache-Control", "no-cache"}});
+    return 200;
+}
+
+/// The Content-Type of a page's file, by its extension.
+const char* contentTypeOf(const std::filesystem::path& file) {
+    static const std::pair<std::string_view, const char*> kTypes[] = {
+        {".html", "text/html; charset=utf-8"},
+        {".js", "text/javascript; charset=utf-8"},
+        {".mjs", "text/javascript; charset=utf-8"},
+        {".css", "text/css; charset=utf-8"},
+        {".json", "application/json"},
+        {".map", "application/json"},
+        {".png", "image/png"},
+        {".svg", "image/svg+xml"},
+        {".wasm", "application/wasm"},
+        {".proto", "text/plain; charset=utf-8"},
+    };
+    const std::string extension = file.extension().string();
+    for (const auto& [known, type] : kTypes)
+        if (extension == known) return type;
+    return "application/octet-stream";
+}
+
+/// Whether `file` lies inside `root` (both canonical).
+bool inside(const std::filesystem::path& root, const std::filesystem::path& file) {
+    auto r = root.begin(), f = file.begin();
+    for (; r != root.end(); ++r, ++f)
+        if (f == file.end() || *r != *f) return false;
+    return f != file.end();
+}
+
+/// GET /PATH: the web root's regular file there ("/": index.html), resolved with its links;
+/// 404 for anything else, and for a file whose real place is outside the root.
+int serveFile(mg_connection* connection, void* data) {
+    namespace fs = std::filesystem;
+    const mg_request_info* request = mg_get_request_info(connection);
+    const std::string_view method = request->request_method;
+    if (method != "GET" && method != "HEAD") return wrongMethod(connection, "GET, HEAD");
+    const std::string& root = *static_cast<const std::string*>(data);
+    // civetweb has decoded the path's %XX escapes and removed its dot segments already; the
+    // file's canonical path decides whatever remains.
+    std::string path = request->local_uri ? request->local_uri : "/";
+    if (path.ends_with('/')) path += "index.html";
+    const auto notFound = [&] {
+        reply(connection, 404, "text/plain; charset=utf-8", "no such page\n",
+              {{"Cache-Control", "no-cache"}});
+        return 404;
+    };
+    if (root.empty() || path.find('\0') != std::string::npos) return notFound();
+    std::error_code error;
+    const fs::path file = fs::canonical(fs::path(root) / fs::path(path).relative_path(), error);
+    if (error || !inside(fs::path(root), file) || !fs::is_regular_file(file, error))
+        return notFound();
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (!in.good() && !in.eof()) return notFound();
+    reply(connection, 200, contentTypeOf(file), bytes,
+          {{"Cache-Control", "no-cache"}, {"X-Content-Type-Options", "nosniff"}});
+    return 200;
+}
+
 /// The socket connects: who is it, and may it subscribe? Every socket is accepted, so that a
 /// refusal can say why in its close frame (a refused handshake tells a browser nothing).
 int onConnect(const mg_connection* connection, void* data) {
@@ -189,20 +432,43 @@ void onClose(const mg_connection* connection, void*) {
 Result<std::unique_ptr<WebServer>> WebServer::start(const std::string& listen,
                                                     std::shared_ptr<PicServer::State> state) {
     // civetweb gives every open WebSocket a thread of its own for the connection's life: as
-    // many threads as one host may hold streams, plus a few for the handshakes.
+    // many threads as one host may hold streams, plus a few for the handshakes and the HTTP
+    // requests. A page's files come over one kept-alive connection (every reply says its
+    // length).
     const std::string threads =
         std::to_string(std::min<size_t>(state->options.maxStreamsPerPeer, 1000) + 4);
     PIC_TRY_ASSIGN(CivetwebServer started,
                    startCivetweb("--web-listen", listen,
-                                 {{"num_threads", threads}, {"websocket_timeout_ms", "3600000"}}));
+                                 {{"num_threads", threads},
+                                  {"websocket_timeout_ms", "3600000"},
+                                  {"enable_keep_alive", "yes"}}));
     std::unique_ptr<WebServer> server(new WebServer());
     server->mState = std::move(state);
     server->mContext = started.context;
     server->mAddress = std::move(started.address);
+    const std::string& webRoot = server->mState->options.webRoot;
+    std::error_code error;
+    if (std::filesystem::is_directory(webRoot, error))
+        server->mWebRoot = std::filesystem::canonical(webRoot, error).string();
+    if (server->mWebRoot.empty())
+        std::fprintf(stderr,
+                     "picserver: --web-root %s is not a folder: browsers get 404 for pages\n",
+                     webRoot.c_str());
     mg_set_websocket_handler(server->mContext, "/v1/stream$", onConnect, onReady, onData, onClose,
                              &server->mState);
+    mg_set_request_handler(server->mContext, "/v1/scene$", serveScene, &server->mState);
+    mg_set_request_handler(server->mContext, "/v1/lights$", serveLights, &server->mState);
+    static const std::string_view proto = kPicProtoText, shBasis = kShBasisText;
+    mg_set_request_handler(server->mContext, "/v1/pic.proto$", serveText,
+                           const_cast<std::string_view*>(&proto));
+    mg_set_request_handler(server->mContext, "/v1/sh_basis.glsl$", serveText,
+                           const_cast<std::string_view*>(&shBasis));
+    // Last: every other path is a page.
+    mg_set_request_handler(server->mContext, "/", serveFile, &server->mWebRoot);
     return server;
 }
+
+std::string defaultWebRoot() { return PIC_WEB_ROOT; }
 
 WebServer::~WebServer() {
     if (mContext) mg_stop(mContext);

@@ -1,7 +1,7 @@
 #pragma once
-/// The browsers' transport (`picserver --web-listen HOST:PORT`): a session's stream over a
-/// WebSocket, on civetweb (Debian's libcivetweb). Browsers cannot make gRPC's streaming calls
-/// and gRPC-Web needs a proxy Debian does not ship, so picserver speaks to them itself:
+/// The browsers' endpoint (`picserver --web-listen HOST:PORT`), on civetweb (Debian's
+/// libcivetweb). Browsers cannot make gRPC's streaming calls and gRPC-Web needs a proxy Debian
+/// does not ship, so picserver speaks to them itself:
 ///
 ///     ws://HOST:PORT/v1/stream?session=ID&token=T
 ///
@@ -14,6 +14,22 @@
 /// with code 4000 + the gRPC status code and its message as the reason: 4016 for a token
 /// that is not the session's, 4005 for no such session, 4014 when the server stops or the
 /// session moved (subscribe again), 4008 over the per-host stream quota.
+///
+/// Beside the stream, over HTTP:
+///
+///     GET  /v1/scene?session=ID&token=T    the session's scene (server/web_scene.h), any token
+///     POST /v1/lights?session=ID&token=T   a light set (core/light_set.h JSON), editor token:
+///                                          the gRPC SetLights, answering {"version": N}
+///     GET  /v1/pic.proto                   proto/pic.proto's text, no token
+///     GET  /PATH                           ServerOptions::webRoot's regular files ("/":
+///                                          index.html); none outside it, 404 otherwise
+///
+/// The two session routes answer a refusal with {"error": message, "code": gRPC code name}
+/// and HTTP 400 (INVALID_ARGUMENT, or a missing session or token), 401 (UNAUTHENTICATED), 403
+/// (PERMISSION_DENIED), 404 (NOT_FOUND), 413 (a body over wire::kMaxRequestBytes), 429
+/// (RESOURCE_EXHAUSTED, with Retry-After in whole seconds when the wait is known), 503
+/// (UNAVAILABLE) or 500 (any other); their metrics and audit calls are WebScene and
+/// WebSetLights.
 
 #include <memory>
 #include <string>
@@ -27,7 +43,8 @@ namespace pic {
 
 class WebServer {
 public:
-    /// Serves `state`'s sessions on `listen` ("HOST:PORT"; port 0 picks a free one);
+    /// Serves `state`'s sessions and state->options.webRoot's files on `listen` ("HOST:PORT";
+    /// port 0 picks a free one), warning once on stderr when the web root does not exist;
     /// InvalidInput naming the address when it cannot listen there.
     static Result<std::unique_ptr<WebServer>> start(const std::string& listen,
                                                     std::shared_ptr<PicServer::State> state);
@@ -43,6 +60,7 @@ private:
     WebServer() = default;
 
     std::shared_ptr<PicServer::State> mState;
+    std::string mWebRoot;  ///< canonical; empty when the folder does not exist
     mg_context* mContext = nullptr;
     std::string mAddress;
 };

@@ -1,6 +1,8 @@
 #include "tests/client/stream_fixture.h"
 
+#include <cctype>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <future>
 
@@ -160,7 +162,30 @@ std::string run(const std::string& command, int& exit) {
     return output;
 }
 
-HttpReply httpGet(const std::string& address, const std::string& path) {
+int HttpReply::code() const {
+    // "HTTP/1.1 200 OK"
+    const size_t space = status.find(' ');
+    if (!status.starts_with("HTTP/") || space == std::string::npos) return 0;
+    return std::atoi(status.c_str() + space + 1);
+}
+
+std::string HttpReply::header(const std::string& name) const {
+    const auto lower = [](std::string text) {
+        for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return text;
+    };
+    const std::string wanted = lower(name) + ":";
+    for (const std::string& line : headers)
+        if (lower(line).starts_with(wanted)) {
+            const size_t start = line.find_first_not_of(' ', wanted.size());
+            return start == std::string::npos ? std::string() : line.substr(start);
+        }
+    return {};
+}
+
+HttpReply httpRequest(const std::string& address, const std::string& method,
+                      const std::string& path, const std::string& body,
+                      const std::vector<std::string>& headers) {
     const size_t colon = address.rfind(':');
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in to{};
@@ -169,23 +194,39 @@ HttpReply httpGet(const std::string& address, const std::string& path) {
     ::inet_pton(AF_INET, address.substr(0, colon).c_str(), &to.sin_addr);
     if (::connect(fd, reinterpret_cast<sockaddr*>(&to), sizeof to) != 0) {
         ::close(fd);
-        return {"error: cannot connect to " + address, ""};
+        return {"error: cannot connect to " + address, "", {}};
     }
-    const std::string request = "GET " + path + " HTTP/1.1\r\nHost: " + address +
-                                "\r\nConnection: close\r\n\r\n";
-    if (::write(fd, request.data(), request.size()) != ssize_t(request.size())) {
-        ::close(fd);
-        return {"error: cannot send", ""};
+    std::string request = method + " " + path + " HTTP/1.1\r\nHost: " + address +
+                          "\r\nConnection: close\r\n";
+    for (const std::string& header : headers) request += header + "\r\n";
+    if (!body.empty() || method == "POST")
+        request += "Content-Length: " + std::to_string(body.size()) + "\r\n";
+    request += "\r\n" + body;
+    // A server may answer before it read all of a large body, and close: what it sent counts.
+    for (size_t sent = 0; sent < request.size();) {
+        const ssize_t n = ::send(fd, request.data() + sent, request.size() - sent, MSG_NOSIGNAL);
+        if (n <= 0) break;
+        sent += size_t(n);
     }
     std::string reply;
-    char buffer[4096];
+    char buffer[65536];
     for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;) reply.append(buffer, size_t(n));
     ::close(fd);
     const size_t lineEnd = reply.find("\r\n");
     const size_t bodyStart = reply.find("\r\n\r\n");
     if (lineEnd == std::string::npos || bodyStart == std::string::npos)
-        return {"error: no HTTP reply", reply};
-    return {reply.substr(0, lineEnd), reply.substr(bodyStart + 4)};
+        return {"error: no HTTP reply", reply, {}};
+    HttpReply out{reply.substr(0, lineEnd), reply.substr(bodyStart + 4), {}};
+    for (size_t start = lineEnd + 2; start < bodyStart;) {
+        const size_t end = reply.find("\r\n", start);
+        out.headers.push_back(reply.substr(start, end - start));
+        start = end + 2;
+    }
+    return out;
+}
+
+HttpReply httpGet(const std::string& address, const std::string& path) {
+    return httpRequest(address, "GET", path);
 }
 
 double metricValue(const std::string& text, const std::string& series) {

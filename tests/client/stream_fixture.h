@@ -184,12 +184,25 @@ std::string readLine(FILE* file);
 /// Runs `command` through the shell; its stdout, its exit code in `exit`.
 std::string run(const std::string& command, int& exit);
 
-/// An HTTP/1.1 GET of `path` from `address` ("HOST:PORT"): the status line and the body,
-/// or "error: …".
+/// An HTTP reply: the status line ("error: …" when there was none), the header lines
+/// ("Name: value", as sent) and the body.
 struct HttpReply {
     std::string status;
     std::string body;
+    std::vector<std::string> headers;
+
+    /// The status code, 0 without a status line.
+    int code() const;
+    /// The value of header `name` (any case), "" without one.
+    std::string header(const std::string& name) const;
 };
+/// An HTTP/1.1 request `method` of `path` (sent as written, unescaped) to `address`
+/// ("HOST:PORT") with `body` and the extra header lines `headers` ("Name: value"), on a
+/// connection of its own that the server closes.
+HttpReply httpRequest(const std::string& address, const std::string& method,
+                      const std::string& path, const std::string& body = "",
+                      const std::vector<std::string>& headers = {});
+/// An HTTP/1.1 GET of `path` from `address`.
 HttpReply httpGet(const std::string& address, const std::string& path);
 
 /// The value of the Prometheus sample `series` (name with its labels, as exposed) in `text`,

@@ -756,7 +756,9 @@ TEST(Stream, ABudgetedUpdateStreamsItsPartsThenExactlyTheFullUpdate) {
             EXPECT_TRUE(update.base == before || update.base.version == 0) << "update " << i;
             // Parts 1, 2, … of the version after the last final state, then its final state.
             EXPECT_EQ(update.version, before.part == 0 ? before.version + 1 : before.version);
-            if (update.part != 0) EXPECT_EQ(update.part, before.part + 1);
+            if (update.part != 0) {
+                EXPECT_EQ(update.part, before.part + 1);
+            }
         }
         v1::Frame frame = *update.broadcast;
         ASSERT_TRUE(decoder.apply(frame)) << "update " << i;
