@@ -17,7 +17,13 @@ PACKAGES=(
   libsqlite3-dev libpq-dev postgresql nginx libcivetweb-dev
   # libFuzzer (bench/run_fuzz.sh): clang 19, whose libstdc++ mode has std::expected.
   clang-19 libclang-rt-19-dev
+  # The browser client's tests: headless chromium (SwiftShader WebGL2).
+  chromium
 )
+# The browser client's npm packages (client/web): Debian's node and npm, unless a node with
+# its own npm is installed already.
+if ! command -v node >/dev/null; then PACKAGES+=(nodejs); fi
+if ! command -v npm >/dev/null; then PACKAGES+=(npm); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

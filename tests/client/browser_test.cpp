@@ -1,0 +1,158 @@
+// The browser client (client/web/) in a real browser: headless chromium, software WebGL2
+// (SwiftShader through ANGLE), driven by puppeteer-core from client/web/tests/. Each test
+// starts a picserver with --web-listen on 127.0.0.1 and stops it; chromium runs as a child
+// process of node and is closed by the driver script.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/image.h"
+#include "core/light_set.h"
+#include "server/served_bake.h"
+#include "tests/client/stream_fixture.h"
+#include "tests/support/baked_scene.h"
+
+namespace pic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using namespace test;
+
+const std::string kWebDir = std::string(PIC_SOURCE_DIR) + "/client/web";
+
+/// A server over a small bake of test scene `name`, with the browsers' listener.
+Result<std::unique_ptr<PicServer>> serveScene(const std::string& name, const BakeOptions& bake) {
+    const std::string& path = bakeFile(name, bake);
+    if (path.empty()) return fail(ErrorCode::Io, "no bake of {}", name);
+    ServeOptions serveOptions;
+    serveOptions.backend = "cpu";
+    serveOptions.bounces.bounces = 1;
+    PIC_TRY_ASSIGN(auto served, ServedBake::load(path, testScenePath(name), serveOptions));
+    std::vector<std::unique_ptr<ServedBake>> bakes;
+    bakes.push_back(std::move(served));
+    ServerOptions options;
+    options.session.setLightsPerSecond = 1e6;
+    options.webListen = "127.0.0.1:0";
+    return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
+}
+
+/// What the browser tests need installed: chromium and the npm packages (scripts/build.sh).
+void requireBrowser() {
+    ASSERT_TRUE(fs::exists("/usr/bin/chromium") || std::getenv("PIC_CHROMIUM"))
+        << "chromium is not installed (scripts/install_deps.sh installs it)";
+    ASSERT_TRUE(fs::exists(kWebDir + "/node_modules/puppeteer-core"))
+        << "client/web's npm packages are not installed (scripts/build.sh installs them)";
+}
+
+/// "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy" of a camera, as --camera and the page's URL take it.
+std::string cameraText(const Camera& c) {
+    return fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}",
+                       c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x,
+                       c.up.y, c.up.z, c.fovyDegrees);
+}
+
+struct ParityCase {
+    std::string scene;
+    uint32_t surfels;
+    std::string size;
+    bool pushLights;  ///< a point and a spot light pushed (else the scene's own lights)
+};
+
+class BrowserParity : public testing::TestWithParam<ParityCase> {};
+
+// The page's image of one view against `picclient render`'s of the same view, size and
+// exposure: the same shading, pass for pass, on another rasteriser. Relative RMSE over 4 × 4
+// blocks within 0.02 (the bound); the per-pixel figure is reported too.
+TEST_P(BrowserParity, TheBrowsersImageIsPicclientRenders) {
+    requireBrowser();
+    const ParityCase& c = GetParam();
+    auto server = serveScene(c.scene, smallBakeOptions(c.surfels, 32));
+    ASSERT_TRUE(server) << server.error().message;
+    auto connection = PicConnection::connect((*server)->address());
+    ASSERT_TRUE(connection);
+    auto session = (*connection)->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    uint64_t version = session->version();
+    const Scene scene = loadTestScene(c.scene);
+    ASSERT_FALSE(scene.cameras.empty());
+    if (c.pushLights) {
+        LightSet lights;
+        Light point;
+        point.id = "point";
+        point.type = LightType::Point;
+        point.position = scene.bounds.center() + glm::vec3(0.15f, 0.25f, 0.1f) * scene.bounds.extent();
+        point.intensity = 0.6f * glm::dot(scene.bounds.extent(), scene.bounds.extent());
+        point.color = {1.0f, 0.8f, 0.6f};
+        Light spot;
+        spot.id = "spot";
+        spot.type = LightType::Spot;
+        spot.position = scene.bounds.center() + glm::vec3(-0.3f, 0.3f, 0.2f) * scene.bounds.extent();
+        spot.direction = glm::normalize(glm::vec3(0.3f, -1.0f, -0.2f));
+        spot.outerConeAngle = 0.6f;
+        spot.innerConeAngle = 0.4f;
+        spot.intensity = point.intensity;
+        lights.lights = {point, spot};
+        auto set = (*connection)->setLights(session->session(), session->editor_token(), lights);
+        ASSERT_TRUE(set) << set.error().message;
+        version = *set;
+    }
+    auto live = (*server)->session(session->session());
+    ASSERT_TRUE(live->waitForVersion(version, 60s));
+
+    const std::string camera = cameraText(scene.cameras.front());
+    const fs::path dir = fs::path(testing::TempDir()) / ("browser_" + c.scene);
+    fs::create_directories(dir);
+    const std::string native = (dir / "picclient.png").string();
+    const std::string browser = (dir / "browser.png").string();
+    int exit = 0;
+    const std::string rendered = run(
+        fmt::format("{} render --server {} --session {} --token {} --camera {} --size {} --out {} "
+                    "--cache-dir {} 2>&1",
+                    PIC_PICCLIENT, (*server)->address(), session->session(),
+                    session->viewer_token(), camera, c.size, native, (dir / "cache").string()),
+        exit);
+    ASSERT_EQ(exit, 0) << rendered;
+    const std::string url =
+        fmt::format("http://{}/?session={}&token={}&camera={}&size={}&ui=0",
+                    (*server)->webAddress(), session->session(), session->viewer_token(), camera,
+                    c.size);
+    const std::string shot =
+        run(fmt::format("node {}/tests/screenshot.mjs --url '{}' --out {} --version {} 2>&1",
+                        kWebDir, url, browser, version),
+            exit);
+    ASSERT_EQ(exit, 0) << shot;
+
+    auto a = readImage(browser);
+    auto b = readImage(native);
+    ASSERT_TRUE(a) << a.error().message;
+    ASSERT_TRUE(b) << b.error().message;
+    ASSERT_EQ(a->width, b->width);
+    ASSERT_EQ(a->height, b->height);
+    auto perPixel = compareImages(*a, *b);
+    auto blocksA = blockAverage(*a, 4);
+    auto blocksB = blockAverage(*b, 4);
+    ASSERT_TRUE(perPixel && blocksA && blocksB);
+    auto blocks = compareImages(*blocksA, *blocksB);
+    ASSERT_TRUE(blocks);
+    std::printf("%s %s: relative RMSE %.4f over 4x4 blocks, %.4f per pixel; mean ratio %.4f\n",
+                c.scene.c_str(), c.size.c_str(), blocks->relativeRmse, perPixel->relativeRmse,
+                perPixel->meanRatio);
+    RecordProperty("block_relative_rmse", fmt::format("{:.4f}", blocks->relativeRmse));
+    RecordProperty("pixel_relative_rmse", fmt::format("{:.4f}", perPixel->relativeRmse));
+    EXPECT_LE(blocks->relativeRmse, 0.02) << "browser " << browser << " vs " << native;
+    EXPECT_GT(perPixel->meanRatio, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, BrowserParity,
+                         testing::Values(ParityCase{"cornell", 4096, "320x240", true},
+                                         ParityCase{"textured_quad", 2048, "320x240", true},
+                                         ParityCase{"atrium", 8192, "384x216", false}),
+                         [](const auto& info) { return info.param.scene; });
+
+}  // namespace
+}  // namespace pic
