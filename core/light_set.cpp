@@ -365,6 +365,21 @@ bool isLightId(std::string_view id) {
            std::ranges::none_of(id, [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
 }
 
+Result<void> checkPresetName(std::string_view name) {
+    const bool allowed =
+        !name.empty() && name.size() <= kMaxPresetNameBytes && name.front() != ' ' &&
+        name.back() != ' ' && std::ranges::all_of(name, [](char c) {
+            return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                   c == ' ' || c == '_' || c == '.' || c == '-';
+        });
+    if (!allowed)
+        return fail(ErrorCode::InvalidInput,
+                    "preset name \"{}\" is not 1 to {} characters of A-Z a-z 0-9 space _ . - "
+                    "without a space first or last",
+                    clipped(name), kMaxPresetNameBytes);
+    return {};
+}
+
 Result<LightSet> parseLightSet(const std::string& json) {
     // nlohmann reports syntax errors and number overflow only as exceptions; none leaves here.
     Json root;
@@ -427,7 +442,10 @@ Result<LightSet> readLightSet(const std::string& path) {
     return set;
 }
 
-std::string toJson(const LightSet& set) {
+namespace {
+
+/// A light set's JSON form.
+FloatJson lightSetJson(const LightSet& set) {
     FloatJson lights = FloatJson::array();
     for (const Light& light : set.lights) {
         // Only the fields the type uses, so the output parses back under the same rules.
@@ -464,7 +482,43 @@ std::string toJson(const LightSet& set) {
     root["emissiveScale"] = std::move(scales);
     if (set.indirectScale != IndirectScale{})
         root["indirectScale"] = {{"y", set.indirectScale.y}, {"cocg", set.indirectScale.cocg}};
-    return root.dump(2);
+    return root;
+}
+
+}  // namespace
+
+std::string toJson(const LightSet& set) {
+    return lightSetJson(set).dump(2);
+}
+
+std::string toJson(const LightPresets& presets) {
+    FloatJson root = FloatJson::object();
+    for (const auto& [name, lights] : presets) root[name] = lightSetJson(lights);
+    return root.dump();
+}
+
+Result<LightPresets> parseLightPresets(const std::string& json) {
+    // nlohmann reports syntax errors only as exceptions; none leaves here.
+    Json root;
+    try {
+        root = Json::parse(json);
+    } catch (const Json::exception& error) {
+        return fail(ErrorCode::InvalidInput, "presets are not valid JSON: {}", error.what());
+    }
+    if (!root.is_object())
+        return fail(ErrorCode::InvalidInput, "presets must be a JSON object, got {}", shown(root));
+    if (root.size() > kMaxPresets)
+        return fail(ErrorCode::InvalidInput, "{} presets, more than the {} allowed", root.size(),
+                    kMaxPresets);
+    LightPresets presets;
+    for (const auto& [name, value] : root.items()) {
+        PIC_TRY(checkPresetName(name));
+        auto lights = parseLightSet(value.dump());
+        if (!lights)
+            return fail(ErrorCode::InvalidInput, "preset \"{}\": {}", name, lights.error().message);
+        presets.emplace(name, std::move(*lights));
+    }
+    return presets;
 }
 
 Result<void> checkLightSet(const LightSet& set, const Scene& scene) {

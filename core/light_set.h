@@ -97,6 +97,26 @@ Result<LightSet> readLightSet(const std::string& path);
 /// Serialises a light set to the same JSON form (round-trips through parseLightSet).
 std::string toJson(const LightSet& lights);
 
+/// Most presets (named light sets) one session holds.
+inline constexpr size_t kMaxPresets = 32;
+/// Longest preset name, in bytes.
+inline constexpr size_t kMaxPresetNameBytes = 64;
+
+/// InvalidInput naming `name` unless it may name a preset: 1 to kMaxPresetNameBytes
+/// characters of [A-Za-z0-9 _.-], neither the first nor the last a space.
+Result<void> checkPresetName(std::string_view name);
+
+/// Presets: light sets by name (checkPresetName), at most kMaxPresets of them.
+using LightPresets = std::map<std::string, LightSet>;
+
+/// Presets as one JSON object, name → the light set's JSON form (round-trips through
+/// parseLightPresets).
+std::string toJson(const LightPresets& presets);
+/// Presets from that JSON; InvalidInput for text that is not a JSON object, more than
+/// kMaxPresets entries, a name checkPresetName refuses, or a light set parseLightSet refuses
+/// (naming the preset and the problem).
+Result<LightPresets> parseLightPresets(const std::string& json);
+
 /// Checks a light set against a scene: every emissiveScale key names a material of the scene.
 Result<void> checkLightSet(const LightSet& lights, const Scene& scene);
 

@@ -28,6 +28,8 @@ constexpr const char* kMigrations[] = {
     "  lights TEXT NOT NULL,"
     "  created_unix_ms BIGINT NOT NULL,"
     "  updated_unix_ms BIGINT NOT NULL)",
+    // 1 → 2: each session's presets, a JSON object name → light set.
+    "ALTER TABLE sessions ADD COLUMN IF NOT EXISTS presets TEXT NOT NULL DEFAULT '{}'",
 };
 static_assert(std::size(kMigrations) == kSessionSchema);
 
@@ -35,7 +37,7 @@ static_assert(std::size(kMigrations) == kSessionSchema);
 constexpr const char* kMigrationLock = "SELECT pg_advisory_xact_lock(7370320)";
 
 constexpr const char* kColumns =
-    "id, editor_token_sha256, viewer_token_sha256, bake_id, version, lights";
+    "id, editor_token_sha256, viewer_token_sha256, bake_id, version, lights, presets";
 
 int64_t unixMs() {
     return std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -100,18 +102,27 @@ public:
     Result<bool> create(const StoredSession& session) override {
         return write(session,
                      "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
-                     "version, lights, created_unix_ms, updated_unix_ms) "
-                     "VALUES ($1, $2, $3, $4, $5, $6, $7, $7) ON CONFLICT (id) DO NOTHING");
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES ($1, $2, $3, $4, $5, $6, $8, $7, $7) ON CONFLICT (id) DO NOTHING");
     }
 
     Result<bool> save(const StoredSession& session) override {
         return write(session,
                      "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
-                     "version, lights, created_unix_ms, updated_unix_ms) "
-                     "VALUES ($1, $2, $3, $4, $5, $6, $7, $7) ON CONFLICT (id) DO UPDATE SET "
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES ($1, $2, $3, $4, $5, $6, $8, $7, $7) ON CONFLICT (id) DO UPDATE SET "
                      "version = excluded.version, lights = excluded.lights, "
                      "updated_unix_ms = excluded.updated_unix_ms "
                      "WHERE excluded.version > sessions.version");
+    }
+
+    Result<bool> savePresets(const StoredSession& session) override {
+        return write(session,
+                     "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES ($1, $2, $3, $4, $5, $6, $8, $7, $7) ON CONFLICT (id) DO UPDATE SET "
+                     "presets = excluded.presets, updated_unix_ms = excluded.updated_unix_ms "
+                     "WHERE excluded.version >= sessions.version");
     }
 
     Result<void> remove(const std::string& id, uint64_t version) override {
@@ -216,17 +227,19 @@ private:
     Result<StoredSession> row(const PGresult* rows, int i) const {
         return sessionFromRow(PQgetvalue(rows, i, 0), PQgetvalue(rows, i, 1),
                               PQgetvalue(rows, i, 2), PQgetvalue(rows, i, 3),
-                              std::atoll(PQgetvalue(rows, i, 4)), PQgetvalue(rows, i, 5), mWhere);
+                              std::atoll(PQgetvalue(rows, i, 4)), PQgetvalue(rows, i, 5),
+                              PQgetvalue(rows, i, 6), mWhere);
     }
 
     Result<bool> write(const StoredSession& session, const char* sql) {
         std::lock_guard lock(mMutex);
-        PIC_TRY_ASSIGN(ResultPtr result,
-                       query(sql,
-                             {session.id, session.editorDigest, session.viewerDigest,
-                              session.bakeId, std::to_string(session.version),
-                              toJson(session.lights), std::to_string(unixMs())},
-                             PGRES_COMMAND_OK));
+        PIC_TRY_ASSIGN(
+            ResultPtr result,
+            query(sql,
+                  {session.id, session.editorDigest, session.viewerDigest, session.bakeId,
+                   std::to_string(session.version), toJson(session.lights),
+                   std::to_string(unixMs()), toJson(session.presets)},
+                  PGRES_COMMAND_OK));
         return std::string(PQcmdTuples(result.get())) != "0";
     }
 

@@ -14,6 +14,7 @@
 #include "core/light_set.h"
 #include "render/cpu_runtime.h"
 #include "render/gpu_runtime.h"
+#include "render/sky_lighting.h"
 #include "server/web_scene.h"
 
 namespace pic {
@@ -144,6 +145,11 @@ Result<void> ServedBake::warmUp() {
     mWarmUpMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return {};
+}
+
+Result<void> ServedBake::checkLights(const LightSet& lights) const {
+    PIC_TRY(checkRuntimeLights(lights, mScene));
+    return checkSkyLights(lights, mScene, mBake);
 }
 
 Result<void> ServedBake::relight(const LightSet& lights, UpdateStats& stats, HalfFrame& frame,

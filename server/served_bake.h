@@ -57,6 +57,11 @@ public:
     /// for the CPU twin (which traces rays).
     const std::string& directVisibility() const { return mDirectVisibility; }
 
+    /// Whether a session of this bake takes `lights`: they fit the scene (checkRuntimeLights)
+    /// and a sky has the bake's sky transfer and a readable environment (checkSkyLights).
+    /// InvalidInput (or the environment's error) naming the problem.
+    Result<void> checkLights(const LightSet& lights) const;
+
     /// Milliseconds of the update run at load (see warmUp).
     double warmUpMs() const { return mWarmUpMs; }
 

@@ -490,7 +490,8 @@ Result<void> restore(PicServer::State& state) {
         }
         state.sessions[entry.id] = std::make_shared<Session>(
             entry.id, entry.editorDigest, entry.viewerDigest, *state.findBake(entry.bakeId),
-            *state.pool, state.options.session, SessionStart{entry.version + 1, std::move(entry.lights)});
+            *state.pool, state.options.session,
+            SessionStart{entry.version + 1, std::move(entry.lights), std::move(entry.presets)});
         ++restored;
     }
     if (stored.empty()) return {};

@@ -22,7 +22,6 @@
 
 #include "proto/pic.pb.h"
 #include "proto/wire.h"
-#include "render/sky_lighting.h"
 #include "server/audit_log.h"
 #include "server/limits.h"
 #include "server/metrics.h"
@@ -158,22 +157,24 @@ struct PicServer::State {
                      session->id().c_str());
     }
 
-    /// What `session` is in the database at `version` with `lights`.
-    static StoredSession row(const Session& session, uint64_t version, LightSet lights) {
+    /// What `session` is in the database at `version` with `lights` and `presets`.
+    static StoredSession row(const Session& session, uint64_t version, LightSet lights,
+                             LightPresets presets) {
         return {session.id(), session.editorDigest(), session.viewerDigest(), session.bake().id(),
-                version, std::move(lights)};
+                version,      std::move(lights),      std::move(presets)};
     }
 
-    /// Why this server cannot carry `stored` on (bake not served, light set refused by the
-    /// scene), or empty.
+    /// Why this server cannot carry `stored` on (bake not served, light set or a preset
+    /// refused by the scene), or empty.
     std::string unusable(const StoredSession& stored) const {
         const ServedBake* bake = findBake(stored.bakeId);
         if (!bake || stored.bakeId.empty())
             return fmt::format("its bake {} is not served here", stored.bakeId);
-        if (auto checked = checkRuntimeLights(stored.lights, bake->scene()); !checked)
+        if (auto checked = bake->checkLights(stored.lights); !checked)
             return checked.error().message;
-        if (auto checked = checkSkyLights(stored.lights, bake->scene(), bake->bake()); !checked)
-            return checked.error().message;
+        for (const auto& [name, lights] : stored.presets)
+            if (auto checked = bake->checkLights(lights); !checked)
+                return fmt::format("preset \"{}\": {}", name, checked.error().message);
         return {};
     }
 
@@ -225,9 +226,10 @@ struct PicServer::State {
                 out = it->second;
                 return grpc::Status::OK;
             }
-            out = std::make_shared<Session>(id, stored.editorDigest, stored.viewerDigest,
-                                            *findBake(stored.bakeId), *pool, options.session,
-                                            SessionStart{version, std::move(stored.lights)});
+            out = std::make_shared<Session>(
+                id, stored.editorDigest, stored.viewerDigest, *findBake(stored.bakeId), *pool,
+                options.session,
+                SessionStart{version, std::move(stored.lights), std::move(stored.presets)});
             sessions[id] = out;
             std::fprintf(stderr, "picserver: session %s taken over from the database at version %llu\n",
                          id.c_str(), (unsigned long long)version);
@@ -288,5 +290,24 @@ struct SetLightsOutcome {
 /// database failed. `access.status` must be OK.
 SetLightsOutcome setLights(PicServer::State& state, const Access& access,
                            const std::function<Result<LightSet>()>& parse);
+
+/// How a change of a session's presets went.
+struct PresetsOutcome {
+    grpc::Status status;
+    std::vector<std::string> names;  ///< the presets' names after it, when status is OK
+};
+
+/// Creates or replaces preset `name` for both transports: an editor's (else
+/// PERMISSION_DENIED) light set for the session `access` admitted, `parse`d (its error's
+/// status), checked as SetLights checks a set (INVALID_ARGUMENT, as for a name checkPresetName
+/// refuses), at most kMaxPresets of them (RESOURCE_EXHAUSTED), committed to the database
+/// before it returns. UNAVAILABLE when the session moved to another server (evicted here;
+/// nothing changed) or closed meanwhile, or the database failed. `access.status` must be OK.
+PresetsOutcome setPreset(PicServer::State& state, const Access& access, const std::string& name,
+                         const std::function<Result<LightSet>()>& parse);
+
+/// Deletes preset `name` (NOT_FOUND naming it when there is none), an editor's call, committed
+/// and refused as setPreset.
+PresetsOutcome removePreset(PicServer::State& state, const Access& access, const std::string& name);
 
 }  // namespace pic

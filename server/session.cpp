@@ -4,7 +4,6 @@
 #include <cstdio>
 
 #include "proto/wire.h"
-#include "render/sky_lighting.h"
 #include "server/progressive.h"
 #include "server/served_bake.h"
 
@@ -16,6 +15,12 @@ using Clock = std::chrono::steady_clock;
 
 double millisecondsSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::vector<std::string> namesOf(const LightPresets& presets) {
+    std::vector<std::string> names;
+    for (const auto& [name, lights] : presets) names.push_back(name);
+    return names;
 }
 
 }  // namespace
@@ -85,6 +90,7 @@ Session::Session(std::string id, std::string editorDigest, std::string viewerDig
       mCreator(std::move(start.creator)),
       mSetLightsRate(mOptions.setLightsPerSecond, mOptions.setLightsPerSecond) {
     mLatestLights = start.lights ? std::move(*start.lights) : defaultLightSet(bake.scene());
+    mPresets = std::move(start.presets);
     mNextVersion = std::max<uint64_t>(start.version, 1);
     mStats.set_versions_set(mNextVersion);
     mPending = Pending{mNextVersion++, mLatestLights, std::chrono::system_clock::now()};
@@ -102,8 +108,7 @@ Session::~Session() {
 }
 
 Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
-    PIC_TRY(checkRuntimeLights(lights, mBake.scene()));
-    PIC_TRY(checkSkyLights(lights, mBake.scene(), mBake.bake()));
+    PIC_TRY(mBake.checkLights(lights));
     // Versions are handed out only here, under the commit lock: the one read now is the one
     // taken below.
     std::lock_guard committing(mCommitMutex);
@@ -127,6 +132,53 @@ Result<uint64_t> Session::setLights(LightSet lights, const Commit& commit) {
     mChanged.notify_all();
     mPool.ready(*this, &mBake);
     return version;
+}
+
+Result<Session::PresetsChange> Session::setPreset(const std::string& name, LightSet lights,
+                                                  const PresetsCommit& commit) {
+    PIC_TRY(checkPresetName(name));
+    PIC_TRY(mBake.checkLights(lights));
+    return changePresets(
+        [&](LightPresets& presets) {
+            if (!presets.contains(name) && presets.size() >= kMaxPresets) return false;
+            presets[name] = std::move(lights);
+            return true;
+        },
+        commit);
+}
+
+Result<Session::PresetsChange> Session::removePreset(const std::string& name,
+                                                     const PresetsCommit& commit) {
+    return changePresets([&](LightPresets& presets) { return presets.erase(name) > 0; }, commit);
+}
+
+Result<Session::PresetsChange> Session::changePresets(
+    const std::function<bool(LightPresets&)>& change, const PresetsCommit& commit) {
+    // Under the commit lock: the version, light set and presets read now stay as they are
+    // until the change is kept.
+    std::lock_guard committing(mCommitMutex);
+    uint64_t version = 0;
+    LightSet latestLights;
+    LightPresets presets;
+    {
+        std::lock_guard lock(mMutex);
+        if (mStopping) return fail(ErrorCode::Io, "session {} was closed", mId);
+        version = mNextVersion - 1;
+        latestLights = mLatestLights;
+        presets = mPresets;
+    }
+    if (!change(presets)) return PresetsChange{false, namesOf(presets)};
+    if (commit) PIC_TRY(commit(version, latestLights, presets));
+    std::lock_guard lock(mMutex);
+    if (mStopping) return fail(ErrorCode::Io, "session {} was closed", mId);
+    mPresets = std::move(presets);
+    mLastUse = std::chrono::steady_clock::now();
+    return PresetsChange{true, namesOf(mPresets)};
+}
+
+LightPresets Session::presets() const {
+    std::lock_guard lock(mMutex);
+    return mPresets;
 }
 
 void Session::close() {
@@ -159,6 +211,11 @@ uint64_t Session::latestVersion() const {
 LightSet Session::latestLights() const {
     std::lock_guard lock(mMutex);
     return mLatestLights;
+}
+
+std::pair<uint64_t, LightSet> Session::latest() const {
+    std::lock_guard lock(mMutex);
+    return {mNextVersion - 1, mLatestLights};
 }
 
 std::shared_ptr<const Update> Session::latestUpdate() const {

@@ -22,6 +22,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -120,10 +121,12 @@ struct SessionOptions {
 };
 
 /// Where a session starts: version 1 with the scene's own lights, or, for a session restored
-/// from the server's database, the version after the one it had reached, with its last set.
+/// from the server's database, the version after the one it had reached, with its last set
+/// and its presets.
 struct SessionStart {
     uint64_t version = 1;
     std::optional<LightSet> lights;
+    LightPresets presets;
     /// Who created it, for quotas (an API key's id or a peer's host); empty for a session
     /// restored or taken over from the database, which counts against nobody.
     std::string creator;
@@ -162,6 +165,29 @@ public:
     /// session is closed.
     Result<uint64_t> setLights(LightSet lights, const Commit& commit = {});
 
+    /// What makes a change of the presets durable before the session keeps it (the server's
+    /// database): called with the session's newest version and light set and the presets as
+    /// they will be; its error refuses the change.
+    using PresetsCommit = std::function<Result<void>(uint64_t version, const LightSet& lights,
+                                                     const LightPresets& presets)>;
+    /// What a change of the presets did: whether it was made, and the names after it.
+    struct PresetsChange {
+        bool done = false;
+        std::vector<std::string> names;  ///< in name order
+    };
+
+    /// Creates or replaces preset `name` (checkPresetName's InvalidInput), a set checked
+    /// against the scene as setLights checks (InvalidInput naming the problem); not done when
+    /// `name` is new and the session holds kMaxPresets already. With `commit`, the change is
+    /// kept only once `commit` succeeded (its error is returned); changes are committed one
+    /// at a time, together with setLights' commits. Io once the session is closed.
+    Result<PresetsChange> setPreset(const std::string& name, LightSet lights,
+                                    const PresetsCommit& commit = {});
+    /// Deletes preset `name`, committed as setPreset's changes; not done when there is none.
+    Result<PresetsChange> removePreset(const std::string& name, const PresetsCommit& commit = {});
+    /// The presets as they are now.
+    LightPresets presets() const;
+
     /// Closes the session for good (it is removed from this server): its subscribers' slots
     /// close, the pending version is dropped and a computation not yet started is abandoned.
     /// Does not wait; the destructor waits for a computation in progress.
@@ -169,6 +195,8 @@ public:
     /// The newest accepted version and light set.
     uint64_t latestVersion() const;
     LightSet latestLights() const;
+    /// Both, read together.
+    std::pair<uint64_t, LightSet> latest() const;
     /// The newest update published (an earlier part of a budgeted version, or a version's
     /// final state), null before the first one.
     std::shared_ptr<const Update> latestUpdate() const;
@@ -203,6 +231,10 @@ private:
     /// Encodes and publishes an earlier part of the version compute() relights.
     void publishPart(HalfFrame state, int bounce, double elapsedMs);
     void publish(std::shared_ptr<const Update> update);
+    /// Applies `change` to a copy of the presets, commits the result and keeps it; `change`
+    /// returning false leaves them as they are (not done).
+    Result<PresetsChange> changePresets(const std::function<bool(LightPresets&)>& change,
+                                        const PresetsCommit& commit);
 
     std::string mId;
     std::string mEditorDigest;
@@ -214,12 +246,13 @@ private:
     TokenBucket mSetLightsRate;
 
     std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
-    std::mutex mCommitMutex;   ///< one light set committed at a time, in version order
+    std::mutex mCommitMutex;   ///< one light set or presets change committed at a time
     mutable std::mutex mMutex;
     mutable std::condition_variable mChanged;
     bool mStopping = false;
     uint64_t mNextVersion = 1;
     LightSet mLatestLights;
+    LightPresets mPresets;
     /// The set waiting to be computed: its version, lights and when it was accepted.
     struct Pending {
         uint64_t version = 0;

@@ -77,15 +77,15 @@ Result<std::vector<StoredSession>> parseJsonSessions(const std::string& text,
                        sessionFromRow(std::move(session.id), std::move(session.editorDigest),
                                       std::move(session.viewerDigest), std::move(session.bakeId),
                                       int64_t(session.version),
-                                      entry.value("lights", Json::object()).dump(), path));
+                                      entry.value("lights", Json::object()).dump(), "{}", path));
         sessions.push_back(std::move(checked));
     }
     return sessions;
 }
 
 Result<StoredSession> sessionFromRow(std::string id, std::string editorDigest,
-                                     std::string viewerDigest, std::string bakeId,
-                                     int64_t version, const std::string& lightsJson,
+                                     std::string viewerDigest, std::string bakeId, int64_t version,
+                                     const std::string& lightsJson, const std::string& presetsJson,
                                      const std::string& where) {
     if (!isDigest(editorDigest) || !isDigest(viewerDigest))
         return fail(ErrorCode::Corrupt,
@@ -96,8 +96,12 @@ Result<StoredSession> sessionFromRow(std::string id, std::string editorDigest,
     auto lights = parseLightSet(lightsJson);
     if (!lights)
         return fail(ErrorCode::Corrupt, "{}: session {}: {}", where, id, lights.error().message);
-    return StoredSession{std::move(id), std::move(editorDigest), std::move(viewerDigest),
-                         std::move(bakeId), uint64_t(version), std::move(*lights)};
+    auto presets = parseLightPresets(presetsJson);
+    if (!presets)
+        return fail(ErrorCode::Corrupt, "{}: session {}: {}", where, id, presets.error().message);
+    return StoredSession{std::move(id),      std::move(editorDigest), std::move(viewerDigest),
+                         std::move(bakeId),  uint64_t(version),       std::move(*lights),
+                         std::move(*presets)};
 }
 
 }  // namespace pic

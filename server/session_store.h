@@ -8,9 +8,10 @@
 ///   first request for it.
 ///
 /// One row per session: its id, its tokens' digests (server/token_digest.h, never the
-/// tokens), its bake and its newest accepted version with that version's light set. Every
-/// write is one committed transaction before the call returns: a SetLights reply means its
-/// light set survives a crash of the server.
+/// tokens), its bake, its newest accepted version with that version's light set, and its
+/// presets (named light sets, one JSON object name → light set). Every write is one
+/// committed transaction before the call returns: a SetLights reply, or a preset's, means
+/// the change survives a crash of the server.
 ///
 /// Versions order the replicas. A row's version only grows (save() refuses a version not
 /// newer than the stored one), so a replica whose copy of a session is behind the database
@@ -40,10 +41,11 @@ struct StoredSession {
     std::string bakeId;
     uint64_t version = 0;  ///< the newest version it had accepted
     LightSet lights;       ///< the light set of that version
+    LightPresets presets;  ///< its named light sets
 };
 
-/// The schema version this build writes.
-inline constexpr int kSessionSchema = 1;
+/// The schema version this build writes: 1, the sessions table; 2, its presets column.
+inline constexpr int kSessionSchema = 2;
 
 class SessionStore {
 public:
@@ -72,9 +74,13 @@ public:
     /// Adds a new session; false (nothing written) when the id is taken.
     virtual Result<bool> create(const StoredSession& session) = 0;
     /// Writes the session's version and light set when its version is newer than the stored
-    /// one (inserting the row should it be gone); false, writing nothing, when the stored
-    /// version is the same or newer.
+    /// one (inserting the row, presets too, should it be gone); false, writing nothing, when
+    /// the stored version is the same or newer.
     virtual Result<bool> save(const StoredSession& session) = 0;
+    /// Writes the session's presets when the stored version is not newer than its version
+    /// (inserting the row should it be gone); false, writing nothing, when a newer version is
+    /// stored (another server took the session over).
+    virtual Result<bool> savePresets(const StoredSession& session) = 0;
     /// Deletes the session unless the stored version is newer than `version` (another
     /// replica has taken it over since).
     virtual Result<void> remove(const std::string& id, uint64_t version) = 0;
@@ -88,10 +94,11 @@ Result<std::vector<StoredSession>> parseJsonSessions(const std::string& text,
                                                      const std::string& path);
 
 /// A row's columns as a session; Corrupt naming `where` and the row for a digest that is not
-/// 64 lowercase hex digits or a light set parseLightSet refuses.
+/// 64 lowercase hex digits, a light set parseLightSet refuses, or presets parseLightPresets
+/// refuses.
 Result<StoredSession> sessionFromRow(std::string id, std::string editorDigest,
-                                     std::string viewerDigest, std::string bakeId,
-                                     int64_t version, const std::string& lightsJson,
+                                     std::string viewerDigest, std::string bakeId, int64_t version,
+                                     const std::string& lightsJson, const std::string& presetsJson,
                                      const std::string& where);
 
 /// The backends (server/sqlite_store.cpp, server/postgres_store.cpp).

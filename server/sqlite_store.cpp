@@ -36,6 +36,8 @@ constexpr const char* kMigrations[] = {
     "  lights TEXT NOT NULL,"
     "  created_unix_ms INTEGER NOT NULL,"
     "  updated_unix_ms INTEGER NOT NULL)",
+    // 1 → 2: each session's presets, a JSON object name → light set.
+    "ALTER TABLE sessions ADD COLUMN presets TEXT NOT NULL DEFAULT '{}'",
 };
 static_assert(std::size(kMigrations) == kSessionSchema);
 
@@ -74,7 +76,7 @@ private:
 };
 
 constexpr const char* kColumns =
-    "id, editor_token_sha256, viewer_token_sha256, bake_id, version, lights";
+    "id, editor_token_sha256, viewer_token_sha256, bake_id, version, lights, presets";
 
 class SqliteStore final : public SessionStore {
 public:
@@ -134,18 +136,27 @@ public:
     Result<bool> create(const StoredSession& session) override {
         return write(session,
                      "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
-                     "version, lights, created_unix_ms, updated_unix_ms) "
-                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?7) ON CONFLICT (id) DO NOTHING");
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?8, ?7, ?7) ON CONFLICT (id) DO NOTHING");
     }
 
     Result<bool> save(const StoredSession& session) override {
         return write(session,
                      "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
-                     "version, lights, created_unix_ms, updated_unix_ms) "
-                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?7) ON CONFLICT (id) DO UPDATE SET "
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?8, ?7, ?7) ON CONFLICT (id) DO UPDATE SET "
                      "version = excluded.version, lights = excluded.lights, "
                      "updated_unix_ms = excluded.updated_unix_ms "
                      "WHERE excluded.version > sessions.version");
+    }
+
+    Result<bool> savePresets(const StoredSession& session) override {
+        return write(session,
+                     "INSERT INTO sessions (id, editor_token_sha256, viewer_token_sha256, bake_id, "
+                     "version, lights, presets, created_unix_ms, updated_unix_ms) "
+                     "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?8, ?7, ?7) ON CONFLICT (id) DO UPDATE SET "
+                     "presets = excluded.presets, updated_unix_ms = excluded.updated_unix_ms "
+                     "WHERE excluded.version >= sessions.version");
     }
 
     Result<void> remove(const std::string& id, uint64_t version) override {
@@ -208,7 +219,7 @@ private:
 
     Result<StoredSession> row(const Statement& select) const {
         return sessionFromRow(select.text(0), select.text(1), select.text(2), select.text(3),
-                              select.integer(4), select.text(5), mPath);
+                              select.integer(4), select.text(5), select.text(6), mPath);
     }
 
     /// Runs an INSERT of `session`'s columns; whether it changed a row.
@@ -223,6 +234,7 @@ private:
         insert.bind(5, int64_t(session.version));
         insert.bind(6, toJson(session.lights));
         insert.bind(7, unixMs());
+        insert.bind(8, toJson(session.presets));
         if (insert.step() != SQLITE_DONE) return error("cannot write");
         return sqlite3_changes(mDb) > 0;
     }

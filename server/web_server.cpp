@@ -243,33 +243,129 @@ int serveScene(mg_connection* connection, void* data) {
     return 200;
 }
 
+/// Reads the request's body into `body`, up to one byte more than a request may hold (as
+/// gRPC's largest message); whether it holds more.
+bool readBody(mg_connection* connection, std::string& body) {
+    if (mg_get_request_info(connection)->content_length > int64_t(wire::kMaxRequestBytes))
+        return true;
+    char buffer[16384];
+    for (int n; (n = mg_read(connection, buffer, sizeof buffer)) > 0;) {
+        body.append(buffer, size_t(n));
+        if (body.size() > wire::kMaxRequestBytes) return true;
+    }
+    return false;
+}
+
+/// The refusal of a body over wire::kMaxRequestBytes (answered 413).
+grpc::Status tooLargeStatus() {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        fmt::format("a light set takes at most {} bytes", wire::kMaxRequestBytes));
+}
+
+/// A light set as a JSON object: its toJson form.
+nlohmann::json lightsJson(const LightSet& lights) {
+    return nlohmann::json::parse(toJson(lights));
+}
+
+/// Every preset as {"name", "lights"}, in name order.
+nlohmann::json presetsJson(const LightPresets& presets) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& [name, lights] : presets)
+        list.push_back({{"name", name}, {"lights", lightsJson(lights)}});
+    return list;
+}
+
+/// A 200 reply of `body` as JSON, not to be cached.
+int replyJson(mg_connection* connection, const nlohmann::json& body) {
+    reply(connection, 200, "application/json",
+          body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+          {{"Cache-Control", "no-store"}});
+    return 200;
+}
+
+/// GET /v1/session?session=ID&token=T: what a browser shows of the session, for any token:
+/// its role, bake, newest version and light set, and its presets.
+int serveSession(mg_connection* connection, void* data) {
+    if (std::string_view(mg_get_request_info(connection)->request_method) != "GET")
+        return wrongMethod(connection, "GET");
+    PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
+    const SessionRequest request = sessionRequestOf(connection);
+    Access access;
+    access.status = request.status;
+    if (access.status.ok()) access = authorise(state, request.sessionId, request.token);
+    state.recordCall(request.peer, request.forwarded, "WebSession", roleName(access.role),
+                     request.sessionId, access.status);
+    if (!access.status.ok()) return refuse(connection, access.status);
+    const Session& session = *access.session;
+    access.session->touch();
+    const auto [version, lights] = session.latest();
+    return replyJson(connection, {{"session", session.id()},
+                                  {"role", roleName(access.role)},
+                                  {"bake_id", session.bake().id()},
+                                  {"version", version},
+                                  {"lights", lightsJson(lights)},
+                                  {"presets", presetsJson(session.presets())}});
+}
+
+/// /v1/presets?session=ID&token=T: GET, any token: {"presets": [{"name", "lights"}]}; PUT
+/// &name=N with a light set's JSON, or DELETE &name=N, editor token: saves or deletes the
+/// preset, answering {"presets": [names]}.
+int servePresets(mg_connection* connection, void* data) {
+    const mg_request_info* info = mg_get_request_info(connection);
+    const std::string_view method = info->request_method;
+    if (method != "GET" && method != "PUT" && method != "DELETE")
+        return wrongMethod(connection, "GET, PUT, DELETE");
+    PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
+    const SessionRequest request = sessionRequestOf(connection);
+    const std::string name = queryVariable(info, "name");
+    std::string body;
+    const bool tooLarge = method == "PUT" && readBody(connection, body);
+    Access access;
+    grpc::Status status = request.status;
+    bool refusedTooLarge = false;
+    if (status.ok() && method != "GET" && name.empty()) {
+        status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                              "the query needs the parameter name=N");
+    } else if (status.ok() && tooLarge) {
+        status = tooLargeStatus();
+        refusedTooLarge = true;
+    }
+    nlohmann::json answer;
+    if (status.ok()) {
+        access = authorise(state, request.sessionId, request.token);
+        status = access.status;
+    }
+    if (status.ok() && method == "GET") {
+        access.session->touch();
+        answer = {{"presets", presetsJson(access.session->presets())}};
+    } else if (status.ok()) {
+        const PresetsOutcome outcome =
+            method == "PUT" ? setPreset(state, access, name, [&] { return parseLightSet(body); })
+                            : removePreset(state, access, name);
+        status = outcome.status;
+        answer = {{"presets", outcome.names}};
+    }
+    state.recordCall(request.peer, request.forwarded, "WebPresets", roleName(access.role),
+                     request.sessionId, status);
+    if (refusedTooLarge) return refuse(connection, status, 413);
+    if (!status.ok()) return refuse(connection, status);
+    return replyJson(connection, answer);
+}
+
 /// POST /v1/lights?session=ID&token=T with a light set's JSON: the gRPC SetLights.
 int serveLights(mg_connection* connection, void* data) {
     const mg_request_info* info = mg_get_request_info(connection);
     if (std::string_view(info->request_method) != "POST") return wrongMethod(connection, "POST");
     PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
     const SessionRequest request = sessionRequestOf(connection);
-    // The body, up to one byte more than a request may hold (as gRPC's largest message).
     std::string body;
-    bool tooLarge = info->content_length > int64_t(wire::kMaxRequestBytes);
-    if (!tooLarge) {
-        char buffer[16384];
-        for (int n; (n = mg_read(connection, buffer, sizeof buffer)) > 0;) {
-            body.append(buffer, size_t(n));
-            if (body.size() > wire::kMaxRequestBytes) {
-                tooLarge = true;
-                break;
-            }
-        }
-    }
+    const bool tooLarge = readBody(connection, body);
     Access access;
     SetLightsOutcome outcome;
     if (!request.status.ok()) {
         outcome.status = request.status;
     } else if (tooLarge) {
-        outcome.status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                                      fmt::format("a light set takes at most {} bytes",
-                                                  wire::kMaxRequestBytes));
+        outcome.status = tooLargeStatus();
     } else {
         access = authorise(state, request.sessionId, request.token);
         outcome.status = access.status;
@@ -280,9 +376,7 @@ int serveLights(mg_connection* connection, void* data) {
                      request.sessionId, outcome.status);
     if (tooLarge && request.status.ok()) return refuse(connection, outcome.status, 413);
     if (!outcome.status.ok()) return refuse(connection, outcome.status, outcome.retryAfter);
-    reply(connection, 200, "application/json",
-          nlohmann::json{{"version", outcome.version}}.dump(), {{"Cache-Control", "no-store"}});
-    return 200;
+    return replyJson(connection, {{"version", outcome.version}});
 }
 
 /// GET of a text built into the server (`text` is the handler's data): /v1/pic.proto, the
@@ -458,6 +552,8 @@ Result<std::unique_ptr<WebServer>> WebServer::start(const std::string& listen,
                              &server->mState);
     mg_set_request_handler(server->mContext, "/v1/scene$", serveScene, &server->mState);
     mg_set_request_handler(server->mContext, "/v1/lights$", serveLights, &server->mState);
+    mg_set_request_handler(server->mContext, "/v1/session$", serveSession, &server->mState);
+    mg_set_request_handler(server->mContext, "/v1/presets$", servePresets, &server->mState);
     static const std::string_view proto = kPicProtoText, shBasis = kShBasisText;
     mg_set_request_handler(server->mContext, "/v1/pic.proto$", serveText,
                            const_cast<std::string_view*>(&proto));

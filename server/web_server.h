@@ -20,16 +20,25 @@
 ///     GET  /v1/scene?session=ID&token=T    the session's scene (server/web_scene.h), any token
 ///     POST /v1/lights?session=ID&token=T   a light set (core/light_set.h JSON), editor token:
 ///                                          the gRPC SetLights, answering {"version": N}
+///     GET  /v1/session?session=ID&token=T  any token: {"session", "role", "bake_id",
+///                                          "version", "lights", "presets"}, the newest
+///                                          version and its light set as a JSON object
+///     GET  /v1/presets?session=ID&token=T  any token: {"presets": [{"name", "lights"}]}, in
+///                                          name order
+///     PUT  /v1/presets?...&name=N          a light set, editor token: saves preset N
+///                                          (server/service_state.h setPreset), answering
+///                                          {"presets": [names]}
+///     DELETE /v1/presets?...&name=N        editor token: deletes preset N, the same answer
 ///     GET  /v1/pic.proto                   proto/pic.proto's text, no token
 ///     GET  /PATH                           ServerOptions::webRoot's regular files ("/":
 ///                                          index.html); none outside it, 404 otherwise
 ///
-/// The two session routes answer a refusal with {"error": message, "code": gRPC code name}
-/// and HTTP 400 (INVALID_ARGUMENT, or a missing session or token), 401 (UNAUTHENTICATED), 403
-/// (PERMISSION_DENIED), 404 (NOT_FOUND), 413 (a body over wire::kMaxRequestBytes), 429
+/// The session routes answer a refusal with {"error": message, "code": gRPC code name} and
+/// HTTP 400 (INVALID_ARGUMENT, or a missing session, token or name), 401 (UNAUTHENTICATED),
+/// 403 (PERMISSION_DENIED), 404 (NOT_FOUND), 413 (a body over wire::kMaxRequestBytes), 429
 /// (RESOURCE_EXHAUSTED, with Retry-After in whole seconds when the wait is known), 503
-/// (UNAVAILABLE) or 500 (any other); their metrics and audit calls are WebScene and
-/// WebSetLights.
+/// (UNAVAILABLE) or 500 (any other); their metrics and audit calls are WebScene,
+/// WebSetLights, WebSession and WebPresets.
 
 #include <memory>
 #include <string>

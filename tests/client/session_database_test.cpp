@@ -1,8 +1,8 @@
-// The server's session database (picserver --db) seen from clients: sessions survive a
-// restart and a SIGKILL right after a reply, one server per SQLite file, the JSON database of
-// earlier releases carried on, the drain on SIGTERM, and on a real PostgreSQL: replicas that
-// hand a session over through the database, and health NOT_SERVING while it is away. Every
-// server a test starts is stopped by it.
+// The server's session database (picserver --db) seen from clients: sessions and their
+// presets survive a restart, light sets a SIGKILL right after a reply, one server per SQLite
+// file, the JSON database of earlier releases carried on, the drain on SIGTERM, and on a real
+// PostgreSQL: replicas that hand a session and its presets over through the database, and
+// health NOT_SERVING while it is away. Every server a test starts is stopped by it.
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -11,6 +11,8 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -34,6 +36,41 @@ using namespace test;
 /// The version a SetLights call gave, or its error.
 std::string outcome(const Result<uint64_t>& version) {
     return version ? std::to_string(*version) : "error: " + version.error().message;
+}
+
+/// A server with the browsers' endpoint on the session database `db` (no light-set rate limit).
+ServerOptions webOn(const std::string& db) {
+    ServerOptions options;
+    options.session.setLightsPerSecond = 1e6;
+    options.webListen = "127.0.0.1:0";
+    options.dbPath = db;
+    return options;
+}
+
+/// "/v1/presets?session=ID&token=T".
+std::string presetsPath(const std::string& id, const std::string& token) {
+    return "/v1/presets?session=" + id + "&token=" + token;
+}
+
+/// The presets GET /v1/presets lists, each as "name: light set JSON", or what went wrong.
+std::vector<std::string> presetsOn(const std::string& address, const std::string& id,
+                                   const std::string& token) {
+    const HttpReply reply = httpGet(address, presetsPath(id, token));
+    if (reply.code() != 200) return {reply.status + " " + reply.body};
+    const nlohmann::json body = nlohmann::json::parse(reply.body, nullptr, false);
+    if (!body.is_object() || !body.contains("presets")) return {"not presets: " + reply.body};
+    std::vector<std::string> presets;
+    for (const nlohmann::json& preset : body["presets"]) {
+        auto lights = parseLightSet(preset.value("lights", nlohmann::json()).dump());
+        presets.push_back(preset.value("name", "") + ": " +
+                          (lights ? toJson(*lights) : "error: " + lights.error().message));
+    }
+    return presets;
+}
+
+/// "name: light set JSON", as presetsOn lists a preset.
+std::string presetOf(const std::string& name, const LightSet& lights) {
+    return name + ": " + toJson(lights);
 }
 
 /// The light set a session holds now, as its JSON.
@@ -89,6 +126,38 @@ TEST(SessionDatabase, SessionsSurviveARestart) {
     ASSERT_FALSE(refused);
     EXPECT_EQ(refused.error().code, ErrorCode::Corrupt);
     EXPECT_NE(refused.error().message.find(db.string()), std::string::npos);
+}
+
+// Presets are committed with the session: a server on the same file after a restart has
+// the ones saved and not those deleted, and the light set stays as it was.
+TEST(SessionDatabase, PresetsSurviveARestart) {
+    const test::ScratchDir dir("pic_sessions_presets");
+    const std::string db = (dir / "sessions.db").string();
+    std::string id, editor, viewer;
+    {
+        Served served = serveWith(webOn(db));
+        ASSERT_TRUE(served.connection);
+        auto session = served.connection->createSession();
+        ASSERT_TRUE(session);
+        id = session->session();
+        editor = session->editor_token();
+        viewer = session->viewer_token();
+        ASSERT_EQ(outcome(served.connection->setLights(id, editor, pointLight(0.25f))), "2");
+        const std::string address = served.server->webAddress();
+        for (const auto& [name, x] : {std::pair{"kept", 0.1f}, std::pair{"gone", 0.2f}})
+            ASSERT_EQ(httpRequest(address, "PUT", presetsPath(id, editor) + "&name=" + name,
+                                  toJson(pointLight(x)))
+                          .code(),
+                      200)
+                << name;
+        ASSERT_EQ(httpRequest(address, "DELETE", presetsPath(id, editor) + "&name=gone").code(),
+                  200);
+    }
+    Served restarted = serveWith(webOn(db));
+    ASSERT_TRUE(restarted.connection);
+    EXPECT_EQ(presetsOn(restarted.server->webAddress(), id, viewer),
+              std::vector<std::string>{presetOf("kept", pointLight(0.1f))});
+    EXPECT_EQ(lightsOf(*restarted.connection, id, viewer), toJson(pointLight(0.25f)));
 }
 
 // A --db that cannot hold the database (a directory, or a file in a missing directory) is
@@ -336,6 +405,43 @@ TEST(SessionDatabasePostgres, ReplicasHandASessionOverThroughTheDatabase) {
     EXPECT_EQ(onA.waitForEnd(), "UNAVAILABLE");
     EXPECT_EQ(lightsOf(*b.connection, id, viewer), toJson(pointLight(0.3f)))
         << "the refused set went nowhere";
+}
+
+// A replica that takes a session over from PostgreSQL gets its presets; the replica that held
+// it learns at its next preset change that the session moved (503, the session evicted
+// there), and the change goes nowhere.
+TEST(SessionDatabasePostgres, ReplicasHandPresetsOverThroughTheDatabase) {
+    auto postgres = startPostgres();
+    ASSERT_TRUE(postgres);
+    Served a = serveWith(webOn(postgres->uri()));
+    Served b = serveWith(webOn(postgres->uri()));
+    ASSERT_TRUE(a.connection && b.connection);
+    auto session = a.connection->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    const std::string id = session->session(), editor = session->editor_token(),
+                      viewer = session->viewer_token();
+    const std::string onA = a.server->webAddress(), onB = b.server->webAddress();
+    ASSERT_EQ(
+        httpRequest(onA, "PUT", presetsPath(id, editor) + "&name=Noon", toJson(pointLight(0.2f)))
+            .code(),
+        200);
+
+    EXPECT_EQ(presetsOn(onB, id, viewer),
+              std::vector<std::string>{presetOf("Noon", pointLight(0.2f))})
+        << "taken over with its presets";
+    ASSERT_EQ(
+        httpRequest(onB, "PUT", presetsPath(id, editor) + "&name=Dusk", toJson(pointLight(-0.2f)))
+            .code(),
+        200);
+
+    const HttpReply stale =
+        httpRequest(onA, "PUT", presetsPath(id, editor) + "&name=Stale", toJson(pointLight(0.9f)));
+    EXPECT_EQ(stale.code(), 503) << stale.status << " " << stale.body;
+    EXPECT_NE(stale.body.find("moved"), std::string::npos) << stale.body;
+    EXPECT_EQ(a.server->session(id), nullptr) << "evicted from the replica that held it";
+    EXPECT_EQ(presetsOn(onB, id, viewer),
+              (std::vector<std::string>{presetOf("Dusk", pointLight(-0.2f)),
+                                        presetOf("Noon", pointLight(0.2f))}));
 }
 
 // While the database cannot be reached, light sets are refused UNAVAILABLE (never

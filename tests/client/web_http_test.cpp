@@ -1,7 +1,8 @@
 // The browsers' HTTP routes (server/web_server.h) with a plain socket on 127.0.0.1: the scene
 // blob of server/web_scene.h decoded as a browser decodes it and compared with the G-buffer's
-// arrays and the bake, light sets posted as JSON reaching the gRPC stream, the refusals'
-// statuses and JSON, the embedded pic.proto, and pages from a web root, none from outside it.
+// arrays and the bake, light sets posted as JSON reaching the gRPC stream, the session's state
+// and its presets (saved, listed, replaced, deleted, at most 32), the refusals' statuses and
+// JSON, the embedded pic.proto, and pages from a web root, none from outside it.
 // Every server a test starts is stopped by it.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <zstd.h>
@@ -350,6 +352,202 @@ TEST(WebHttp, TheRateLimitAnswers429WithRetryAfter) {
     const HttpReply second = httpRequest(address, "POST", path, toJson(pointLight(0.2f)));
     expectRefusal(second, 429, "RESOURCE_EXHAUSTED", "at most 1 light sets a second");
     EXPECT_EQ(second.header("Retry-After"), "1") << "≤ 1000 ms rounded up to whole seconds";
+}
+
+/// The JSON body of a 200 reply not to be cached, failing the test where it is not one.
+Json jsonOf(const HttpReply& reply) {
+    EXPECT_EQ(reply.code(), 200) << reply.status << " " << reply.body;
+    EXPECT_EQ(reply.header("Content-Type"), "application/json");
+    EXPECT_EQ(reply.header("Cache-Control"), "no-store");
+    const Json body = Json::parse(reply.body, nullptr, false);
+    EXPECT_TRUE(body.is_object()) << reply.body;
+    return body.is_object() ? body : Json::object();
+}
+
+/// A light set as the routes give it (a JSON object) in its toJson form, or the error.
+std::string lightsOf(const Json& json) {
+    auto parsed = parseLightSet(json.dump());
+    return parsed ? toJson(*parsed) : "error: " + parsed.error().message;
+}
+
+/// The names of a {"presets": [...]} answer: its strings, or its objects' "name"s.
+std::vector<std::string> presetNames(const Json& body) {
+    std::vector<std::string> names;
+    for (const Json& entry : body.value("presets", Json::array()))
+        names.push_back(entry.is_string() ? entry.get<std::string>() : entry.value("name", ""));
+    return names;
+}
+
+TEST(WebHttp, TheSessionSaysTheRoleTheNewestSetAndThePresets) {
+    Served served = serveWith(withWeb());
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    const std::string id = session->session();
+    const std::string address = served.server->webAddress();
+
+    const Json first =
+        jsonOf(httpGet(address, "/v1/session" + sessionQuery(id, session->editor_token())));
+    EXPECT_EQ(first.value("session", ""), id);
+    EXPECT_EQ(first.value("role", ""), "editor");
+    EXPECT_EQ(first.value("bake_id", ""), session->bake_id());
+    EXPECT_EQ(first.value("version", 0u), 1u);
+    auto joined = served.connection->joinSession(id, session->viewer_token());
+    ASSERT_TRUE(joined) << joined.error().message;
+    auto sceneLights = wire::fromProto(joined->lights());
+    ASSERT_TRUE(sceneLights) << sceneLights.error().message;
+    EXPECT_EQ(lightsOf(first.value("lights", Json())), toJson(*sceneLights))
+        << "the scene's own lights, as JoinSession gives them";
+    EXPECT_EQ(first.value("presets", Json()), Json::array());
+
+    // After a light set and a preset, a viewer sees both.
+    const LightSet posted = pointLight(0.15f);
+    const Json set = jsonOf(httpRequest(
+        address, "POST", "/v1/lights" + sessionQuery(id, session->editor_token()), toJson(posted)));
+    const uint64_t version = set.value("version", 0u);
+    EXPECT_GT(version, 1u);
+    const LightSet saved = pointLight(-0.2f);
+    jsonOf(
+        httpRequest(address, "PUT",
+                    "/v1/presets" + sessionQuery(id, session->editor_token()) + "&name=Left%20lamp",
+                    toJson(saved)));
+    const Json seen =
+        jsonOf(httpGet(address, "/v1/session" + sessionQuery(id, session->viewer_token())));
+    EXPECT_EQ(seen.value("role", ""), "viewer");
+    EXPECT_EQ(seen.value("version", 0u), version) << "a preset takes no version";
+    EXPECT_EQ(lightsOf(seen.value("lights", Json())), toJson(posted));
+    ASSERT_EQ(presetNames(seen), std::vector<std::string>{"Left lamp"}) << seen.dump();
+    EXPECT_EQ(lightsOf(seen.at("presets").at(0).value("lights", Json())), toJson(saved));
+
+    expectRefusal(httpGet(address, "/v1/session" + sessionQuery(id, "not-a-token")), 401,
+                  "UNAUTHENTICATED", "not one of session");
+    expectRefusal(
+        httpGet(address, "/v1/session" + sessionQuery("0123456789abcdef", session->viewer_token())),
+        404, "NOT_FOUND", "0123456789abcdef");
+    expectRefusal(httpGet(address, "/v1/session?session=" + id), 400, "INVALID_ARGUMENT", "token=");
+    expectRefusal(httpGet(address, "/v1/session?token=" + session->viewer_token()), 400,
+                  "INVALID_ARGUMENT", "session=");
+
+    const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
+    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebSession\",code=\"OK\"}"), 2.0)
+        << metrics.body;
+    EXPECT_EQ(
+        metricValue(metrics.body, "pic_calls_total{call=\"WebSession\",code=\"UNAUTHENTICATED\"}"),
+        1.0)
+        << metrics.body;
+}
+
+TEST(WebHttp, AnEditorSavesListsReplacesAndDeletesPresets) {
+    Served served = serveWith(withWeb());
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    const std::string id = session->session();
+    const std::string address = served.server->webAddress();
+    const std::string editor = "/v1/presets" + sessionQuery(id, session->editor_token());
+    const std::string viewer = "/v1/presets" + sessionQuery(id, session->viewer_token());
+
+    EXPECT_EQ(jsonOf(httpGet(address, viewer)), Json({{"presets", Json::array()}}));
+    const Json saved =
+        jsonOf(httpRequest(address, "PUT", editor + "&name=warm-1.b", toJson(pointLight(0.2f))));
+    EXPECT_EQ(presetNames(saved), std::vector<std::string>{"warm-1.b"});
+    const Json both = jsonOf(
+        httpRequest(address, "PUT", editor + "&name=Cool%20corner_2", toJson(pointLight(-0.3f))));
+    EXPECT_EQ(presetNames(both), (std::vector<std::string>{"Cool corner_2", "warm-1.b"}))
+        << "in name order";
+
+    // Either token lists them with their light sets.
+    Json listed = jsonOf(httpGet(address, viewer));
+    ASSERT_EQ(presetNames(listed), (std::vector<std::string>{"Cool corner_2", "warm-1.b"}));
+    EXPECT_EQ(lightsOf(listed.at("presets").at(0).at("lights")), toJson(pointLight(-0.3f)));
+    EXPECT_EQ(lightsOf(listed.at("presets").at(1).at("lights")), toJson(pointLight(0.2f)));
+
+    // A PUT of a name that exists replaces its set.
+    jsonOf(httpRequest(address, "PUT", editor + "&name=warm-1.b", toJson(pointLight(0.4f))));
+    listed = jsonOf(httpGet(address, editor));
+    ASSERT_EQ(presetNames(listed), (std::vector<std::string>{"Cool corner_2", "warm-1.b"}));
+    EXPECT_EQ(lightsOf(listed.at("presets").at(1).at("lights")), toJson(pointLight(0.4f)));
+    EXPECT_EQ(served.server->session(id)->latestVersion(), 1u) << "presets take no version";
+
+    // Refusals, none of which changes the presets.
+    expectRefusal(httpRequest(address, "PUT", viewer + "&name=mine", toJson(pointLight(0.1f))), 403,
+                  "PERMISSION_DENIED", "editor");
+    expectRefusal(httpRequest(address, "DELETE", viewer + "&name=warm-1.b"), 403,
+                  "PERMISSION_DENIED", "editor");
+    for (const auto& [query, shown] :
+         {std::pair{std::string("%20lead"), std::string(" lead")},
+          std::pair{std::string("trail%20"), std::string("trail ")},
+          std::pair{std::string("a%2Fb"), std::string("a/b")},
+          std::pair{std::string("caf%C3%A9"), std::string("caf\xC3\xA9")},
+          std::pair{std::string(65, 'x'), std::string(64, 'x')}}) {
+        SCOPED_TRACE(shown);
+        expectRefusal(
+            httpRequest(address, "PUT", editor + "&name=" + query, toJson(pointLight(0.1f))), 400,
+            "INVALID_ARGUMENT", "preset name \"" + shown);
+    }
+    jsonOf(httpRequest(address, "PUT", editor + "&name=" + std::string(64, 'x'),
+                       toJson(pointLight(0.1f))));
+    jsonOf(httpRequest(address, "DELETE", editor + "&name=" + std::string(64, 'x')));
+    expectRefusal(httpRequest(address, "PUT", editor, toJson(pointLight(0.1f))), 400,
+                  "INVALID_ARGUMENT", "name=");
+    expectRefusal(httpRequest(address, "DELETE", editor), 400, "INVALID_ARGUMENT", "name=");
+    expectRefusal(httpRequest(address, "PUT", editor + "&name=odd",
+                              R"({"lights":[],"emissiveScale":{"no such material":2}})"),
+                  400, "INVALID_ARGUMENT", "no such material");
+    expectRefusal(httpRequest(address, "PUT", editor + "&name=odd",
+                              R"({"lights":[{"id":"a","type":"laser"}]})"),
+                  400, "INVALID_ARGUMENT", "laser");
+    expectRefusal(
+        httpRequest(address, "PUT", editor + "&name=odd", std::string((1 << 20) + 1, ' ')), 413,
+        "RESOURCE_EXHAUSTED", "at most");
+    const HttpReply wrong = httpRequest(address, "POST", editor + "&name=odd", "{}");
+    EXPECT_EQ(wrong.code(), 405) << wrong.status;
+    EXPECT_EQ(wrong.header("Allow"), "GET, PUT, DELETE");
+    EXPECT_EQ(presetNames(jsonOf(httpGet(address, viewer))),
+              (std::vector<std::string>{"Cool corner_2", "warm-1.b"}));
+
+    // A DELETE removes it; a second finds none.
+    EXPECT_EQ(presetNames(jsonOf(httpRequest(address, "DELETE", editor + "&name=warm-1.b"))),
+              std::vector<std::string>{"Cool corner_2"});
+    EXPECT_EQ(presetNames(jsonOf(httpGet(address, viewer))),
+              std::vector<std::string>{"Cool corner_2"});
+    expectRefusal(httpRequest(address, "DELETE", editor + "&name=warm-1.b"), 404, "NOT_FOUND",
+                  "no preset \"warm-1.b\"");
+
+    const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
+    EXPECT_EQ(metricValue(metrics.body,
+                          "pic_calls_total{call=\"WebPresets\",code=\"PERMISSION_DENIED\"}"),
+              2.0)
+        << metrics.body;
+    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebPresets\",code=\"NOT_FOUND\"}"),
+              1.0)
+        << metrics.body;
+}
+
+TEST(WebHttp, ASessionHoldsAtMost32Presets) {
+    Served served = serveWith(withWeb());
+    ASSERT_TRUE(served.connection);
+    auto session = served.connection->createSession();
+    ASSERT_TRUE(session);
+    const std::string address = served.server->webAddress();
+    const std::string editor =
+        "/v1/presets" + sessionQuery(session->session(), session->editor_token());
+    for (int i = 0; i < 32; ++i)
+        ASSERT_EQ(httpRequest(address, "PUT", editor + fmt::format("&name=p{:02}", i),
+                              toJson(pointLight(0.01f * float(i))))
+                      .code(),
+                  200)
+            << i;
+    expectRefusal(httpRequest(address, "PUT", editor + "&name=p32", toJson(pointLight(0.5f))), 429,
+                  "RESOURCE_EXHAUSTED", "32 presets");
+    // One of the 32 may still be replaced; once one is deleted, a new one fits.
+    EXPECT_EQ(httpRequest(address, "PUT", editor + "&name=p07", toJson(pointLight(0.5f))).code(),
+              200);
+    EXPECT_EQ(httpRequest(address, "DELETE", editor + "&name=p00").code(), 200);
+    const Json saved =
+        jsonOf(httpRequest(address, "PUT", editor + "&name=p32", toJson(pointLight(0.5f))));
+    EXPECT_EQ(presetNames(saved).size(), 32u);
+    EXPECT_EQ(presetNames(saved).back(), "p32");
 }
 
 TEST(WebHttp, ServesTheProtoAndTheShBasisWithoutAToken) {

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -417,6 +418,58 @@ TEST(LightSetCheck, NamesUnknownMaterials) {
     EXPECT_EQ(checked.error().code, ErrorCode::InvalidInput);
     EXPECT_NE(checked.error().message.find("\"lamp_shade\""), std::string::npos);
     EXPECT_NE(checked.error().message.find("\"white\""), std::string::npos);
+}
+
+TEST(LightPresets, NamesAreShortAndPlain) {
+    for (const std::string& name :
+         std::vector<std::string>{"a", "Warm corner", "noon-2.b", "x_y", std::string(64, 'z')})
+        EXPECT_TRUE(checkPresetName(name)) << name;
+    for (const std::string& name :
+         std::vector<std::string>{"", " lead", "trail ", "a/b", "tab\there", "caf\xC3\xA9",
+                                  "q\"uote", std::string(65, 'z')}) {
+        auto checked = checkPresetName(name);
+        ASSERT_FALSE(checked) << name;
+        EXPECT_EQ(checked.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(checked.error().message.find("preset name \"" + name.substr(0, 64)),
+                  std::string::npos)
+            << checked.error().message;
+    }
+}
+
+TEST(LightPresets, RoundTripThroughJson) {
+    auto warm =
+        parseLightSet(oneLight(R"("id":"w","type":"point","position":[0,1,0],"intensity":2)"));
+    auto sun = parseLightSet(
+        oneLight(R"("id":"s","type":"directional","direction":[0,-1,0.5],"color":[1,0.9,0.8])"));
+    ASSERT_TRUE(warm && sun);
+    const LightPresets presets = {{"Warm", *warm}, {"sun 2", *sun}};
+    const std::string json = toJson(presets);
+    auto read = parseLightPresets(json);
+    ASSERT_TRUE(read) << read.error().message;
+    ASSERT_EQ(read->size(), 2u);
+    EXPECT_EQ(toJson(read->at("Warm")), toJson(*warm));
+    EXPECT_EQ(toJson(read->at("sun 2")), toJson(*sun));
+    EXPECT_EQ(toJson(*read), json);
+    auto none = parseLightPresets("{}");
+    ASSERT_TRUE(none);
+    EXPECT_TRUE(none->empty());
+}
+
+TEST(LightPresets, RefusesWhatASessionCouldNotHold) {
+    const auto refused = [](const std::string& json, const std::string& says) {
+        auto read = parseLightPresets(json);
+        ASSERT_FALSE(read) << json;
+        EXPECT_EQ(read.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(read.error().message.find(says), std::string::npos) << read.error().message;
+    };
+    refused("[]", "JSON object");
+    refused("{", "not valid JSON");
+    refused(R"({" bad": {}})", "preset name \" bad\"");
+    refused(R"({"odd": {"lights": [{"type": "laser"}]}})", "preset \"odd\"");
+    std::string many = "{";
+    for (size_t i = 0; i <= kMaxPresets; ++i)
+        many += fmt::format("{}\"p{}\": {{}}", i ? "," : "", i);
+    refused(many + "}", "33 presets");
 }
 
 TEST(LightSetDefault, TakesTheSceneLightsWithoutScaling) {

@@ -190,6 +190,99 @@ TEST_P(SessionStoreTest, ADatabaseOfANewerSchemaIsRefused) {
         << refused.error().message;
 }
 
+/// The presets of row `id` as their JSON, or what went wrong.
+std::string presetsOf(SessionStore& store, const std::string& id) {
+    auto found = store.find(id);
+    if (!found) return "error: " + found.error().message;
+    if (!*found) return "no row";
+    return toJson((*found)->presets);
+}
+
+TEST_P(SessionStoreTest, PresetsAreSavedUnlessANewerVersionIsStored) {
+    auto store = open();
+    ASSERT_TRUE(store);
+    ASSERT_EQ(outcome(store->create(sessionNamed("a"))), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), "{}");
+
+    StoredSession row = sessionNamed("a");
+    row.presets = {{"Left", lampAt(-0.5f)}, {"right 2", lampAt(0.5f)}};
+    ASSERT_EQ(outcome(store->savePresets(row)), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), toJson(row.presets));
+
+    // A light set leaves them; the row's version and light set stay what save() wrote.
+    ASSERT_EQ(outcome(store->save(sessionNamed("a", 3, 0.25f))), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), toJson(row.presets));
+    // A server whose copy is behind (version 2) changes nothing; one at the stored version
+    // (or past it: a restored session counts on from the stored version) does.
+    row.version = 2;
+    row.presets.erase("Left");
+    EXPECT_EQ(outcome(store->savePresets(row)), "false");
+    EXPECT_EQ(presetsOf(*store, "a"),
+              toJson(LightPresets{{"Left", lampAt(-0.5f)}, {"right 2", lampAt(0.5f)}}));
+    row.version = 3;
+    ASSERT_EQ(outcome(store->savePresets(row)), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), toJson(row.presets));
+    row.version = 4;
+    row.presets.clear();
+    ASSERT_EQ(outcome(store->savePresets(row)), "true");
+    auto found = store->find("a");
+    ASSERT_TRUE(found && *found);
+    EXPECT_TRUE((*found)->presets.empty());
+    EXPECT_EQ((*found)->version, 3u) << "presets do not move the version";
+    EXPECT_EQ(toJson((*found)->lights), toJson(lampAt(0.25f)));
+
+    // Gone (removed as idle), the row comes back with them, as save() brings it back.
+    ASSERT_TRUE(store->remove("a", 3));
+    row.presets = {{"back", lampAt(0.125f)}};
+    ASSERT_EQ(outcome(store->savePresets(row)), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), toJson(row.presets));
+    // And save() of a row that is gone writes its presets too.
+    ASSERT_TRUE(store->remove("a", 4));
+    StoredSession saved = sessionNamed("a", 5);
+    saved.presets = {{"again", lampAt(0.0f)}};
+    ASSERT_EQ(outcome(store->save(saved)), "true");
+    EXPECT_EQ(presetsOf(*store, "a"), toJson(saved.presets));
+}
+
+// A database of schema 1 (before presets) keeps its sessions and gains the presets column at
+// open, every session's presets empty.
+TEST_P(SessionStoreTest, ADatabaseOfSchemaOneGainsPresets) {
+    const std::string createV1 =
+        "CREATE TABLE sessions (id TEXT PRIMARY KEY, editor_token_sha256 TEXT NOT NULL, "
+        "viewer_token_sha256 TEXT NOT NULL, bake_id TEXT NOT NULL, version BIGINT NOT NULL, "
+        "lights TEXT NOT NULL, created_unix_ms BIGINT NOT NULL, updated_unix_ms BIGINT NOT NULL)";
+    const std::string insert =
+        fmt::format("INSERT INTO sessions VALUES ('old', '{}', '{}', 'bake-1', 6, '{}', 1, 1)",
+                    tokenDigest("old-editor"), tokenDigest("old-viewer"), toJson(lampAt(0.75f)));
+    if (GetParam() == "postgresql") {
+        ASSERT_TRUE(postgresExec(mSpec, "CREATE TABLE pic_schema (version INTEGER NOT NULL)"));
+        ASSERT_TRUE(postgresExec(mSpec, "INSERT INTO pic_schema (version) VALUES (1)"));
+        ASSERT_TRUE(postgresExec(mSpec, createV1));
+        ASSERT_TRUE(postgresExec(mSpec, insert));
+    } else {
+        sqlite3* db = nullptr;
+        ASSERT_EQ(sqlite3_open(mSpec.c_str(), &db), SQLITE_OK);
+        for (const std::string& sql : {createV1, insert, std::string("PRAGMA user_version = 1")})
+            EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+        sqlite3_close(db);
+    }
+    {
+        auto store = open();
+        ASSERT_TRUE(store);
+        auto found = store->find("old");
+        ASSERT_TRUE(found && *found) << (found ? "no row" : found.error().message);
+        EXPECT_EQ((*found)->version, 6u);
+        EXPECT_EQ(toJson((*found)->lights), toJson(lampAt(0.75f)));
+        EXPECT_TRUE((*found)->presets.empty());
+        StoredSession row = **found;
+        row.presets = {{"kept", lampAt(0.5f)}};
+        ASSERT_EQ(outcome(store->savePresets(row)), "true");
+    }
+    auto reopened = open();
+    ASSERT_TRUE(reopened);
+    EXPECT_EQ(presetsOf(*reopened, "old"), toJson(LightPresets{{"kept", lampAt(0.5f)}}));
+}
+
 TEST_P(SessionStoreTest, ConcurrentWritersEachGetTheirRowsIn) {
     auto store = open();
     ASSERT_TRUE(store);
