@@ -6,7 +6,8 @@
 # to place an object):
 #   bake → picserver (GPU backend: a GPU, else lavapipe) → a session → a light change pushed
 #   by an editor → a frame rendered by the thin client from the streamed caches → a short
-#   load test; prints the timings, the latencies and where the image is.
+#   load test; prints the timings, the latencies, where the image is and the session's URL for
+#   a browser (run from a terminal, the demo then keeps serving until Enter is pressed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -39,7 +40,7 @@ echo "bake written to $BAKE (timings in $BAKE.timings.json)"
 # The server on a free loopback port; its first line says which. Stopped on exit.
 SERVER_LOG="$OUT_DIR/${NAME}_server.log"
 "$BUILD_DIR/server/picserver" --bake "$BAKE" --scene "$SCENE" --listen 127.0.0.1:0 \
-  --backend gpu --quiet > "$SERVER_LOG" 2>&1 &
+  --web-listen "${PIC_WEB_LISTEN:-127.0.0.1:0}" --backend gpu --quiet > "$SERVER_LOG" 2>&1 &
 SERVER_PID=$!
 trap 'kill "$SERVER_PID" 2>/dev/null || true; wait "$SERVER_PID" 2>/dev/null || true' EXIT
 ADDRESS=""
@@ -72,3 +73,8 @@ REPORT="$OUT_DIR/${NAME}_load.json"
   --report "$REPORT"
 echo "server log (one line per update): $SERVER_LOG"
 echo "frame rendered by the thin client from the streamed caches: $IMAGE"
+WEB=$(sed -n 's|^picserver: browsers on \(http://[^ ]*/\) .*|\1|p' "$SERVER_LOG" | head -n 1)
+echo "the session in a browser: ${WEB}?session=$SESSION&token=$EDITOR"
+if [[ -t 0 && -t 1 ]]; then
+  read -r -p "serving until Enter is pressed… " _ || true
+fi

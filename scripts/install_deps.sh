@@ -17,9 +17,10 @@ PACKAGES=(
   libsqlite3-dev libpq-dev postgresql nginx libcivetweb-dev
   # libFuzzer (bench/run_fuzz.sh): clang 19, whose libstdc++ mode has std::expected.
   clang-19 libclang-rt-19-dev
-  # The browser client's tests: headless chromium (SwiftShader WebGL2).
-  chromium
 )
+# The browser client's tests: headless chromium (SwiftShader WebGL2); PIC_NO_BROWSER=1 leaves
+# it out where no test runs (the container image's build stage).
+if [[ "${PIC_NO_BROWSER:-0}" != 1 ]]; then PACKAGES+=(chromium); fi
 # The browser client's npm packages (client/web): Debian's node and npm, unless a node with
 # its own npm is installed already.
 if ! command -v node >/dev/null; then PACKAGES+=(nodejs); fi

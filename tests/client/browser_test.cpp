@@ -9,6 +9,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/image.h"
 #include "core/light_set.h"
@@ -153,6 +154,97 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BrowserParity,
                                          ParityCase{"textured_quad", 2048, "320x240", true},
                                          ParityCase{"atrium", 8192, "384x216", false}),
                          [](const auto& info) { return info.param.scene; });
+
+/// One light at `position` with the given id.
+LightSet pointAt(const glm::vec3& position, float intensity) {
+    Light light;
+    light.id = "lamp";
+    light.type = LightType::Point;
+    light.position = position;
+    light.intensity = intensity;
+    LightSet set;
+    set.lights = {light};
+    return set;
+}
+
+glm::vec3 vec3Of(const nlohmann::json& v) { return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>()}; }
+
+// Design review with two browsers and a native client on one session: the editor drags a
+// light's gizmo, and the viewer's browser, `picclient watch` and a gRPC subscriber get the
+// version that carries it, the light where the editor put it; the viewer cannot change
+// lights; a viewer whose connection drops connects again and draws the next change.
+TEST(BrowserSession, ALightDraggedInOneBrowserReachesTheOthers) {
+    requireBrowser();
+    auto server = serveScene("cornell", smallBakeOptions(4096, 32));
+    ASSERT_TRUE(server) << server.error().message;
+    auto connection = PicConnection::connect((*server)->address());
+    ASSERT_TRUE(connection);
+    auto session = (*connection)->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    const Scene scene = loadTestScene("cornell");
+    const glm::vec3 start = scene.bounds.center() + glm::vec3(0.0f, 0.2f, 0.0f) * scene.bounds.extent();
+    auto first = (*connection)->setLights(session->session(), session->editor_token(),
+                                          pointAt(start, glm::dot(scene.bounds.extent(), scene.bounds.extent())));
+    ASSERT_TRUE(first) << first.error().message;
+    Reader native(**connection, session->session(), session->viewer_token());
+    ASSERT_TRUE(native.waitFor(*first));
+    Child watch({PIC_PICCLIENT, "watch", "--server", (*server)->address(), "--session",
+                 session->session(), "--token", session->viewer_token()});
+
+    // Small shadow maps: every drag redraws a point light's six layers in both pages.
+    const std::string page = fmt::format("http://{}/?session={}&size=480x320&samples=1&shadow_map_size=256&token=",
+                                         (*server)->webAddress(), session->session());
+    int exit = 0;
+    const std::string output = run(fmt::format("node {}/tests/session.mjs --editor '{}{}' --viewer '{}{}' 2>&1",
+                                               kWebDir, page, session->editor_token(), page,
+                                               session->viewer_token()),
+                                   exit);
+    ASSERT_EQ(exit, 0) << output;
+    // The driver's report is its last line.
+    const size_t end = output.find_last_not_of('\n');
+    const size_t begin = output.rfind('\n', end);
+    const auto json = nlohmann::json::parse(
+        output.substr(begin == std::string::npos ? 0 : begin + 1, end + 1), nullptr, false);
+    ASSERT_FALSE(json.is_discarded()) << output;
+    EXPECT_EQ(json["editorRole"], "editor");
+    EXPECT_EQ(json["viewerRole"], "viewer");
+
+    // The viewer draws the editor's version with the light where the editor dropped it.
+    const glm::vec3 before = vec3Of(json["before"]["position"]);
+    const glm::vec3 dragged = vec3Of(json["editorLight"]["position"]);
+    const glm::vec3 seen = vec3Of(json["viewerLight"]["position"]);
+    EXPECT_GT(glm::length(dragged - before), 1e-3f) << "the drag did not move the light";
+    EXPECT_LT(glm::length(seen - dragged), 1e-5f);
+    const uint64_t version = json["version"].get<uint64_t>();
+    EXPECT_GT(version, *first);
+
+    // The viewer's drag sends nothing and its own set is refused, changing no version.
+    EXPECT_EQ(json["viewerDragRequests"], 0);
+    EXPECT_EQ(json["viewerRefusal"]["status"], 403) << json["viewerRefusal"].dump();
+    EXPECT_EQ(json["viewerVersionAfterRefusal"], json["versionBeforeRefusal"]);
+
+    // Connected again, the viewer draws the editor's next drag.
+    EXPECT_GE(json["resumed"]["connections"].get<int>(), 2);
+    const uint64_t last = json["resumed"]["version"].get<uint64_t>();
+    EXPECT_GT(last, version);
+    EXPECT_LT(glm::length(vec3Of(json["resumed"]["light"]["position"]) -
+                          vec3Of(json["editorLightAfter"]["position"])),
+              1e-5f);
+
+    // The native clients: a gRPC subscriber holds the last version with the dragged light,
+    // and picclient watch printed it.
+    ASSERT_TRUE(native.waitFor(last));
+    const auto lights = native.lights();
+    ASSERT_TRUE(lights && lights->lights.size() == 1);
+    EXPECT_LT(glm::length(lights->lights[0].position - vec3Of(json["editorLightAfter"]["position"])), 1e-5f);
+    uint64_t watched = 0;
+    while (watched < last) {
+        const std::string line = readLine(watch.out());
+        ASSERT_FALSE(line.empty()) << "picclient watch ended before version " << last;
+        if (line.starts_with("version ")) watched = std::stoull(line.substr(8));
+    }
+    EXPECT_GE(watched, last);
+}
 
 }  // namespace
 }  // namespace pic

@@ -1,9 +1,12 @@
 // The browser client's page: /?session=ID&token=T[&camera=ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy]
-// [&scene_camera=N][&size=WxH][&samples=N][&exposure=X][&ui=0]. Fetches the scene and the
+// [&scene_camera=N][&size=WxH][&samples=N][&exposure=X][&shadow_map_size=N][&ui=0]. Fetches the scene and the
 // wire schema, streams the session's caches and draws them as `picclient render` does.
 // window.pic reports progress to tests and scripts.
+import { SessionApi } from './api.js';
 import { Camera } from './camera.js';
-import { lightSetOf } from './lights.js';
+import { Controls } from './controls.js';
+import { SessionPanel } from './editor.js';
+import { lightSetJson, lightSetOf } from './lights.js';
 import { Renderer } from './renderer.js';
 import { parseScene } from './scene.js';
 import { Stream } from './stream.js';
@@ -51,19 +54,23 @@ function viewParams() {
     sceneCamera: number('scene_camera', 0, (v) => Number.isInteger(v) && v >= 0),
     samples: number('samples', 4, (v) => Number.isInteger(v) && v >= 1 && v <= 64),
     exposure: number('exposure', 1, (v) => Number.isFinite(v) && v > 0),
+    shadowMapSize: number('shadow_map_size', 1024, (v) => Number.isInteger(v) && v >= 16 && v <= 8192),
     ui: q.get('ui') !== '0',
   };
 }
 
+const sceneCameras = (scene) =>
+  (scene.cameras || []).map((c) => new Camera(c.eye, c.target, c.up, c.fovy_degrees));
+
 /// The scene's camera `index`, or a view of its bounds when it has none.
 function startCamera(scene, params) {
   if (params.camera) return params.camera;
-  const cameras = scene.cameras || [];
+  const cameras = sceneCameras(scene);
   if (cameras.length > 0) {
     if (params.sceneCamera >= cameras.length)
       throw new Error(`scene_camera ${params.sceneCamera}: the scene has ${cameras.length} cameras`);
     const c = cameras[params.sceneCamera];
-    return new Camera(c.eye, c.target, c.up, c.fovy_degrees);
+    return new Camera([...c.eye], [...c.target], [...c.up], c.fovyDegrees);
   }
   const centre = scale(add(scene.bounds.min, scene.bounds.max), 0.5);
   const diagonal = length(sub(scene.bounds.max, scene.bounds.min));
@@ -95,30 +102,64 @@ async function main() {
   const scene = parseScene(new Uint8Array(sceneBytes));
   const FrameType = protobuf.parse(protoText, { keepCase: true }).root.lookupType('pic.v1.Frame');
   const canvas = document.getElementById('view');
-  const renderer = new Renderer(canvas, scene, shBasis);
+  const renderer = new Renderer(canvas, scene, shBasis, { shadowMapSize: params.shadowMapSize });
   const camera = startCamera(scene, params);
   state.sceneBytes = scene.bytes;
   state.sceneMs = performance.now() - started;
   report(`scene ${scene.scene_name} (${(scene.bytes / 1048576).toFixed(1)} MiB); waiting for the stream…`);
 
-  let dirty = false;
+  // Drawing: at once after a change; while the view moves, one sample per pixel, and the
+  // full count once it has been still for a moment.
+  let dirty = false, moving = 0, drawnLights = null;
   let pending = null;  // what the newest frame brought: {version, part, lightsSetNs, received}
-  let lightsProto = null;
+  const redraw = () => { dirty = true; };
+
+  // The session UI: cameras, light gizmos and panel, presets (not with ui=0).
+  let panel = null, controls = null;
+  if (params.ui) {
+    const api = new SessionApi(params.session, params.token);
+    const info = await api.session();
+    document.body.classList.toggle('viewer', info.role !== 'editor');
+    controls = new Controls(canvas, camera, length(sub(scene.bounds.max, scene.bounds.min)), () => {
+      moving = performance.now();
+      redraw();
+      if (panel) {
+        panel.refreshMode();
+        panel.placeGizmos();
+      }
+    });
+    controls.sceneCameras = sceneCameras(scene);
+    panel = new SessionPanel({ root: document.body, canvas, scene, camera, controls, api,
+                               role: info.role, session: params.session, token: params.token,
+                               onPreview: redraw });
+    panel.setPresets(info.presets || []);
+    state.role = info.role;
+    state.panel = panel;
+    // Presets other editors save show up within a few seconds.
+    setInterval(() => api.presets().then((p) => panel.setPresets(p.presets)).catch(() => {}), 5000);
+  }
+
+  let streamSet = null, lightsProto = null;
   const stream = new Stream({
     url: location.origin, session: params.session, token: params.token, FrameType, scene,
     onState: (decoder, frame, arrival) => {
       renderer.setCaches(decoder.planes);
       if (decoder.lights && decoder.lights !== lightsProto) {
         lightsProto = decoder.lights;
-        renderer.setLights(lightSetOf(lightsProto));
+        // Most versions keep the lights of the one before (parts of a budgeted update, other
+        // clients' sets of equal lights): the same set keeps its object, and the panel its rows.
+        const set = lightSetOf(lightsProto);
+        if (!streamSet || lightSetJson(set) !== lightSetJson(streamSet)) streamSet = set;
       }
+      if (panel) panel.streamed(streamSet, decoder.version);
       state.version = decoder.version;
       state.part = decoder.part;
       state.frames = stream.frames;
+      state.lights = streamSet;
       pending = { version: decoder.version, part: decoder.part, received: arrival.received,
                   lightsSetNs: Number(frame.lights_set_unix_ns || 0), bytes: arrival.bytes,
                   key: Number(frame.base_version || 0) === 0 };
-      dirty = true;
+      redraw();
     },
     onStatus: (text, final) => {
       state.connections = stream ? stream.connections : 0;
@@ -128,34 +169,52 @@ async function main() {
   });
   state.stream = stream;
 
-  // Frames per second: draws in the last second.
   const drawTimes = [];
+  let drawMs = 0;
   const size = () => params.size || [Math.max(1, innerWidth), Math.max(1, innerHeight)];
-  addEventListener('resize', () => { dirty = true; });
-  const frame = () => {
+  addEventListener('resize', () => {
+    redraw();
+    if (panel) panel.placeGizmos();
+  });
+  const frame = (now) => {
     requestAnimationFrame(frame);
-    if (!dirty || state.state === 'error') return;
+    if (controls) controls.tick(now);
+    const still = now - moving > 150;
+    if (state.state === 'error' || !streamSet) return;
+    if (!dirty && !(still && moving && state.lastSamples !== params.samples)) return;
     dirty = false;
+    const lights = panel ? panel.lights() : streamSet;
+    if (lights !== drawnLights) {
+      renderer.setLights(lights);
+      drawnLights = lights;
+    }
+    const samples = still ? params.samples : 1;
     const [width, height] = size();
-    renderer.render(camera, width, height, { samples: params.samples, exposure: params.exposure });
+    const t0 = performance.now();
+    renderer.render(camera, width, height, { samples, exposure: params.exposure });
     renderer.gl.finish();
-    const now = performance.now();
-    drawTimes.push(now);
-    while (drawTimes[0] < now - 1000) drawTimes.shift();
+    const done = performance.now();
+    drawMs = done - t0;
+    // The gizmos follow the view (and the canvas, which the first draw sizes).
+    if (panel) panel.placeGizmos();
+    state.lastSamples = samples;
+    drawTimes.push(done);
+    while (drawTimes[0] < done - 1000) drawTimes.shift();
     ++state.draws;
-    if (pending) {
+    if (pending && samples === params.samples) {
       state.drawnVersion = pending.version;
       state.drawnPart = pending.part;
       if (pending.lightsSetNs > 0)
         state.latencies.push({ version: pending.version, part: pending.part, key: pending.key,
                                bytes: pending.bytes,
                                ms: Date.now() - pending.lightsSetNs / 1e6,
-                               decodeToDrawnMs: now - pending.received });
+                               decodeToDrawnMs: done - pending.received });
       pending = null;
       state.state = 'ready';
     }
     stats.textContent = `version ${state.version}${state.part ? ` (part ${state.part})` : ''} · ` +
-                        `${drawTimes.length} fps · ${width}×${height} · ${params.samples} spp`;
+                        `${drawTimes.length} fps · ${drawMs.toFixed(0)} ms per frame · ` +
+                        `${width}×${height} · ${samples} spp`;
   };
   requestAnimationFrame(frame);
 }

@@ -1,8 +1,8 @@
 // Opens one view of a session in headless chromium (SwiftShader WebGL2 through ANGLE) and
 // saves the canvas as PNG once the page has drawn a version's final state:
 //   node screenshot.mjs --url URL --out FILE.png [--version N] [--timeout-s S]
-//                       [--chromium PATH]
-// Prints one JSON line: the page's window.pic report (versions, sizes, times). Exit status 1
+//                       [--chromium PATH] [--page 1]
+// (--page 1: the whole page, panel and gizmos included, not the canvas alone). Prints one JSON line: the page's window.pic report (versions, sizes, times). Exit status 1
 // with the page's error or a timeout on stderr.
 import puppeteer from 'puppeteer-core';
 import { launchOptions, parseArgs } from './browser.mjs';
@@ -29,12 +29,16 @@ try {
                           (window.pic.drawnVersion >= v && window.pic.drawnPart === 0)),
     { timeout: Number(args['timeout-s']) * 1000, polling: 50 }, version);
   const report = await page.evaluate(() => {
-    const { stream, ...rest } = window.pic;
+    const { stream, panel, ...rest } = window.pic;
     return rest;
   });
   if (report.state === 'error') throw new Error(`the page failed: ${report.error}\n${logs.join('\n')}`);
-  const canvas = await page.$('canvas');
-  await canvas.screenshot({ path: args.out, omitBackground: false });
+  if (args.page) {
+    await page.screenshot({ path: args.out });
+  } else {
+    const canvas = await page.$('canvas');
+    await canvas.screenshot({ path: args.out, omitBackground: false });
+  }
   console.log(JSON.stringify(report));
 } catch (error) {
   console.error(error.message);
