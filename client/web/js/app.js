@@ -110,9 +110,18 @@ async function main() {
 
   // Drawing: at once after a change; while the view moves, one sample per pixel, and the
   // full count once it has been still for a moment.
-  let dirty = false, moving = 0, drawnLights = null;
+  // A frame is requested only when something changed, so that an idle tab costs nothing.
+  let dirty = false, moving = 0, drawnLights = null, scheduled = false;
   let pending = null;  // what the newest frame brought: {version, part, lightsSetNs, received}
-  const redraw = () => { dirty = true; };
+  const schedule = () => {
+    if (scheduled) return;
+    scheduled = true;
+    requestAnimationFrame(frame);
+  };
+  const redraw = () => {
+    dirty = true;
+    schedule();
+  };
 
   // The session UI: cameras, light gizmos and panel, presets (not with ui=0).
   let panel = null, controls = null;
@@ -176,8 +185,8 @@ async function main() {
     redraw();
     if (panel) panel.placeGizmos();
   });
-  const frame = (now) => {
-    requestAnimationFrame(frame);
+  function frame(now) {
+    scheduled = false;
     if (controls) controls.tick(now);
     const still = now - moving > 150;
     if (state.state === 'error' || !streamSet) return;
@@ -204,6 +213,7 @@ async function main() {
     if (pending && samples === params.samples) {
       state.drawnVersion = pending.version;
       state.drawnPart = pending.part;
+      if (state.latencies.length >= 10000) state.latencies.shift();
       if (pending.lightsSetNs > 0)
         state.latencies.push({ version: pending.version, part: pending.part, key: pending.key,
                                bytes: pending.bytes,
@@ -215,8 +225,9 @@ async function main() {
     stats.textContent = `version ${state.version}${state.part ? ` (part ${state.part})` : ''} · ` +
                         `${drawTimes.length} fps · ${drawMs.toFixed(0)} ms per frame · ` +
                         `${width}×${height} · ${samples} spp`;
-  };
-  requestAnimationFrame(frame);
+    // A moving view was drawn with one sample: all of them once it has been still a moment.
+    if (samples !== params.samples) setTimeout(schedule, 160);
+  }
 }
 
 main().catch((error) => fail(error.message));

@@ -112,6 +112,11 @@ export class Controls {
     if ('wasdqe'.includes(k) && k.length === 1) {
       if (pressed) this.keys.add(k);
       else this.keys.delete(k);
+      // Walking starts the page's frames; tick() keeps them coming while a key is held.
+      if (pressed && this.mode === 'walk') {
+        this.lastTick = performance.now();
+        this.onChange();
+      }
     }
     this.shift = e.shiftKey;
   }

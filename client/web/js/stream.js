@@ -9,6 +9,9 @@ import { FrameDecoder } from './frames.js';
 /// request the server refuses (INVALID_ARGUMENT, FAILED_PRECONDITION).
 const kFinal = new Set([4003, 4005, 4007, 4009, 4016]);
 
+/// Frames whose size Stream.received keeps (tests/latency.mjs reads them).
+const kReceived = 10000;
+
 export class Stream {
   /// Streams session `session` with `token` from `url` (the page's origin); FrameType is the
   /// protobufjs type pic.v1.Frame. onState(decoder, frame) after each decoded frame,
@@ -24,6 +27,7 @@ export class Stream {
     this.connections = 0;
     this.frames = 0;
     this.bytes = 0;
+    this.received = [];  // {bytes, key} of each decoded frame, the last kReceived
     this.retryMs = 250;
     this.closed = false;
     this.connect();
@@ -56,6 +60,8 @@ export class Stream {
       }
       ++this.frames;
       this.bytes += bytes.byteLength;
+      this.received.push({ bytes: bytes.byteLength, key: Number(frame.base_version || 0) === 0 });
+      if (this.received.length > kReceived) this.received.shift();
       this.onState(this.decoder, frame, { received, bytes: bytes.byteLength });
     };
     socket.onclose = (event) => {
