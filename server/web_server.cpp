@@ -205,15 +205,23 @@ SessionRequest sessionRequestOf(const mg_connection* connection) {
     return out;
 }
 
+/// The session and role `request` names, or its refusal (the request's own first).
+Access authoriseRequest(PicServer::State& state, const SessionRequest& request) {
+    if (!request.status.ok()) {
+        Access refused;
+        refused.status = request.status;
+        return refused;
+    }
+    return authorise(state, request.sessionId, request.token);
+}
+
 /// GET /v1/scene?session=ID&token=T: the session's bake as server/web_scene.h lays it out.
 int serveScene(mg_connection* connection, void* data) {
     if (std::string_view(mg_get_request_info(connection)->request_method) != "GET")
         return wrongMethod(connection, "GET");
     PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
     const SessionRequest request = sessionRequestOf(connection);
-    Access access;
-    access.status = request.status;
-    if (access.status.ok()) access = authorise(state, request.sessionId, request.token);
+    Access access = authoriseRequest(state, request);
     const Result<std::string>* scene = nullptr;
     if (access.status.ok()) {
         access.session->touch();
@@ -290,9 +298,7 @@ int serveSession(mg_connection* connection, void* data) {
         return wrongMethod(connection, "GET");
     PicServer::State& state = **static_cast<std::shared_ptr<PicServer::State>*>(data);
     const SessionRequest request = sessionRequestOf(connection);
-    Access access;
-    access.status = request.status;
-    if (access.status.ok()) access = authorise(state, request.sessionId, request.token);
+    Access access = authoriseRequest(state, request);
     state.recordCall(request.peer, request.forwarded, "WebSession", roleName(access.role),
                      request.sessionId, access.status);
     if (!access.status.ok()) return refuse(connection, access.status);
