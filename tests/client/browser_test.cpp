@@ -4,6 +4,7 @@
 // process of node and is closed by the driver script.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -244,6 +245,68 @@ TEST(BrowserSession, ALightDraggedInOneBrowserReachesTheOthers) {
         if (line.starts_with("version ")) watched = std::stoull(line.substr(8));
     }
     EXPECT_GE(watched, last);
+}
+
+// The browser transport without a browser (client/web/tests/sockets.mjs, the page's own
+// stream and frame decoder in node, as MODE=sockets of bench/run_browser.sh runs it): eight
+// WebSocket subscribers of one session each decode every version the editor pushes, and
+// each holds the last one.
+TEST(BrowserTransport, EverySocketDecodesEveryVersion) {
+    requireBrowser();
+    int exit = 0;
+    std::string node = run("command -v node", exit);
+    node.erase(node.find_last_not_of('\n') + 1);
+    ASSERT_EQ(exit, 0) << "node is not on PATH";
+    // node's WebSocket: built in from node 22, behind a flag in node 20.
+    std::vector<std::string> args = {node};
+    for (const std::string flag : {"", "--experimental-websocket"}) {
+        run(fmt::format("{} {} -e 'process.exit(typeof WebSocket === \"function\" ? 0 : 1)' > /dev/null 2>&1",
+                        node, flag),
+            exit);
+        if (exit != 0) continue;
+        if (!flag.empty()) args.push_back(flag);
+        break;
+    }
+    if (exit != 0) GTEST_SKIP() << "this node has no WebSocket (node >= 20.10 has one)";
+    auto server = serveScene("cornell", smallBakeOptions(4096, 32));
+    ASSERT_TRUE(server) << server.error().message;
+    auto connection = PicConnection::connect((*server)->address());
+    ASSERT_TRUE(connection);
+    auto session = (*connection)->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    Reader native(**connection, session->session(), session->viewer_token());
+
+    constexpr int kSockets = 8, kChanges = 5;
+    args.insert(args.end(), {kWebDir + "/tests/sockets.mjs", "--url",
+                             fmt::format("http://{}/?session={}&token={}", (*server)->webAddress(),
+                                         session->session(), session->viewer_token()),
+                             "--sockets", std::to_string(kSockets), "--duration-s", "120",
+                             "--decode", "1", "--timeout-s", "300"});
+    Child sockets(args);
+    ASSERT_EQ(readLine(sockets.out()), "ready");
+
+    const Scene scene = loadTestScene("cornell");
+    const float intensity = glm::dot(scene.bounds.extent(), scene.bounds.extent());
+    uint64_t last = 0;
+    for (int i = 0; i < kChanges; ++i) {
+        const glm::vec3 at = scene.bounds.center() + glm::vec3(0.1f * i, 0.2f, 0.0f) * scene.bounds.extent();
+        auto version = (*connection)->setLights(session->session(), session->editor_token(), pointAt(at, intensity));
+        ASSERT_TRUE(version) << version.error().message;
+        ASSERT_TRUE(native.waitFor(*version));  // one at a time: none is merged into the next
+        last = *version;
+    }
+    sockets.signal(SIGUSR2);  // the changes are over: drain and report
+    const auto report = nlohmann::json::parse(readLine(sockets.out()), nullptr, false);
+    ASSERT_EQ(sockets.wait(), 0);
+    ASSERT_FALSE(report.is_discarded());
+    EXPECT_EQ(report["versions"]["newest"], last);
+    EXPECT_EQ(report["versions"]["sockets_without_newest"], 0);
+    EXPECT_EQ(report["versions"]["never_received_total"], 0);
+    EXPECT_EQ(report["versions"]["skipped_total"], 0) << report.dump();
+    EXPECT_EQ(report["received_latency_ms"]["samples"], kSockets * kChanges) << report.dump();
+    EXPECT_EQ(report["frame_bytes"]["key"]["frames"], kSockets);  // one key frame each, no reconnect
+    EXPECT_EQ(report["frame_bytes"]["delta"]["frames"], kSockets * kChanges);
+    EXPECT_EQ(report["reconnects"], 0);
 }
 
 }  // namespace

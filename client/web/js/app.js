@@ -214,11 +214,12 @@ async function main() {
       state.drawnVersion = pending.version;
       state.drawnPart = pending.part;
       if (state.latencies.length >= 10000) state.latencies.shift();
-      if (pending.lightsSetNs > 0)
+      if (pending.lightsSetNs > 0) {
+        const at = Date.now();
         state.latencies.push({ version: pending.version, part: pending.part, key: pending.key,
-                               bytes: pending.bytes,
-                               ms: Date.now() - pending.lightsSetNs / 1e6,
+                               bytes: pending.bytes, at, ms: at - pending.lightsSetNs / 1e6,
                                decodeToDrawnMs: done - pending.received });
+      }
       pending = null;
       state.state = 'ready';
     }

@@ -15,19 +15,22 @@
 //     window.pic before the page runs) and bytes over HTTP (transferSize of the navigation and
 //     resource entries: the page, scripts, libraries, /v1/scene; the WebSocket's first key
 //     frame is first_frame_bytes);
-//   latency_ms: window.pic.latencies' `ms` (the server accepting the light set → the tab
-//     drawing it) over the final states (part 0) of the versions a tab drew after `ready`;
-//     received_latency_ms the same versions until their frame reached the page's socket
-//     handler (`ms` − decodeToDrawnMs);
+//   latency_ms: per tab and per version accepted after the tab's `ready` (the server
+//     accepting its light set, lights_set_unix_ns, as any tab received it) → the tab drawing
+//     the final state (part 0) of that version or a newer one (window.pic.latencies' `at`):
+//     a version the tab skipped counts until it drew a newer one, as picclient load counts
+//     it; received_latency_ms the same until the frame reached the page's socket handler
+//     (window.pic.stream.received's `at`);
 //   versions: pushed (newest version any tab received − each tab's version at `ready`), drawn,
 //     received (frames), skipped = pushed − drawn;
-//   frame_bytes: key and delta frames as the WebSocket carried them (serialised v1::Frame),
-//     from Stream.received, else from the drawn frames' latencies entries.
+//   frame_bytes: key and delta frames as the WebSocket carried them (serialised v1::Frame,
+//     window.pic.stream.received).
 // Exit status 1 with the reason on stderr (a tab that fails, a timeout); chromium is closed on
 // every path.
 import { writeFileSync } from 'node:fs';
 import puppeteer from 'puppeteer-core';
 import { launchOptions, parseArgs } from './browser.mjs';
+import { acceptedTimes, bytesStats, latencyStats, mean, percentile, round, untilFirst } from './stats.mjs';
 
 const args = parseArgs(process.argv.slice(2), {
   tabs: '1', 'duration-s': '10', 'open-concurrency': '1', 'load-timeout-s': '120',
@@ -56,21 +59,6 @@ const sizeMatch = /[?&]size=(\d+)x(\d+)/.exec(args.url);
 const viewport = { width: sizeMatch ? Number(sizeMatch[1]) : 800,
                    height: sizeMatch ? Number(sizeMatch[2]) : 600, deviceScaleFactor: 1 };
 
-/// The nearest-rank percentile (as picclient load computes it), 0 without values.
-function percentile(values, p) {
-  if (values.length === 0) return 0;
-  const sorted = [...values].sort((a, b) => a - b);
-  return sorted[Math.min(sorted.length - 1, Math.max(0, Math.ceil(p * sorted.length) - 1))];
-}
-const mean = (values) => (values.length ? values.reduce((a, b) => a + b, 0) / values.length : 0);
-const round = (x, digits = 1) => Math.round(x * 10 ** digits) / 10 ** digits;
-const latencyStats = (ms) => ({
-  p50: round(percentile(ms, 0.5)), p90: round(percentile(ms, 0.9)),
-  p99: round(percentile(ms, 0.99)), max: round(ms.length ? Math.max(...ms) : 0),
-  mean: round(mean(ms)), samples: ms.length,
-});
-const bytesStats = (bytes) => ({ frames: bytes.length, median: percentile(bytes, 0.5),
-                                 mean: Math.round(mean(bytes)) });
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
 let phase = 'starting chromium';
@@ -249,27 +237,26 @@ try {
   const newest = Math.max(...now.map((s) => s.version));
 
   phase = 'reading the tabs';
+  const read = await Promise.all(opened.map((tab) => tab.page.evaluate(() => ({
+    latencies: window.pic.latencies || [],
+    received: window.pic.stream ? window.pic.stream.received : [],
+  }))));
+  const accepted = acceptedTimes(read.map((r) => r.received));
   const perTab = [];
   const pooledMs = [], pooledReceivedMs = [], keyBytes = [], deltaBytes = [];
   const failed = [];
   for (const [i, tab] of opened.entries()) {
     const end = now[i];
-    const { latencies, received } = await tab.page.evaluate(() => ({
-      latencies: window.pic.latencies || [],
-      received: window.pic.stream && window.pic.stream.received ? window.pic.stream.received : null,
-    }));
+    const { latencies, received } = read[i];
     const base = tab.atReady.drawnVersion;
     const finals = latencies.filter((l) => l.version > base && l.part === 0);
-    const ms = finals.map((l) => l.ms);
-    // When the frame reached the page's socket handler: drawn − (drawn − received).
-    const receivedMs = finals.map((l) => l.ms - l.decodeToDrawnMs);
+    const { ms, missed } = untilFirst(accepted, finals, base, newest);
+    const receivedMs = untilFirst(accepted, received.filter((f) => f.part === 0), base, newest).ms;
     pooledMs.push(...ms);
     pooledReceivedMs.push(...receivedMs);
     // Frame sizes: every frame the socket brought (the load's key frame included).
-    const frames = received ||
-                   latencies.map((l) => ({ bytes: l.bytes, key: l.key }));
-    const key = frames.filter((f) => f.key).map((f) => f.bytes);
-    const delta = frames.filter((f) => !f.key).map((f) => f.bytes);
+    const key = received.filter((f) => f.key).map((f) => f.bytes);
+    const delta = received.filter((f) => !f.key).map((f) => f.bytes);
     keyBytes.push(...key);
     deltaBytes.push(...delta);
     const pushed = newest - base;
@@ -282,11 +269,10 @@ try {
       latency_ms: latencyStats(ms),
       received_latency_ms: latencyStats(receivedMs),
       versions: { at_ready: base, newest_received: end.version, last_drawn: end.drawnVersion,
-                  pushed, drawn, skipped: pushed - drawn,
+                  pushed, drawn, skipped: pushed - drawn, never_drawn: missed,
                   frames_received: end.frames - tab.atReady.frames,
                   draws: end.draws - tab.atReady.draws },
-      frame_bytes: { key: bytesStats(key), delta: bytesStats(delta),
-                     source: received ? 'stream.received' : 'latencies (drawn frames only)' },
+      frame_bytes: { key: bytesStats(key), delta: bytesStats(delta) },
       connections: end.connections,
       state: end.state,
       stats: end.stats,  // the page's last draw: version, fps, ms per frame
@@ -320,10 +306,9 @@ try {
       skipped_total: perTab.reduce((s, t) => s + t.versions.skipped, 0),
       frames_received_total: perTab.reduce((s, t) => s + t.versions.frames_received, 0),
       tabs_without_newest: perTab.filter((t) => t.versions.last_drawn < newest).length,
+      never_drawn_total: perTab.reduce((s, t) => s + t.versions.never_drawn, 0),
     },
-    frame_bytes: { key: bytesStats(keyBytes), delta: bytesStats(deltaBytes),
-                   source: perTab.every((t) => t.frame_bytes.source === 'stream.received')
-                     ? 'stream.received' : 'latencies (drawn frames only)' },
+    frame_bytes: { key: bytesStats(keyBytes), delta: bytesStats(deltaBytes) },
     reconnects: perTab.reduce((s, t) => s + Math.max(0, t.connections - 1), 0),
     context_lost: perTab.reduce((s, t) => s + t.context_lost, 0),
     // [s after ready, version received, version drawn, frames] of tab 0, each second.
