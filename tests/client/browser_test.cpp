@@ -43,6 +43,25 @@ Result<std::unique_ptr<PicServer>> serveScene(const std::string& name, const Bak
     return PicServer::start(std::move(bakes), "127.0.0.1:0", options);
 }
 
+/// A server over a small bake of test scene `name` (serveScene), a connection to it and a
+/// new session on it; fatal failures when any of them fails (ASSERT_NO_FATAL_FAILURE).
+struct OpenSession {
+    std::unique_ptr<PicServer> server;
+    std::unique_ptr<PicConnection> connection;
+    v1::CreateSessionResponse session;
+};
+void openSession(const std::string& name, uint32_t surfels, OpenSession& out) {
+    auto server = serveScene(name, smallBakeOptions(surfels, 32));
+    ASSERT_TRUE(server) << server.error().message;
+    out.server = std::move(*server);
+    auto connection = PicConnection::connect(out.server->address());
+    ASSERT_TRUE(connection) << connection.error().message;
+    out.connection = std::move(*connection);
+    auto session = out.connection->createSession();
+    ASSERT_TRUE(session) << session.error().message;
+    out.session = std::move(*session);
+}
+
 /// What the browser tests need installed: chromium and the npm packages (scripts/build.sh).
 void requireBrowser() {
     ASSERT_TRUE(fs::exists("/usr/bin/chromium") || std::getenv("PIC_CHROMIUM"))
@@ -73,13 +92,10 @@ class BrowserParity : public testing::TestWithParam<ParityCase> {};
 TEST_P(BrowserParity, TheBrowsersImageIsPicclientRenders) {
     requireBrowser();
     const ParityCase& c = GetParam();
-    auto server = serveScene(c.scene, smallBakeOptions(c.surfels, 32));
-    ASSERT_TRUE(server) << server.error().message;
-    auto connection = PicConnection::connect((*server)->address());
-    ASSERT_TRUE(connection);
-    auto session = (*connection)->createSession();
-    ASSERT_TRUE(session) << session.error().message;
-    uint64_t version = session->version();
+    OpenSession open;
+    ASSERT_NO_FATAL_FAILURE(openSession(c.scene, c.surfels, open));
+    auto& [server, connection, session] = open;
+    uint64_t version = session.version();
     const Scene scene = loadTestScene(c.scene);
     ASSERT_FALSE(scene.cameras.empty());
     if (c.pushLights) {
@@ -99,11 +115,11 @@ TEST_P(BrowserParity, TheBrowsersImageIsPicclientRenders) {
         spot.innerConeAngle = 0.4f;
         spot.intensity = point.intensity;
         lights.lights = {point, spot};
-        auto set = (*connection)->setLights(session->session(), session->editor_token(), lights);
+        auto set = connection->setLights(session.session(), session.editor_token(), lights);
         ASSERT_TRUE(set) << set.error().message;
         version = *set;
     }
-    auto live = (*server)->session(session->session());
+    auto live = server->session(session.session());
     ASSERT_TRUE(live->waitForVersion(version, 60s));
 
     const std::string camera = cameraText(scene.cameras.front());
@@ -115,13 +131,13 @@ TEST_P(BrowserParity, TheBrowsersImageIsPicclientRenders) {
     const std::string rendered = run(
         fmt::format("{} render --server {} --session {} --token {} --camera {} --size {} --out {} "
                     "--cache-dir {} 2>&1",
-                    PIC_PICCLIENT, (*server)->address(), session->session(),
-                    session->viewer_token(), camera, c.size, native, (dir / "cache").string()),
+                    PIC_PICCLIENT, server->address(), session.session(),
+                    session.viewer_token(), camera, c.size, native, (dir / "cache").string()),
         exit);
     ASSERT_EQ(exit, 0) << rendered;
     const std::string url =
         fmt::format("http://{}/?session={}&token={}&camera={}&size={}&ui=0",
-                    (*server)->webAddress(), session->session(), session->viewer_token(), camera,
+                    server->webAddress(), session.session(), session.viewer_token(), camera,
                     c.size);
     const std::string shot =
         run(fmt::format("node {}/tests/screenshot.mjs --url '{}' --out {} --version {} 2>&1",
@@ -176,29 +192,26 @@ glm::vec3 vec3Of(const nlohmann::json& v) { return {v[0].get<float>(), v[1].get<
 // lights; a viewer whose connection drops connects again and draws the next change.
 TEST(BrowserSession, ALightDraggedInOneBrowserReachesTheOthers) {
     requireBrowser();
-    auto server = serveScene("cornell", smallBakeOptions(4096, 32));
-    ASSERT_TRUE(server) << server.error().message;
-    auto connection = PicConnection::connect((*server)->address());
-    ASSERT_TRUE(connection);
-    auto session = (*connection)->createSession();
-    ASSERT_TRUE(session) << session.error().message;
+    OpenSession open;
+    ASSERT_NO_FATAL_FAILURE(openSession("cornell", 4096, open));
+    auto& [server, connection, session] = open;
     const Scene scene = loadTestScene("cornell");
     const glm::vec3 start = scene.bounds.center() + glm::vec3(0.0f, 0.2f, 0.0f) * scene.bounds.extent();
-    auto first = (*connection)->setLights(session->session(), session->editor_token(),
+    auto first = connection->setLights(session.session(), session.editor_token(),
                                           pointAt(start, glm::dot(scene.bounds.extent(), scene.bounds.extent())));
     ASSERT_TRUE(first) << first.error().message;
-    Reader native(**connection, session->session(), session->viewer_token());
+    Reader native(*connection, session.session(), session.viewer_token());
     ASSERT_TRUE(native.waitFor(*first));
-    Child watch({PIC_PICCLIENT, "watch", "--server", (*server)->address(), "--session",
-                 session->session(), "--token", session->viewer_token()});
+    Child watch({PIC_PICCLIENT, "watch", "--server", server->address(), "--session",
+                 session.session(), "--token", session.viewer_token()});
 
     // Small shadow maps: every drag redraws a point light's six layers in both pages.
     const std::string page = fmt::format("http://{}/?session={}&size=480x320&samples=1&shadow_map_size=256&token=",
-                                         (*server)->webAddress(), session->session());
+                                         server->webAddress(), session.session());
     int exit = 0;
     const std::string output = run(fmt::format("node {}/tests/session.mjs --editor '{}{}' --viewer '{}{}' 2>&1",
-                                               kWebDir, page, session->editor_token(), page,
-                                               session->viewer_token()),
+                                               kWebDir, page, session.editor_token(), page,
+                                               session.viewer_token()),
                                    exit);
     ASSERT_EQ(exit, 0) << output;
     // The driver's report is its last line.
@@ -268,18 +281,15 @@ TEST(BrowserTransport, EverySocketDecodesEveryVersion) {
         break;
     }
     if (exit != 0) GTEST_SKIP() << "this node has no WebSocket (node >= 20.10 has one)";
-    auto server = serveScene("cornell", smallBakeOptions(4096, 32));
-    ASSERT_TRUE(server) << server.error().message;
-    auto connection = PicConnection::connect((*server)->address());
-    ASSERT_TRUE(connection);
-    auto session = (*connection)->createSession();
-    ASSERT_TRUE(session) << session.error().message;
-    Reader native(**connection, session->session(), session->viewer_token());
+    OpenSession open;
+    ASSERT_NO_FATAL_FAILURE(openSession("cornell", 4096, open));
+    auto& [server, connection, session] = open;
+    Reader native(*connection, session.session(), session.viewer_token());
 
     constexpr int kSockets = 8, kChanges = 5;
     args.insert(args.end(), {kWebDir + "/tests/sockets.mjs", "--url",
-                             fmt::format("http://{}/?session={}&token={}", (*server)->webAddress(),
-                                         session->session(), session->viewer_token()),
+                             fmt::format("http://{}/?session={}&token={}", server->webAddress(),
+                                         session.session(), session.viewer_token()),
                              "--sockets", std::to_string(kSockets), "--duration-s", "120",
                              "--decode", "1", "--timeout-s", "300"});
     Child sockets(args);
@@ -290,7 +300,7 @@ TEST(BrowserTransport, EverySocketDecodesEveryVersion) {
     uint64_t last = 0;
     for (int i = 0; i < kChanges; ++i) {
         const glm::vec3 at = scene.bounds.center() + glm::vec3(0.1f * i, 0.2f, 0.0f) * scene.bounds.extent();
-        auto version = (*connection)->setLights(session->session(), session->editor_token(), pointAt(at, intensity));
+        auto version = connection->setLights(session.session(), session.editor_token(), pointAt(at, intensity));
         ASSERT_TRUE(version) << version.error().message;
         ASSERT_TRUE(native.waitFor(*version));  // one at a time: none is merged into the next
         last = *version;
