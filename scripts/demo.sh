@@ -56,6 +56,7 @@ SESSION_JSON=$("$BUILD_DIR/client/picclient" session --server "$ADDRESS")
 field() { sed -E "s/.*\"$1\":\"([^\"]*)\".*/\1/" <<<"$SESSION_JSON"; }
 SESSION=$(field session)
 EDITOR=$(field editor_token)
+VIEWER=$(field viewer_token)
 echo "session $SESSION"
 
 IMAGE="$OUT_DIR/${NAME}_client.png"
@@ -74,7 +75,8 @@ REPORT="$OUT_DIR/${NAME}_load.json"
 echo "server log (one line per update): $SERVER_LOG"
 echo "frame rendered by the thin client from the streamed caches: $IMAGE"
 WEB=$(sed -n 's|^picserver: browsers on \(http://[^ ]*/\) .*|\1|p' "$SERVER_LOG" | head -n 1)
-echo "the session in a browser: ${WEB}?session=$SESSION&token=$EDITOR"
+echo "the session in a browser: ${WEB}?session=$SESSION&token=$EDITOR&viewer=$VIEWER (editor)"
+echo "                 for viewers: ${WEB}?session=$SESSION&token=$VIEWER"
 if [[ -t 0 && -t 1 ]]; then
   read -r -p "serving until Enter is pressed… " _ || true
 fi

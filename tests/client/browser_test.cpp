@@ -209,9 +209,9 @@ TEST(BrowserSession, ALightDraggedInOneBrowserReachesTheOthers) {
     const std::string page = fmt::format("http://{}/?session={}&size=480x320&samples=1&shadow_map_size=256&token=",
                                          server->webAddress(), session.session());
     int exit = 0;
-    const std::string output = run(fmt::format("node {}/tests/session.mjs --editor '{}{}' --viewer '{}{}' 2>&1",
-                                               kWebDir, page, session.editor_token(), page,
-                                               session.viewer_token()),
+    const std::string output = run(fmt::format("node {}/tests/session.mjs --editor '{}{}&viewer={}' --viewer '{}{}' 2>&1",
+                                               kWebDir, page, session.editor_token(),
+                                               session.viewer_token(), page, session.viewer_token()),
                                    exit);
     ASSERT_EQ(exit, 0) << output;
     // The driver's report is its last line.
@@ -222,6 +222,22 @@ TEST(BrowserSession, ALightDraggedInOneBrowserReachesTheOthers) {
     ASSERT_FALSE(json.is_discarded()) << output;
     EXPECT_EQ(json["editorRole"], "editor");
     EXPECT_EQ(json["viewerRole"], "viewer");
+
+    // Share links: the editor's view link grants viewing, its editing link editing; a viewer's
+    // link is a viewer's; a page whose viewer token is the editor's does not start.
+    const auto tokenOf = [](const std::string& url) {
+        const size_t at = url.find("token=");
+        return at == std::string::npos ? std::string() : url.substr(at + 6, url.find('&', at) - at - 6);
+    };
+    EXPECT_EQ(tokenOf(json["editorShare"]["view"]), session.viewer_token()) << json["editorShare"].dump();
+    EXPECT_EQ(json["editorShare"]["view"].get<std::string>().find(session.editor_token()), std::string::npos);
+    EXPECT_EQ(tokenOf(json["editorShare"]["edit"]), session.editor_token()) << json["editorShare"].dump();
+    EXPECT_TRUE(json["editorShare"]["editButton"]);
+    EXPECT_EQ(json["editorShare"]["label"], "Share this view");
+    EXPECT_EQ(tokenOf(json["viewerShare"]["view"]), session.viewer_token());
+    EXPECT_FALSE(json["viewerShare"]["editButton"]);
+    EXPECT_NE(json["wrongViewerError"].get<std::string>().find("viewer token"), std::string::npos)
+        << json["wrongViewerError"];
 
     // The viewer draws the editor's version with the light where the editor dropped it.
     const glm::vec3 before = vec3Of(json["before"]["position"]);

@@ -1,5 +1,6 @@
-// The browser client's page: /?session=ID&token=T[&camera=ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy]
-// [&scene_camera=N][&size=WxH][&samples=N][&exposure=X][&shadow_map_size=N][&ui=0]. Fetches the scene and the
+// The browser client's page: /?session=ID&token=T[&viewer=VIEWER_TOKEN]
+// [&camera=ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy][&scene_camera=N][&size=WxH][&samples=N]
+// [&exposure=X][&shadow_map_size=N][&ui=0]. Fetches the scene and the
 // wire schema, streams the session's caches and draws them as `picclient render` does.
 // window.pic reports progress to tests and scripts.
 import { SessionApi } from './api.js';
@@ -50,6 +51,9 @@ function viewParams() {
   };
   return {
     session, token, size,
+    // An editor's page may carry the session's viewer token too: its share link then grants
+    // viewing only (the server keeps digests, not tokens, so it cannot say it).
+    viewer: q.get('viewer') || null,
     camera: q.has('camera') ? Camera.parse(q.get('camera')) : null,
     sceneCamera: number('scene_camera', 0, (v) => Number.isInteger(v) && v >= 0),
     samples: number('samples', 4, (v) => Number.isInteger(v) && v >= 1 && v <= 64),
@@ -128,6 +132,14 @@ async function main() {
   if (params.ui) {
     const api = new SessionApi(params.session, params.token);
     const info = await api.session();
+    // A viewer token the session does not call a viewer's would make "Share this view" grant
+    // more than it says.
+    if (params.viewer) {
+      const viewer = await new SessionApi(params.session, params.viewer).session()
+        .catch((error) => ({ role: error.message }));
+      if (viewer.role !== 'viewer')
+        throw new Error(`the URL's viewer token is not the session's viewer token (${viewer.role})`);
+    }
     document.body.classList.toggle('viewer', info.role !== 'editor');
     controls = new Controls(canvas, camera, length(sub(scene.bounds.max, scene.bounds.min)), () => {
       moving = performance.now();
@@ -140,7 +152,7 @@ async function main() {
     controls.sceneCameras = sceneCameras(scene);
     panel = new SessionPanel({ root: document.body, canvas, scene, camera, controls, api,
                                role: info.role, session: params.session, token: params.token,
-                               onPreview: redraw });
+                               viewerToken: params.viewer, onPreview: redraw });
     panel.setPresets(info.presets || []);
     state.role = info.role;
     state.panel = panel;

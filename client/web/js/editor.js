@@ -23,9 +23,12 @@ const fromHex = (hex) => [1, 3, 5].map((i) => {
 });
 
 export class SessionPanel {
-  /// `role` "editor" or "viewer"; onPreview() when the lights to draw changed locally.
-  constructor({ root, canvas, scene, camera, controls, api, role, session, token, onPreview }) {
-    Object.assign(this, { root, canvas, scene, camera, controls, api, role, session, token, onPreview });
+  /// `role` "editor" or "viewer"; viewerToken the session's viewer token when the page knows
+  /// it (else null); onPreview() when the lights to draw changed locally.
+  constructor({ root, canvas, scene, camera, controls, api, role, session, token, viewerToken,
+                onPreview }) {
+    Object.assign(this, { root, canvas, scene, camera, controls, api, role, session, token,
+                          viewerToken, onPreview });
     this.editor = role === 'editor';
     this.streamSet = null;     // the newest frame's light set
     this.streamVersion = 0;
@@ -69,7 +72,8 @@ export class SessionPanel {
       <div class="role">${this.editor ? 'editor' : 'viewer: lights are read-only'}</div>
       <h3>View</h3>
       <div class="row"><select id="cameras"></select><button id="mode" title="F">orbit</button></div>
-      <div class="row"><button id="share">Share this view</button></div>
+      <div class="row"><button id="share">${this.shareLabel()}</button>
+        ${this.editor && this.viewerToken ? '<button id="share-edit">Share for editing</button>' : ''}</div>
       <h3>Lights</h3>
       <div id="lights"></div>
       <h3>Presets</h3>
@@ -88,7 +92,8 @@ export class SessionPanel {
       cameras.value = '';
     };
     $('mode').onclick = () => { this.controls.mode = this.controls.mode === 'walk' ? 'orbit' : 'walk'; this.refreshMode(); };
-    $('share').onclick = () => this.share();
+    $('share').onclick = () => this.share(false);
+    if ($('share-edit')) $('share-edit').onclick = () => this.share(true);
     $('apply').onclick = () => this.applyPreset($('presets').value);
     $('save').onclick = () => this.savePreset();
     $('delete').onclick = () => this.deletePreset($('presets').value);
@@ -324,18 +329,26 @@ export class SessionPanel {
     }
   }
 
-  /// A link to this session and view (with this page's token: an editor's link lets its
-  /// reader edit).
-  shareUrl() {
-    const q = new URLSearchParams({ session: this.session, token: this.token, camera: this.camera.toString() });
+  /// "Share this view" says what the link grants when that is more than viewing.
+  shareLabel() {
+    return this.editor && !this.viewerToken ? 'Share this view (lets its reader edit)' : 'Share this view';
+  }
+
+  /// A link to this session and view: with the viewer token where the page knows it, unless
+  /// `editing` (then, and without one, this page's token: an editor's lets its reader edit).
+  shareUrl(editing = false) {
+    const token = !editing && this.viewerToken ? this.viewerToken : this.token;
+    const q = new URLSearchParams({ session: this.session, token });
+    if (editing && this.viewerToken) q.set('viewer', this.viewerToken);
+    q.set('camera', this.camera.toString());
     return `${location.origin}/?${q}`;
   }
 
-  async share() {
-    const url = this.shareUrl();
+  async share(editing) {
+    const url = this.shareUrl(editing);
     try {
       await navigator.clipboard.writeText(url);
-      this.say('link to this view copied');
+      this.say(editing ? 'link for editing copied' : 'link to this view copied');
     } catch (_) {
       prompt('Link to this view:', url);
     }

@@ -1,6 +1,9 @@
 // Two browsers on one session, driven as reviewers use them:
 //   node session.mjs --editor URL --viewer URL [--timeout-s S]
-// (URLs of the page with ui on). The editor drags its first light's gizmo; the viewer must
+// (URLs of the page with ui on; the editor's carrying the viewer token as `viewer`). The
+// editor's share links: the view's with the viewer token, the editing one with its own; a
+// page whose `viewer` is not the session's viewer token refuses to start. The editor drags
+// its first light's gizmo; the viewer must
 // draw the version that carries it and show the light where the editor put it. The viewer's
 // gizmos do not drag, and a light change it sends is refused. The viewer's connection is then
 // dropped; it connects again and draws the editor's next drag. Prints one JSON line of what
@@ -14,7 +17,9 @@ const browser = await puppeteer.launch(launchOptions(args));
 const out = {};
 let status = 0;
 
-async function open(url) {
+/// The page at `url` once it has drawn, or failed (`window.pic.error`, thrown unless
+/// `failing`).
+async function open(url, failing = false) {
   const page = await browser.newPage();
   await page.setViewport({ width: 960, height: 600, deviceScaleFactor: 1 });
   page.logs = [];
@@ -23,7 +28,7 @@ async function open(url) {
   await page.goto(url);
   await page.waitForFunction(() => window.pic && (window.pic.state !== 'loading'), { timeout, polling: 50 });
   const error = await page.evaluate(() => window.pic.error);
-  if (error) throw new Error(`${url}: ${error}\n${page.logs.join('\n')}`);
+  if (error && !failing) throw new Error(`${url}: ${error}\n${page.logs.join('\n')}`);
   return page;
 }
 
@@ -55,6 +60,18 @@ try {
   const viewer = await open(args.viewer);
   out.editorRole = await editor.evaluate(() => window.pic.role);
   out.viewerRole = await viewer.evaluate(() => window.pic.role);
+  const shareLinks = (page) => page.evaluate(() => ({
+    view: window.pic.panel.shareUrl(false), edit: window.pic.panel.shareUrl(true),
+    label: document.getElementById('share').textContent,
+    editButton: document.getElementById('share-edit') !== null,
+  }));
+  out.editorShare = await shareLinks(editor);
+  out.viewerShare = await shareLinks(viewer);
+  const wrongViewer = new URL(args.editor);
+  wrongViewer.searchParams.set('viewer', wrongViewer.searchParams.get('token'));
+  const refused = await open(wrongViewer.href, true);
+  out.wrongViewerError = await refused.evaluate(() => window.pic.error);
+  await refused.close();
   const before = await viewer.evaluate(() => window.pic.lights.lights[0]);
   const id = await drag(editor, 80, 30);
   const seen = await drawnEdit(editor, viewer, id);
