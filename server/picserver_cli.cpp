@@ -132,8 +132,9 @@ int picserverMain(int argc, char** argv) {
                  "serve a non-loopback --listen without --api-keys (anyone who reaches the port "
                  "may create sessions and download the scenes)");
     app.add_option("--set-lights-per-second", options.session.setLightsPerSecond,
-                   "light sets a second one session accepts (as many at once); beyond, "
-                   "RESOURCE_EXHAUSTED with the delay to wait (default 30)")
+                   "light sets a second one session accepts (as many at once), preset "
+                   "changes counted with them; beyond, RESOURCE_EXHAUSTED with the delay "
+                   "to wait (default 30)")
         ->check(CLI::Range(0.01, 1e6));
     app.add_option("--update-budget-ms", options.session.updateBudgetMs,
                    "an update expected to take longer than this (the session's last one did) "

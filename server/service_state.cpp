@@ -47,6 +47,16 @@ grpc::Status sessionStatus(const Error& error) {
                                        : wire::toStatus(error);
 }
 
+/// The refusal of a write over the session's rate (Session::takeWriteTurn), `wait` ms early.
+grpc::Status writeRateStatus(const PicServer::State& state, const Session& session,
+                             std::chrono::milliseconds wait) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        fmt::format("session {} takes at most {:g} light sets a second (preset "
+                                    "changes count as light sets); retry in {} ms",
+                                    session.id(), state.options.session.setLightsPerSecond,
+                                    wait.count()));
+}
+
 }  // namespace
 
 SetLightsOutcome setLights(PicServer::State& state, const Access& access,
@@ -59,12 +69,9 @@ SetLightsOutcome setLights(PicServer::State& state, const Access& access,
         return outcome;
     }
     const std::shared_ptr<Session>& session = access.session;
-    if (const auto wait = session->takeSetLightsTurn(); wait.count() > 0) {
+    if (const auto wait = session->takeWriteTurn(); wait.count() > 0) {
         outcome.retryAfter = wait;
-        outcome.status = grpc::Status(
-            grpc::StatusCode::RESOURCE_EXHAUSTED,
-            fmt::format("session {} takes at most {:g} light sets a second; retry in {} ms",
-                        session->id(), state.options.session.setLightsPerSecond, wait.count()));
+        outcome.status = writeRateStatus(state, *session, wait);
         return outcome;
     }
     auto lights = parse();
@@ -109,6 +116,11 @@ PresetsOutcome changePresets(
     const std::function<grpc::Status()>& notDone, std::string_view notApplied) {
     PresetsOutcome outcome;
     const std::shared_ptr<Session>& session = access.session;
+    if (const auto wait = session->takeWriteTurn(); wait.count() > 0) {
+        outcome.retryAfter = wait;
+        outcome.status = writeRateStatus(state, *session, wait);
+        return outcome;
+    }
     // Durable before the reply, as a light set.
     StoreCommit stored;
     Session::PresetsCommit commit;

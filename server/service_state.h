@@ -282,8 +282,8 @@ struct SetLightsOutcome {
 };
 
 /// SetLights for both transports: an editor's light set (else PERMISSION_DENIED) for the
-/// session `access` admitted, at most SessionOptions::setLightsPerSecond of them
-/// (RESOURCE_EXHAUSTED with the wait), `parse`d only once the rate limit let it through
+/// session `access` admitted, at most SessionOptions::setLightsPerSecond of them with the
+/// preset changes (RESOURCE_EXHAUSTED with the wait), `parse`d only once the rate limit let it through
 /// (its error's status), checked against the scene (INVALID_ARGUMENT), committed to the
 /// database before it returns, then queued. UNAVAILABLE when the session moved to another
 /// server (evicted here; the set was not applied) or closed while it was set, or the
@@ -295,12 +295,15 @@ SetLightsOutcome setLights(PicServer::State& state, const Access& access,
 struct PresetsOutcome {
     grpc::Status status;
     std::vector<std::string> names;  ///< the presets' names after it, when status is OK
+    /// When status is RESOURCE_EXHAUSTED by the session's rate limit: how long to wait.
+    std::chrono::milliseconds retryAfter{0};
 };
 
 /// Creates or replaces preset `name` for both transports: an editor's (else
 /// PERMISSION_DENIED) light set for the session `access` admitted, `parse`d (its error's
 /// status), checked as SetLights checks a set (INVALID_ARGUMENT, as for a name checkPresetName
-/// refuses), at most kMaxPresets of them (RESOURCE_EXHAUSTED), committed to the database
+/// refuses), at most kMaxPresets of them (RESOURCE_EXHAUSTED), counted against the session's
+/// rate of light sets (RESOURCE_EXHAUSTED with the wait), committed to the database
 /// before it returns. UNAVAILABLE when the session moved to another server (evicted here;
 /// nothing changed) or closed meanwhile, or the database failed. `access.status` must be OK.
 PresetsOutcome setPreset(PicServer::State& state, const Access& access, const std::string& name,

@@ -88,7 +88,7 @@ Session::Session(std::string id, std::string editorDigest, std::string viewerDig
       mPool(pool),
       mOptions(std::move(options)),
       mCreator(std::move(start.creator)),
-      mSetLightsRate(mOptions.setLightsPerSecond, mOptions.setLightsPerSecond) {
+      mWriteRate(mOptions.setLightsPerSecond, mOptions.setLightsPerSecond) {
     mLatestLights = start.lights ? std::move(*start.lights) : defaultLightSet(bake.scene());
     mPresets = std::move(start.presets);
     mNextVersion = std::max<uint64_t>(start.version, 1);

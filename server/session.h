@@ -112,8 +112,9 @@ struct SessionOptions {
     uint32_t keyframeInterval = 32;   ///< every N-th version is broadcast as a key frame
     int zstdLevel = kDefaultZstdLevel;
     std::function<void(const UpdateLog&)> log;  ///< called once per computed update
-    /// Light sets a second the session accepts (burst: as many); beyond, SetLights is refused
-    /// with the time until the next one would be accepted.
+    /// Writes a second the session accepts, light sets and preset changes together (each one
+    /// a database transaction; burst: as many); beyond, they are refused with the time until
+    /// the next one would be accepted.
     double setLightsPerSecond = 30.0;
     /// Milliseconds an update may take before its caches are streamed in parts (0: never;
     /// server/progressive.h).
@@ -150,9 +151,9 @@ public:
     ServedBake& bake() const { return mBake; }
     /// SessionStart::creator.
     const std::string& creator() const { return mCreator; }
-    /// A light set's turn under SessionOptions::setLightsPerSecond: zero when it may go on,
-    /// else how long until one may.
-    std::chrono::milliseconds takeSetLightsTurn() { return mSetLightsRate.take(); }
+    /// A write's turn (a light set or a preset change) under
+    /// SessionOptions::setLightsPerSecond: zero when it may go on, else how long until one may.
+    std::chrono::milliseconds takeWriteTurn() { return mWriteRate.take(); }
 
     /// What makes an accepted light set durable before the session queues it (the server's
     /// database): called with the version the set will produce; its error refuses the set.
@@ -243,7 +244,7 @@ private:
     RelightPool& mPool;
     SessionOptions mOptions;
     std::string mCreator;
-    TokenBucket mSetLightsRate;
+    TokenBucket mWriteRate;
 
     std::mutex mPublishMutex;  ///< orders puts into slots: publishes and first updates
     std::mutex mCommitMutex;   ///< one light set or presets change committed at a time

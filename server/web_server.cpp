@@ -337,6 +337,7 @@ int servePresets(mg_connection* connection, void* data) {
         refusedTooLarge = true;
     }
     nlohmann::json answer;
+    std::chrono::milliseconds retryAfter{0};
     if (status.ok()) {
         access = authorise(state, request.sessionId, request.token);
         status = access.status;
@@ -349,12 +350,13 @@ int servePresets(mg_connection* connection, void* data) {
             method == "PUT" ? setPreset(state, access, name, [&] { return parseLightSet(body); })
                             : removePreset(state, access, name);
         status = outcome.status;
+        retryAfter = outcome.retryAfter;
         answer = {{"presets", outcome.names}};
     }
     state.recordCall(request.peer, request.forwarded, "WebPresets", roleName(access.role),
                      request.sessionId, status);
     if (refusedTooLarge) return refuse(connection, status, 413);
-    if (!status.ok()) return refuse(connection, status);
+    if (!status.ok()) return refuse(connection, status, retryAfter);
     return replyJson(connection, answer);
 }
 

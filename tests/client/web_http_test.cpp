@@ -352,6 +352,16 @@ TEST(WebHttp, TheRateLimitAnswers429WithRetryAfter) {
     const HttpReply second = httpRequest(address, "POST", path, toJson(pointLight(0.2f)));
     expectRefusal(second, 429, "RESOURCE_EXHAUSTED", "at most 1 light sets a second");
     EXPECT_EQ(second.header("Retry-After"), "1") << "≤ 1000 ms rounded up to whole seconds";
+
+    // Preset changes are writes too: within the same second, saving and deleting one are
+    // refused alike, and nothing is saved.
+    const std::string presets = "/v1/presets" + sessionQuery(session->session(), session->editor_token());
+    const HttpReply save = httpRequest(address, "PUT", presets + "&name=day", toJson(pointLight(0.3f)));
+    expectRefusal(save, 429, "RESOURCE_EXHAUSTED", "preset changes count as light sets");
+    EXPECT_EQ(save.header("Retry-After"), "1");
+    const HttpReply remove = httpRequest(address, "DELETE", presets + "&name=day", "");
+    expectRefusal(remove, 429, "RESOURCE_EXHAUSTED", "at most 1 light sets a second");
+    EXPECT_TRUE(served.server->session(session->session())->presets().empty());
 }
 
 /// The JSON body of a 200 reply not to be cached, failing the test where it is not one.
