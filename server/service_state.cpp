@@ -47,14 +47,19 @@ grpc::Status sessionStatus(const Error& error) {
                                        : wire::toStatus(error);
 }
 
-/// The refusal of a write over the session's rate (Session::takeWriteTurn), `wait` ms early.
-grpc::Status writeRateStatus(const PicServer::State& state, const Session& session,
-                             std::chrono::milliseconds wait) {
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        fmt::format("session {} takes at most {:g} light sets a second (preset "
-                                    "changes count as light sets); retry in {} ms",
-                                    session.id(), state.options.session.setLightsPerSecond,
-                                    wait.count()));
+/// Takes `session`'s turn for a write (Session::takeWriteTurn): false when it may go on, else
+/// true with `outcome` (a SetLightsOutcome or PresetsOutcome) refused with the wait.
+template <typename Outcome>
+bool overWriteRate(const PicServer::State& state, Session& session, Outcome& outcome) {
+    const auto wait = session.takeWriteTurn();
+    if (wait.count() <= 0) return false;
+    outcome.retryAfter = wait;
+    outcome.status = grpc::Status(
+        grpc::StatusCode::RESOURCE_EXHAUSTED,
+        fmt::format("session {} takes at most {:g} light sets a second (preset changes count "
+                    "as light sets); retry in {} ms",
+                    session.id(), state.options.session.setLightsPerSecond, wait.count()));
+    return true;
 }
 
 }  // namespace
@@ -69,11 +74,7 @@ SetLightsOutcome setLights(PicServer::State& state, const Access& access,
         return outcome;
     }
     const std::shared_ptr<Session>& session = access.session;
-    if (const auto wait = session->takeWriteTurn(); wait.count() > 0) {
-        outcome.retryAfter = wait;
-        outcome.status = writeRateStatus(state, *session, wait);
-        return outcome;
-    }
+    if (overWriteRate(state, *session, outcome)) return outcome;
     auto lights = parse();
     if (!lights) {
         outcome.status = wire::toStatus(lights.error());
@@ -116,11 +117,7 @@ PresetsOutcome changePresets(
     const std::function<grpc::Status()>& notDone, std::string_view notApplied) {
     PresetsOutcome outcome;
     const std::shared_ptr<Session>& session = access.session;
-    if (const auto wait = session->takeWriteTurn(); wait.count() > 0) {
-        outcome.retryAfter = wait;
-        outcome.status = writeRateStatus(state, *session, wait);
-        return outcome;
-    }
+    if (overWriteRate(state, *session, outcome)) return outcome;
     // Durable before the reply, as a light set.
     StoreCommit stored;
     Session::PresetsCommit commit;

@@ -17,6 +17,7 @@
 #include "server/served_bake.h"
 #include "tests/client/stream_fixture.h"
 #include "tests/support/baked_scene.h"
+#include "tests/support/lights.h"
 
 namespace pic {
 namespace {
@@ -172,15 +173,10 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BrowserParity,
                                          ParityCase{"atrium", 8192, "384x216", false}),
                          [](const auto& info) { return info.param.scene; });
 
-/// One light at `position` with the given id.
+/// A white point light "lamp" at `position`, alone in its set.
 LightSet pointAt(const glm::vec3& position, float intensity) {
-    Light light;
-    light.id = "lamp";
-    light.type = LightType::Point;
-    light.position = position;
-    light.intensity = intensity;
     LightSet set;
-    set.lights = {light};
+    set.lights = {pointLight(position, intensity, glm::vec3(1.0f))};
     return set;
 }
 

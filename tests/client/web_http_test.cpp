@@ -35,6 +35,11 @@ using namespace std::chrono_literals;
 using namespace test;
 using Json = nlohmann::json;
 
+/// The calls of `call` that ended with gRPC code `code`, as the server's metrics text counts them.
+double callsCounted(const std::string& metrics, const std::string& call, const std::string& code) {
+    return metricValue(metrics, "pic_calls_total{call=\"" + call + "\",code=\"" + code + "\"}");
+}
+
 /// A decompressed scene blob: its JSON and its binary area (from B on).
 struct WebBlob {
     Json json;
@@ -245,8 +250,7 @@ TEST(WebHttp, TheSceneIsTheSessionsBakeForAnyOfItsTokens) {
     EXPECT_TRUE(held.body.empty());
 
     const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
-    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebScene\",code=\"OK\"}"), 3.0)
-        << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebScene", "OK"), 3.0) << metrics.body;
 }
 
 TEST(WebHttp, SessionRoutesRefuseWithTheStatusAndJson) {
@@ -273,13 +277,8 @@ TEST(WebHttp, SessionRoutesRefuseWithTheStatusAndJson) {
     EXPECT_EQ(wrong.header("Allow"), "GET");
 
     const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
-    EXPECT_EQ(
-        metricValue(metrics.body, "pic_calls_total{call=\"WebScene\",code=\"UNAUTHENTICATED\"}"),
-        1.0)
-        << metrics.body;
-    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebScene\",code=\"NOT_FOUND\"}"),
-              1.0)
-        << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebScene", "UNAUTHENTICATED"), 1.0) << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebScene", "NOT_FOUND"), 1.0) << metrics.body;
 }
 
 TEST(WebHttp, AnEditorsLightSetReachesTheStreamAsItsVersion) {
@@ -329,12 +328,8 @@ TEST(WebHttp, AnEditorsLightSetReachesTheStreamAsItsVersion) {
         << "no refused set was applied";
 
     const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
-    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebSetLights\",code=\"OK\"}"), 1.0)
-        << metrics.body;
-    EXPECT_EQ(metricValue(metrics.body,
-                          "pic_calls_total{call=\"WebSetLights\",code=\"PERMISSION_DENIED\"}"),
-              1.0)
-        << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebSetLights", "OK"), 1.0) << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebSetLights", "PERMISSION_DENIED"), 1.0) << metrics.body;
 }
 
 TEST(WebHttp, TheRateLimitAnswers429WithRetryAfter) {
@@ -355,8 +350,10 @@ TEST(WebHttp, TheRateLimitAnswers429WithRetryAfter) {
 
     // Preset changes are writes too: within the same second, saving and deleting one are
     // refused alike, and nothing is saved.
-    const std::string presets = "/v1/presets" + sessionQuery(session->session(), session->editor_token());
-    const HttpReply save = httpRequest(address, "PUT", presets + "&name=day", toJson(pointLight(0.3f)));
+    const std::string presets =
+        "/v1/presets" + sessionQuery(session->session(), session->editor_token());
+    const HttpReply save =
+        httpRequest(address, "PUT", presets + "&name=day", toJson(pointLight(0.3f)));
     expectRefusal(save, 429, "RESOURCE_EXHAUSTED", "preset changes count as light sets");
     EXPECT_EQ(save.header("Retry-After"), "1");
     const HttpReply remove = httpRequest(address, "DELETE", presets + "&name=day", "");
@@ -439,12 +436,8 @@ TEST(WebHttp, TheSessionSaysTheRoleTheNewestSetAndThePresets) {
                   "INVALID_ARGUMENT", "session=");
 
     const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
-    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebSession\",code=\"OK\"}"), 2.0)
-        << metrics.body;
-    EXPECT_EQ(
-        metricValue(metrics.body, "pic_calls_total{call=\"WebSession\",code=\"UNAUTHENTICATED\"}"),
-        1.0)
-        << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebSession", "OK"), 2.0) << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebSession", "UNAUTHENTICATED"), 1.0) << metrics.body;
 }
 
 TEST(WebHttp, AnEditorSavesListsReplacesAndDeletesPresets) {
@@ -525,13 +518,8 @@ TEST(WebHttp, AnEditorSavesListsReplacesAndDeletesPresets) {
                   "no preset \"warm-1.b\"");
 
     const HttpReply metrics = httpGet(served.server->metricsAddress(), "/metrics");
-    EXPECT_EQ(metricValue(metrics.body,
-                          "pic_calls_total{call=\"WebPresets\",code=\"PERMISSION_DENIED\"}"),
-              2.0)
-        << metrics.body;
-    EXPECT_EQ(metricValue(metrics.body, "pic_calls_total{call=\"WebPresets\",code=\"NOT_FOUND\"}"),
-              1.0)
-        << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebPresets", "PERMISSION_DENIED"), 2.0) << metrics.body;
+    EXPECT_EQ(callsCounted(metrics.body, "WebPresets", "NOT_FOUND"), 1.0) << metrics.body;
 }
 
 TEST(WebHttp, ASessionHoldsAtMost32Presets) {

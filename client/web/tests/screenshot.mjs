@@ -2,26 +2,20 @@
 // saves the canvas as PNG once the page has drawn a version's final state:
 //   node screenshot.mjs --url URL --out FILE.png [--version N] [--timeout-s S]
 //                       [--chromium PATH] [--page 1]
-// (--page 1: the whole page, panel and gizmos included, not the canvas alone). Prints one JSON line: the page's window.pic report (versions, sizes, times). Exit status 1
-// with the page's error or a timeout on stderr.
-import puppeteer from 'puppeteer-core';
-import { launchOptions, parseArgs } from './browser.mjs';
+// (--page 1: the whole page, panel and gizmos included, not the canvas alone). Prints one JSON
+// line: the page's window.pic report (versions, sizes, times). Exit status 1 with the page's
+// error or a timeout on stderr.
+import { newPage, parseArgs, runWithBrowser } from './browser.mjs';
 
 const args = parseArgs(process.argv.slice(2), { version: '1', 'timeout-s': '120' });
 if (!args.url || !args.out) {
   console.error('usage: node screenshot.mjs --url URL --out FILE.png [--version N] [--timeout-s S]');
   process.exit(2);
 }
-const browser = await puppeteer.launch(launchOptions(args));
-let status = 0;
-try {
-  const page = await browser.newPage();
+await runWithBrowser(args, async (browser) => {
   const size = /[?&]size=(\d+)x(\d+)/.exec(args.url);
-  await page.setViewport({ width: size ? Number(size[1]) : 800, height: size ? Number(size[2]) : 600,
-                           deviceScaleFactor: 1 });
-  const logs = [];
-  page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
-  page.on('pageerror', (e) => logs.push(`page error: ${e.message}`));
+  const page = await newPage(browser, { width: size ? Number(size[1]) : 800,
+                                        height: size ? Number(size[2]) : 600 });
   await page.goto(args.url);
   const version = Number(args.version);
   await page.waitForFunction(
@@ -32,18 +26,12 @@ try {
     const { stream, panel, ...rest } = window.pic;
     return rest;
   });
-  if (report.state === 'error') throw new Error(`the page failed: ${report.error}\n${logs.join('\n')}`);
+  if (report.state === 'error') throw new Error(`the page failed: ${report.error}\n${page.logs.join('\n')}`);
   if (args.page) {
     await page.screenshot({ path: args.out });
   } else {
     const canvas = await page.$('canvas');
     await canvas.screenshot({ path: args.out, omitBackground: false });
   }
-  console.log(JSON.stringify(report));
-} catch (error) {
-  console.error(error.message);
-  status = 1;
-} finally {
-  await browser.close();
-}
-process.exit(status);
+  return report;
+});

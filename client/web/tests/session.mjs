@@ -8,23 +8,15 @@
 // gizmos do not drag, and a light change it sends is refused. The viewer's connection is then
 // dropped; it connects again and draws the editor's next drag. Prints one JSON line of what
 // happened; exit status 1 with the reason on stderr.
-import puppeteer from 'puppeteer-core';
-import { launchOptions, parseArgs } from './browser.mjs';
+import { newPage, parseArgs, runWithBrowser } from './browser.mjs';
 
 const args = parseArgs(process.argv.slice(2), { 'timeout-s': '120' });
 const timeout = Number(args['timeout-s']) * 1000;
-const browser = await puppeteer.launch(launchOptions(args));
-const out = {};
-let status = 0;
 
-/// The page at `url` once it has drawn, or failed (`window.pic.error`, thrown unless
+/// `browser`'s page at `url` once it has drawn, or failed (`window.pic.error`, thrown unless
 /// `failing`).
-async function open(url, failing = false) {
-  const page = await browser.newPage();
-  await page.setViewport({ width: 960, height: 600, deviceScaleFactor: 1 });
-  page.logs = [];
-  page.on('console', (m) => page.logs.push(`${m.type()}: ${m.text()}`));
-  page.on('pageerror', (e) => page.logs.push(`page error: ${e.message}`));
+async function open(browser, url, failing = false) {
+  const page = await newPage(browser, { width: 960, height: 600 });
   await page.goto(url);
   await page.waitForFunction(() => window.pic && (window.pic.state !== 'loading'), { timeout, polling: 50 });
   const error = await page.evaluate(() => window.pic.error);
@@ -55,9 +47,10 @@ async function drawnEdit(editor, page, id, after = 0) {
   return { version, light };
 }
 
-try {
-  const editor = await open(args.editor);
-  const viewer = await open(args.viewer);
+await runWithBrowser(args, async (browser) => {
+  const out = {};
+  const editor = await open(browser, args.editor);
+  const viewer = await open(browser, args.viewer);
   out.editorRole = await editor.evaluate(() => window.pic.role);
   out.viewerRole = await viewer.evaluate(() => window.pic.role);
   const shareLinks = (page) => page.evaluate(() => ({
@@ -69,7 +62,7 @@ try {
   out.viewerShare = await shareLinks(viewer);
   const wrongViewer = new URL(args.editor);
   wrongViewer.searchParams.set('viewer', wrongViewer.searchParams.get('token'));
-  const refused = await open(wrongViewer.href, true);
+  const refused = await open(browser, wrongViewer.href, true);
   out.wrongViewerError = await refused.evaluate(() => window.pic.error);
   await refused.close();
   const before = await viewer.evaluate(() => window.pic.lights.lights[0]);
@@ -101,11 +94,5 @@ try {
   out.resumed = { version: resumed.version, light: resumed.light,
                   connections: await viewer.evaluate(() => window.pic.stream.connections) };
   out.editorLightAfter = await editor.evaluate((lightId) => window.pic.panel.lights().lights.find((l) => l.id === lightId), id);
-  console.log(JSON.stringify(out));
-} catch (error) {
-  console.error(error.message);
-  status = 1;
-} finally {
-  await browser.close();
-}
-process.exit(status);
+  return out;
+});
