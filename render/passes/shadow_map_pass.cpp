@@ -397,7 +397,8 @@ void ShadowMapPass::bindPipeline(VkCommandBuffer cmd, VkPipeline pipeline, uint3
     const VkRect2D scissor{{0, 0}, {side, side}};
     vkCmdSetViewport(cmd, 0, 1, &viewport);
     vkCmdSetScissor(cmd, 0, 1, &scissor);
-    const ShadowMapPush push{mLayers[layer].clipFromWorld};
+    const ShadowMapPush push{.clipFromWorld = mLayers[layer].clipFromWorld,
+                             .viewport = glm::vec2(float(side))};
     vkCmdPushConstants(cmd, mPipelineLayout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push),
                        &push);
     const VkBuffer vertices = mVertices.handle();

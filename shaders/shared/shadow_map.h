@@ -59,11 +59,13 @@ struct GpuShadowLayer {
 };
 PIC_STRUCT_CHECK(GpuShadowLayer, 80);
 
-// Push constants of the rasteriser: one layer's clip-from-world matrix.
+// Push constants of the rasteriser: one layer's clip-from-world matrix and its side.
 struct ShadowMapPush {
     mat4 clipFromWorld;
+    vec2 viewport;  // texels: the layer's side, twice (lib/subpixel.glsl snapToSubpixels)
+    vec2 pad0;
 };
-PIC_STRUCT_CHECK(ShadowMapPush, 64);
+PIC_STRUCT_CHECK(ShadowMapPush, 80);
 
 PIC_NAMESPACE_END
 

@@ -51,8 +51,8 @@ export function subsampleOffset(s, n) {
   return [(s + 0.5) / n, shifted - Math.floor(shifted)];
 }
 
-/// What the G-buffer pass draws one subsample with: clip (WebGL's clip-from-world, image row 0
-/// at the top of the canvas), forward, and the ray direction's change per pixel scaled by
+/// What the G-buffer pass draws one subsample with: clip (WebGL's clip-from-world, the image's
+/// top row at the targets' row 0), forward, and the ray direction's change per pixel scaled by
 /// footprintScale (texture footprints). With depth.zeroToOne (EXT_clip_control's 0..1 depth)
 /// the stored depth is near/w, the Vulkan renderer's reversed depth (test GREATER, clear 0);
 /// without it, a conventional −1..1 depth between depth.near and depth.far (test LESS, clear 1).
@@ -73,8 +73,10 @@ export function gbufferView(camera, width, height, near, offset, footprintScale,
     rows[0][c] += shiftX * rowW[c];
     rows[1][c] += shiftY * rowW[c];
   }
-  // WebGL's window y grows upward where Vulkan's framebuffer y grows downward: y flips.
-  rows[1] = rows[1].map((x) => -x);
+  // Not flipped for WebGL's upward window y: the targets hold the image top row first, as
+  // the Vulkan renderer's do, so that an edge through a pixel centre (SwiftShader snaps
+  // vertices to 1/16 pixel, which puts many there) goes to the side lavapipe gives it; the
+  // display pass flips.
   if (depth.zeroToOne) {
     rows[2] = [0, 0, 0, near];
   } else {

@@ -221,6 +221,7 @@ export class Renderer {
         gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, this.shadowDepth, 0,
                                    shadow.firstLayer + i);
         gl.viewport(0, 0, layer.side, layer.side);
+        gl.uniform2f(p.uniforms.viewport, layer.side, layer.side);
         gl.clear(gl.DEPTH_BUFFER_BIT);
         gl.uniformMatrix4fv(p.uniforms.clip, false,
                             this.clipControl ? layer.clip : glDepthFromZo(layer.clip));

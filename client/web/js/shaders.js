@@ -16,10 +16,22 @@ const int kDataWidth = ${kDataWidth};
 ivec2 dataAt(int i) { return ivec2(i % kDataWidth, i / kDataWidth); }
 `;
 
-export const shadowVertex = `${prelude}
+// shaders/lib/subpixel.glsl: framebuffer x, y on the 1/16-pixel grid every rasteriser shares
+// (SwiftShader snaps to 1/16, lavapipe to 1/256), plus 1/1024 pixel.
+const snapToSubpixels = `
+uniform vec2 viewport;
+vec4 snapToSubpixels(vec4 clip) {
+  if (!(clip.w > 0.0)) return clip;
+  vec2 pixels = (clip.xy / clip.w * 0.5 + 0.5) * viewport;
+  vec2 snapped = (floor(pixels * 16.0 + 0.5) + 1.0 / 64.0) / 16.0;
+  return vec4((snapped / viewport * 2.0 - 1.0) * clip.w, clip.zw);
+}
+`;
+
+export const shadowVertex = `${prelude}${snapToSubpixels}
 in vec3 position;
 uniform mat4 clip;
-void main() { gl_Position = clip * vec4(position, 1.0); }
+void main() { gl_Position = snapToSubpixels(clip * vec4(position, 1.0)); }
 `;
 
 export const shadowFragment = `${prelude}
@@ -512,7 +524,9 @@ float srgb(float linear) {
   return linear <= 0.0031308 ? 12.92 * linear : 1.055 * pow(linear, 1.0 / 2.4) - 0.055;
 }
 void main() {
-  vec3 v = clamp(texelFetch(radianceSum, ivec2(gl_FragCoord.xy), 0).rgb / samples * exposure, 0.0, 1.0);
+  // The sums hold the image top row first (camera.js gbufferView); the canvas's y grows upward.
+  ivec2 xy = ivec2(gl_FragCoord.x, float(textureSize(radianceSum, 0).y) - gl_FragCoord.y);
+  vec3 v = clamp(texelFetch(radianceSum, xy, 0).rgb / samples * exposure, 0.0, 1.0);
   outColor = vec4(srgb(v.r), srgb(v.g), srgb(v.b), 1.0);
 }
 `;

@@ -1,7 +1,8 @@
 // The shadow-map pass on lavapipe (or the machine's GPU): merged coplanar casters and solids
 // drawn from one side store the same depths as the scene's own triangles drawn from both
 // sides; levels of detail stay within their error; footprint sides give the orthographic
-// texel at the median receiver distance; only lights that changed are rendered again.
+// texel at the median receiver distance; only lights that changed are rendered again;
+// vertices land on the 1/16-texel grid.
 
 #include <gtest/gtest.h>
 
@@ -106,11 +107,14 @@ TEST_P(ShadowCasters, MergedAndOneSidedStoreTheSameDepths) {
 
     // Merged coplanar triangles cover the same surfaces. Their longer edges round
     // differently, so texel centres that lie on an edge (within rounding) may change sides:
-    // a few texels on silhouettes, nothing else.
+    // a few texels on silhouettes, nothing else. Each triangulation's corners snap to the
+    // 1/16-texel grid (lib/subpixel.glsl) in their own way, which tilts a triangle's depth
+    // by its depth change over up to 1/32 texel: on the atrium's surfaces that graze the
+    // light, 3e-4 of the depth range at 0.6 % of the texels, under 1e-3 at 0.01 %.
     const auto merged =
         render({.mergeCoplanar = true, .oneSidedSolids = true, .levelsOfDetail = false}, oneSided);
-    differingTexels(merged, reference, 1e-4f, fraction);
-    EXPECT_LE(fraction, 5e-3) << GetParam() << ": merged casters, differences > 1e-4";
+    differingTexels(merged, reference, 1e-3f, fraction);
+    EXPECT_LE(fraction, 5e-3) << GetParam() << ": merged casters, differences > 1e-3";
     differingTexels(merged, reference, 1e-2f, fraction);
     EXPECT_LE(fraction, 5e-4) << GetParam() << ": merged casters, differences > 1e-2";
     EXPECT_EQ((*context)->validationMessages(), 0u);
@@ -377,6 +381,86 @@ TEST(GpuShadowMaps, OnlyLightsThatChangedAreRerendered) {
     lights.lights[1].position.x += 0.05f;
     ASSERT_TRUE(gpu->setLights(lights, &stats));
     EXPECT_EQ(stats.shadowMapsRendered, 1);
+}
+
+/// A floor (y = −1) and a marker triangle at y = 1, which fix the scene's bounds, and a
+/// caster quad from x = xa to xb (|z| ≤ 0.3) whose height rises with x (y = x/2).
+Scene tiltedCasterScene(float xa, float xb) {
+    Scene scene;
+    scene.materials = {Material{.name = "grey"}};
+    const auto add = [&](std::initializer_list<glm::vec3> corners) {
+        const uint32_t first = uint32_t(scene.vertices.size());
+        for (const glm::vec3& p : corners) {
+            Vertex v;
+            v.position = p;
+            scene.vertices.push_back(v);
+            scene.bounds.extend(p);
+        }
+        for (uint32_t k = 1; k + 1 < corners.size(); ++k)
+            scene.triangles.push_back(Triangle{{first, first + k, first + k + 1}, 0, 0});
+    };
+    add({{-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}});
+    add({{0.9f, 1, 0.9f}, {1, 1, 0.9f}, {1, 1, 1}});
+    add({{xa, 0.5f * xa, -0.3f},
+         {xb, 0.5f * xb, -0.3f},
+         {xb, 0.5f * xb, 0.3f},
+         {xa, 0.5f * xa, 0.3f}});
+    for (Triangle& t : scene.triangles) {
+        const glm::vec3 n = glm::normalize(
+            glm::cross(scene.vertices[t.v[1]].position - scene.vertices[t.v[0]].position,
+                       scene.vertices[t.v[2]].position - scene.vertices[t.v[0]].position));
+        for (uint32_t v : t.v) scene.vertices[v].normal = n;
+    }
+    return scene;
+}
+
+// shadow_map.vert puts vertices on the 1/16-texel grid (lib/subpixel.glsl), which every
+// rasteriser represents; lavapipe's own grid is 1/256. A caster whose corners all lie 0.02
+// texel past texel centres (in x) is drawn 0.02 texel nearer them, minus the 1/1024 nudge:
+// the depth stored at a texel centre is the tilted caster's depth that far to the side.
+TEST(GpuShadowMaps, VerticesSnapToTheSixteenthTexelGrid) {
+    auto context = gpu::Context::create();
+    if (!context) GTEST_SKIP() << "no Vulkan device: " << context.error().message;
+    constexpr uint32_t kSize = 64;
+    LightSet sun;
+    sun.lights.push_back(
+        Light{.id = "sun", .type = LightType::Directional, .direction = {0, -1, 0}});
+    const auto create = [&](const Scene& scene) {
+        return gpu::createPass<gpu::ShadowMapPass>(
+            **context,
+            {.scene = &scene,
+             .shadowMapSize = kSize,
+             .shadowMap = {
+                 .mergeCoplanar = false, .oneSidedSolids = false, .levelsOfDetail = false}});
+    };
+    // The layer's matrix, from a first caster: the bounds, and so the layer, do not depend on
+    // where the caster lies between them.
+    const Scene first = tiltedCasterScene(-0.3f, 0.3f);
+    auto probe = create(first);
+    ASSERT_TRUE(probe) << probe.error().message;
+    bool reallocated = false;
+    ASSERT_TRUE((*probe)->prepare(sun, reallocated));
+    const glm::mat4 clip = (*probe)->layerRecords()[0].clipFromWorld;
+    const auto casterAt = [](float x) { return glm::vec4(x, 0.5f * x, 0.0f, 1.0f); };
+    const auto texelX = [&](float x) {
+        return ((clip * casterAt(x)).x * 0.5f + 0.5f) * float(kSize);
+    };
+    const auto worldX = [&](float u) { return (u - texelX(0.0f)) / (texelX(1.0f) - texelX(0.0f)); };
+    const auto depthAt = [&](float u) { return (clip * casterAt(worldX(u))).z; };
+
+    constexpr float kPast = 0.02f;
+    const Scene scene = tiltedCasterScene(worldX(20.5f + kPast), worldX(43.5f + kPast));
+    auto pass = create(scene);
+    ASSERT_TRUE(pass) << pass.error().message;
+    const auto layers = renderLayers(**context, **pass, sun);
+    ASSERT_EQ(layers.size(), 1u);
+    ASSERT_EQ((*pass)->layerRecords()[0].clipFromWorld, clip);
+    const float row = ((clip * glm::vec4(0, 0, 0, 1)).y * 0.5f + 0.5f) * float(kSize);
+    const float stored = layers[0][size_t(row) * kSize + 32];
+    const float exact = depthAt(32.5f);
+    const float snapped = depthAt(32.5f + kPast - 1.0f / 1024.0f);
+    ASSERT_GT(std::abs(snapped - exact), 1e-5f);
+    EXPECT_NEAR(stored, snapped, 0.1f * std::abs(snapped - exact)) << "unsnapped: " << exact;
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ShadowCasters,
