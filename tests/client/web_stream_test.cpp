@@ -180,7 +180,13 @@ TEST(WebStream, ABrowserGetsTheGrpcStreamsFramesAndDecodesTheServersCaches) {
     const auto frames = browser.frames();
     ASSERT_FALSE(frames.empty());
     EXPECT_EQ(frames.front().base_version(), 0u) << "a key frame first";
-    EXPECT_GE(live->stats().frames_sent(), frames.size() + 4);
+    // The WebSocket thread counts a frame once its write returns, which may be after the
+    // browser has read it.
+    const size_t sent = frames.size() + 4;
+    for (auto end = std::chrono::steady_clock::now() + 10s;
+         live->stats().frames_sent() < sent && std::chrono::steady_clock::now() < end;)
+        std::this_thread::sleep_for(10ms);
+    EXPECT_GE(live->stats().frames_sent(), sent);
 
     // A browser that connects later starts on the newest version's key frame.
     WebReader late(served.server->webAddress(), session->session(), session->editor_token());
