@@ -405,12 +405,6 @@ Scene tiltedCasterScene(float xa, float xb) {
          {xb, 0.5f * xb, -0.3f},
          {xb, 0.5f * xb, 0.3f},
          {xa, 0.5f * xa, 0.3f}});
-    for (Triangle& t : scene.triangles) {
-        const glm::vec3 n = glm::normalize(
-            glm::cross(scene.vertices[t.v[1]].position - scene.vertices[t.v[0]].position,
-                       scene.vertices[t.v[2]].position - scene.vertices[t.v[0]].position));
-        for (uint32_t v : t.v) scene.vertices[v].normal = n;
-    }
     return scene;
 }
 
